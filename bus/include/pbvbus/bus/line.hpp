@@ -1,0 +1,135 @@
+#pragma once
+// One RS-485 segment (design.md "The line").
+//
+// Carries 11-bit UART characters at the line's baud. Frames are delivered to each receiver as
+// one event at the end of their last stop bit; what every station observes is the same as with
+// character-by-character delivery:
+//  - two transmissions that overlap in time on the same piece of cable corrupt each other's
+//    overlapping characters (PROFIBUS has no collision detection; receivers see the damage);
+//  - noise flips bits (seeded), which a receiver sees as parity, framing or FCS errors;
+//  - a fault during a frame (cut, short, power loss, transceiver failure) ends it early, and
+//    receivers that lose the sender see a partial frame at the moment of the fault;
+//  - each receiver is told how long its segment was idle before the frame, which is what
+//    the FDL layer needs for the TSYN rule.
+// Propagation delay is taken as zero: at 12 Mbit/s 100 m of cable is ~6 bit times, less than
+// min TSDR, and PROFIBUS timing is specified at the stations.
+//
+// Attachments keep the order in which they were attached: that is their position along the
+// cable, which is what a cable cut between two stations refers to.
+
+#include <bitset>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pbvbus/bus/device.hpp"
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/bus/tap.hpp"
+
+namespace pbvbus::bus {
+
+using AttachmentId = int;
+
+struct LineStats {
+  std::uint64_t frames = 0;       ///< transmissions started
+  std::uint64_t collisions = 0;   ///< transmissions damaged by overlap
+  std::uint64_t noisy = 0;        ///< transmissions with at least one flipped bit
+  std::uint64_t partial = 0;      ///< transmissions cut short by a fault
+  std::uint64_t lost = 0;         ///< transmissions nobody could hear (short, dead transceiver)
+  std::uint64_t octets = 0;       ///< octets put on the wire
+};
+
+class Line final : private EventTarget {
+ public:
+  static constexpr int kMaxAttachments = 256;
+
+  Line(Scheduler& sched, std::string name, Baud baud, std::uint64_t seed = 1);
+  ~Line();
+  Line(const Line&) = delete;
+  Line& operator=(const Line&) = delete;
+
+  const std::string& name() const { return m_name; }
+  Baud baud() const { return m_baud; }
+  Ticks bit_ticks() const { return ticks_per_bit(m_baud); }
+  Scheduler& scheduler() { return m_sched; }
+  int index() const { return m_index; }
+  void set_index(int i) { m_index = i; }
+
+  /// Attaches `dev` at the next position along the cable. The device stays unpowered until
+  /// power_on() (or start()).
+  AttachmentId attach(Device& dev, std::string label = {});
+  int attachment_count() const { return static_cast<int>(m_atts.size()); }
+  Device& device(AttachmentId a);
+  const std::string& label(AttachmentId a) const;
+  bool powered(AttachmentId a) const;
+
+  /// Powers every attachment that is not yet powered, at the current time.
+  void start();
+
+  void add_tap(Tap& tap);
+  void remove_tap(Tap& tap);
+
+  // --- faults and repairs (each takes effect at the scheduler's current time) ---------------
+  /// Cuts the cable between position `a` and the position after it (a, a+1). Both sides go on
+  /// working as separate segments.
+  void set_cut_after(AttachmentId a, bool cut);
+  /// Cuts between two attachments: at the cable position right after the first of the two.
+  void set_cut_between(AttachmentId a, AttachmentId b, bool cut);
+  /// A short circuit: nothing can be received anywhere on the line.
+  void set_short_circuit(bool on);
+  /// Bit error rate in errors per 10^9 bits; 0 = no noise.
+  void set_noise(std::uint64_t errors_per_billion);
+  void set_power(AttachmentId a, bool on);
+  /// A failed transceiver neither drives nor hears the line; the device does not notice.
+  void set_transceiver_ok(AttachmentId a, bool ok);
+  /// A babbling transmitter drives garbage continuously until stopped.
+  void set_babbling(AttachmentId a, bool on);
+
+  bool short_circuit() const { return m_short; }
+  bool cut_after(AttachmentId a) const;
+  /// Whether a and b can currently hear each other (same segment, line not shorted).
+  bool connected(AttachmentId a, AttachmentId b) const;
+
+  const LineStats& stats() const { return m_stats; }
+
+ private:
+  struct Attachment;
+  struct Transmission;
+  class Port;
+  friend class Port;
+
+  void on_event(Ticks now, std::uint64_t tag) override;  // end of transmission `tag`
+  void start_transmission(Attachment& from, std::vector<std::uint8_t> bytes);
+  void end_transmission(std::uint64_t id);
+  void deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags,
+               Ticks end);
+  void tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end);
+  void apply_noise(Transmission& t);
+  void recompute_segments();
+  /// After a topology or power change: cut short every in-flight frame for receivers that can
+  /// no longer hear its sender.
+  void truncate_in_flight();
+  bool can_hear(const Attachment& rx, const Attachment& tx) const;
+  void emit_event(LineEventKind k, int a = -1, int b = -1, std::uint64_t v = 0);
+  void babble_burst(Attachment& a);
+  std::uint64_t next_random();
+
+  Scheduler& m_sched;
+  std::string m_name;
+  Baud m_baud;
+  int m_index = 0;
+  std::vector<std::unique_ptr<Attachment>> m_atts;
+  std::vector<Tap*> m_taps;
+  std::vector<std::unique_ptr<Transmission>> m_in_flight;
+  std::vector<std::unique_ptr<Transmission>> m_pool;
+  /// End of the last activity per segment (index = segment id); kIdleForever-based idle.
+  std::vector<Ticks> m_segment_last_end;
+  bool m_short = false;
+  std::uint64_t m_noise_ppb = 0;
+  std::uint64_t m_rng;
+  std::uint64_t m_next_tx_id = 0;
+  LineStats m_stats;
+};
+
+}  // namespace pbvbus::bus

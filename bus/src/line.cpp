@@ -1,0 +1,418 @@
+#include "pbvbus/bus/line.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <stdexcept>
+
+namespace pbvbus::bus {
+
+namespace {
+constexpr Ticks kNeverHeard = INT64_MIN / 4;
+constexpr std::uint64_t kTagTimer = 0, kTagTxStart = 1, kTagBabble = 2;
+
+/// Destination address octet of an FDL frame, or -1 if the frame has none (SC, garbage).
+int frame_da(std::span<const std::uint8_t> b) {
+  if (b.empty()) return -1;
+  switch (b[0]) {
+    case 0x10:
+    case 0xA2:
+    case 0xDC: return b.size() > 1 ? b[1] & 0x7F : -1;
+    case 0x68: return b.size() > 4 ? b[4] & 0x7F : -1;
+    default: return -1;
+  }
+}
+}  // namespace
+
+struct Line::Transmission {
+  std::uint64_t id = 0;
+  Attachment* from = nullptr;
+  std::vector<std::uint8_t> bytes;
+  std::size_t sent_len = 0;
+  Ticks start = 0;
+  Ticks end = 0;
+  std::uint16_t flags = 0;
+  std::bitset<kMaxAttachments> rx;
+};
+
+class Line::Port final : public DevicePort {
+ public:
+  Port(Line& l, Attachment& a) : m_line(l), m_att(a) {}
+  Ticks now() const override { return m_line.m_sched.now(); }
+  Baud baud() const override { return m_line.m_baud; }
+  void transmit(Ticks start, std::span<const std::uint8_t> bytes) override;
+  void set_timer(Ticks at) override;
+
+ private:
+  Line& m_line;
+  Attachment& m_att;
+};
+
+struct Line::Attachment final : EventTarget {
+  Attachment(Line& l, int i, Device& d, std::string lbl)
+      : line(l), id(i), dev(&d), label(std::move(lbl)), port(l, *this) {}
+
+  void on_event(Ticks now, std::uint64_t tag) override {
+    const std::uint64_t kind = tag & 3, value = tag >> 2;
+    if (kind == kTagTimer) {
+      if (value != timer_gen) return;  // superseded by an earlier wake-up
+      next_event = kNever;
+      if (!powered) return;
+      if (deadline <= now) {
+        deadline = kNever;
+        dev->on_timer(now);
+      } else if (deadline != kNever) {
+        arm(deadline);
+      }
+    } else if (kind == kTagTxStart) {
+      if (value != power_epoch || pending.empty()) return;
+      // The pending transmission due now: earliest start, then order of request.
+      auto it = std::min_element(pending.begin(), pending.end(), [](const auto& a, const auto& b) {
+        return a.start != b.start ? a.start < b.start : a.seq < b.seq;
+      });
+      std::vector<std::uint8_t> bytes = std::move(it->bytes);
+      pending.erase(it);
+      line.start_transmission(*this, std::move(bytes));
+    } else if (kind == kTagBabble) {
+      if (value == babble_epoch) line.babble_burst(*this);
+    }
+  }
+
+  void arm(Ticks at) {
+    next_event = at;
+    line.m_sched.schedule(at, *this, (++timer_gen << 2) | kTagTimer);
+  }
+
+  struct Pending {
+    Ticks start;
+    std::uint64_t seq;
+    std::vector<std::uint8_t> bytes;
+  };
+
+  Line& line;
+  int id;
+  Device* dev;
+  std::string label;
+  Port port;
+  bool powered = false;
+  bool xcvr_ok = true;
+  bool babbling = false;
+  bool cut_after = false;
+  int segment = 0;
+  Ticks last_activity_end = kNeverHeard;
+  // Timer: one wanted deadline; `next_event` is the earliest wake-up still valid in the queue.
+  Ticks deadline = kNever;
+  Ticks next_event = kNever;
+  std::uint64_t timer_gen = 0;
+  std::vector<Pending> pending;
+  std::uint64_t pending_seq = 0;
+  std::uint64_t power_epoch = 0;
+  std::uint64_t babble_epoch = 0;
+};
+
+void Line::Port::transmit(Ticks start, std::span<const std::uint8_t> bytes) {
+  if (!m_att.powered || bytes.empty()) return;
+  Ticks now = m_line.m_sched.now();
+  if (start < now) start = now;
+  // Always through the queue, even at `now`: a device answering from inside on_frame() must not
+  // start a transmission while the line is still delivering the previous one.
+  m_att.pending.push_back({start, m_att.pending_seq++, {bytes.begin(), bytes.end()}});
+  m_line.m_sched.schedule(start, m_att, (m_att.power_epoch << 2) | kTagTxStart);
+}
+
+void Line::Port::set_timer(Ticks at) {
+  m_att.deadline = at;
+  if (!m_att.powered || at == kNever) return;
+  if (at < m_att.next_event) m_att.arm(at);
+}
+
+// --------------------------------------------------------------------------------------------
+
+Line::Line(Scheduler& sched, std::string name, Baud baud, std::uint64_t seed)
+    : m_sched(sched), m_name(std::move(name)), m_baud(baud),
+      m_rng(seed ^ 0x9E3779B97F4A7C15ULL) {}
+
+Line::~Line() = default;
+
+AttachmentId Line::attach(Device& dev, std::string label) {
+  if (m_atts.size() >= kMaxAttachments) throw std::length_error("line " + m_name + ": too many attachments");
+  const int id = static_cast<int>(m_atts.size());
+  m_atts.push_back(std::make_unique<Attachment>(*this, id, dev, std::move(label)));
+  dev.bind(m_atts.back()->port);
+  recompute_segments();
+  return id;
+}
+
+Device& Line::device(AttachmentId a) { return *m_atts.at(static_cast<std::size_t>(a))->dev; }
+const std::string& Line::label(AttachmentId a) const { return m_atts.at(static_cast<std::size_t>(a))->label; }
+bool Line::powered(AttachmentId a) const { return m_atts.at(static_cast<std::size_t>(a))->powered; }
+bool Line::cut_after(AttachmentId a) const { return m_atts.at(static_cast<std::size_t>(a))->cut_after; }
+
+void Line::start() {
+  for (auto& a : m_atts)
+    if (!a->powered) set_power(a->id, true);
+}
+
+void Line::add_tap(Tap& tap) { m_taps.push_back(&tap); }
+void Line::remove_tap(Tap& tap) { std::erase(m_taps, &tap); }
+
+std::uint64_t Line::next_random() {
+  // splitmix64: small, fast and the same on every platform (std distributions are not).
+  std::uint64_t z = (m_rng += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+bool Line::can_hear(const Attachment& rx, const Attachment& tx) const {
+  return !m_short && rx.powered && rx.xcvr_ok && tx.powered && tx.xcvr_ok && rx.segment == tx.segment;
+}
+
+bool Line::connected(AttachmentId a, AttachmentId b) const {
+  return can_hear(*m_atts[a], *m_atts[b]);
+}
+
+void Line::recompute_segments() {
+  int seg = 0;
+  for (auto& a : m_atts) {
+    a->segment = seg;
+    if (a->cut_after) ++seg;
+  }
+}
+
+// Characters of `t` that overlap [from, to) get garbled.
+static void garble(std::vector<std::uint8_t>& bytes, Ticks t_start, Ticks char_ticks, Ticks from,
+                   Ticks to, std::uint64_t noise) {
+  if (to <= from) return;
+  const auto n = static_cast<Ticks>(bytes.size());
+  Ticks first = std::max<Ticks>(0, (from - t_start) / char_ticks);
+  Ticks last = std::min<Ticks>(n, (to - t_start + char_ticks - 1) / char_ticks);
+  for (Ticks i = first; i < last; ++i) {
+    bytes[static_cast<std::size_t>(i)] ^= static_cast<std::uint8_t>((noise >> ((i % 8) * 8)) | 1);
+  }
+}
+
+void Line::apply_noise(Transmission& t) {
+  if (m_noise_ppb == 0) return;
+  bool any = false;
+  for (auto& byte : t.bytes) {
+    // 11-bit character: start(0), 8 data LSB first, even parity, stop(1).
+    const std::uint8_t parity = static_cast<std::uint8_t>(__builtin_popcount(byte) & 1);
+    std::uint32_t ch = (static_cast<std::uint32_t>(byte) << 1) | (static_cast<std::uint32_t>(parity) << 9) | (1u << 10);
+    std::uint32_t flips = 0;
+    for (int bit = 0; bit < 11; ++bit)
+      if (next_random() % 1'000'000'000ULL < m_noise_ppb) flips |= 1u << bit;
+    if (!flips) continue;
+    any = true;
+    ch ^= flips;
+    const auto data = static_cast<std::uint8_t>((ch >> 1) & 0xFF);
+    if ((ch & 1u) != 0 || (ch & (1u << 10)) == 0) t.flags |= kRxFraming;
+    if (static_cast<std::uint32_t>(__builtin_popcount(data) & 1) != ((ch >> 9) & 1u)) t.flags |= kRxParity;
+    byte = data;
+  }
+  if (any) ++m_stats.noisy;
+}
+
+void Line::start_transmission(Attachment& from, std::vector<std::uint8_t> bytes) {
+  if (!from.powered) return;
+  const Ticks now = m_sched.now();
+  const Ticks char_ticks = chars_to_ticks(1, m_baud);
+  ++m_stats.frames;
+  m_stats.octets += bytes.size();
+  if (m_short || !from.xcvr_ok) {
+    // Nothing reaches the cable (or the cable carries nothing readable).
+    ++m_stats.lost;
+    return;
+  }
+  std::unique_ptr<Transmission> t;
+  if (!m_pool.empty()) {
+    t = std::move(m_pool.back());
+    m_pool.pop_back();
+  } else {
+    t = std::make_unique<Transmission>();
+  }
+  t->id = ++m_next_tx_id;
+  t->from = &from;
+  t->bytes = std::move(bytes);
+  t->sent_len = t->bytes.size();
+  t->start = now;
+  t->end = now + static_cast<Ticks>(t->bytes.size()) * char_ticks;
+  t->flags = from.babbling ? kRxBabble : 0;
+  t->rx.reset();
+  for (auto& a : m_atts)
+    if (a.get() != &from && can_hear(*a, from)) t->rx.set(static_cast<std::size_t>(a->id));
+
+  // Overlap with anything else on the same segment corrupts both.
+  for (auto& o : m_in_flight) {
+    if (o->from->segment != from.segment || o->end <= now) continue;
+    if (!(o->flags & kRxCollision)) ++m_stats.collisions;
+    if (!(t->flags & kRxCollision)) ++m_stats.collisions;
+    o->flags |= kRxCollision;
+    t->flags |= kRxCollision;
+    garble(o->bytes, o->start, char_ticks, now, std::min(o->end, t->end), next_random());
+    garble(t->bytes, t->start, char_ticks, now, std::min(o->end, t->end), next_random());
+  }
+  apply_noise(*t);
+  from.last_activity_end = std::max(from.last_activity_end, t->end);
+  m_sched.schedule(t->end, *this, t->id);
+  m_in_flight.push_back(std::move(t));
+}
+
+void Line::deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags, Ticks end) {
+  const Ticks prev = to.last_activity_end;
+  to.last_activity_end = std::max(prev, end);
+  std::span<const std::uint8_t> bytes(t.bytes.data(), len);
+  const int filter = to.dev->receive_filter();
+  if (filter != kReceiveAll) {
+    const int da = frame_da(bytes);
+    if (da != filter && da != 127) return;
+  }
+  RxFrame f;
+  f.bytes = bytes;
+  f.start = t.start;
+  f.end = end;
+  f.idle_before = prev == kNeverHeard ? kIdleForever : std::max<Ticks>(0, t.start - prev);
+  f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
+  to.dev->on_frame(f);
+}
+
+void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end) {
+  if (m_taps.empty()) return;
+  TapFrame f;
+  f.line = this;
+  f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
+  f.start = t.start;
+  f.end = end;
+  f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
+  f.sender = static_cast<std::uint16_t>(t.from->id);
+  f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  for (Tap* tap : m_taps) tap->on_frame(f);
+}
+
+void Line::on_event(Ticks, std::uint64_t tag) { end_transmission(tag); }
+
+void Line::end_transmission(std::uint64_t id) {
+  // Detach from the in-flight list first: receivers may start new transmissions (queued).
+  auto it = std::find_if(m_in_flight.begin(), m_in_flight.end(),
+                         [&](const auto& p) { return p->id == id; });
+  if (it == m_in_flight.end()) return;  // already ended early by a fault
+  std::unique_ptr<Transmission> owned = std::move(*it);
+  m_in_flight.erase(it);
+  for (auto& a : m_atts)
+    if (owned->rx.test(static_cast<std::size_t>(a->id))) deliver(*owned, *a, owned->bytes.size(), 0, owned->end);
+  tap_frame(*owned, owned->bytes.size(), 0, owned->end);
+  m_pool.push_back(std::move(owned));
+}
+
+void Line::truncate_in_flight() {
+  const Ticks now = m_sched.now();
+  const Ticks char_ticks = chars_to_ticks(1, m_baud);
+  for (std::size_t i = 0; i < m_in_flight.size();) {
+    Transmission& t = *m_in_flight[i];
+    const auto done = static_cast<std::size_t>(std::clamp<Ticks>((now - t.start) / char_ticks, 0,
+                                                                 static_cast<Ticks>(t.bytes.size())));
+    const bool sender_gone = m_short || !t.from->powered || !t.from->xcvr_ok;
+    for (auto& a : m_atts) {
+      const auto bit = static_cast<std::size_t>(a->id);
+      if (!t.rx.test(bit)) continue;
+      if (sender_gone || !can_hear(*a, *t.from)) {
+        t.rx.reset(bit);
+        ++m_stats.partial;
+        if (done > 0 && a->powered && a->xcvr_ok) deliver(t, *a, done, kRxPartial, now);
+      }
+    }
+    if (sender_gone) {
+      // The frame ends here for everybody, the tap included.
+      t.sent_len = t.bytes.size();
+      tap_frame(t, done, kRxPartial, now);
+      t.from->last_activity_end = now;
+      std::unique_ptr<Transmission> owned = std::move(m_in_flight[i]);
+      m_in_flight.erase(m_in_flight.begin() + static_cast<std::ptrdiff_t>(i));
+      m_pool.push_back(std::move(owned));
+      continue;
+    }
+    ++i;
+  }
+}
+
+void Line::emit_event(LineEventKind k, int a, int b, std::uint64_t v) {
+  LineEvent e{this, m_sched.now(), k, a, b, v};
+  for (Tap* tap : m_taps) tap->on_line_event(e);
+}
+
+void Line::set_cut_after(AttachmentId a, bool cut) {
+  auto& att = *m_atts.at(static_cast<std::size_t>(a));
+  if (att.cut_after == cut) return;
+  att.cut_after = cut;
+  recompute_segments();
+  if (cut) truncate_in_flight();
+  emit_event(cut ? LineEventKind::CableCut : LineEventKind::CableRepaired, a,
+             a + 1 < attachment_count() ? a + 1 : -1);
+}
+
+void Line::set_cut_between(AttachmentId a, AttachmentId b, bool cut) {
+  set_cut_after(std::min(a, b), cut);
+}
+
+void Line::set_short_circuit(bool on) {
+  if (m_short == on) return;
+  m_short = on;
+  if (on) truncate_in_flight();
+  emit_event(on ? LineEventKind::ShortCircuit : LineEventKind::ShortRepaired);
+}
+
+void Line::set_noise(std::uint64_t errors_per_billion) {
+  m_noise_ppb = std::min<std::uint64_t>(errors_per_billion, 1'000'000'000ULL);
+  emit_event(m_noise_ppb ? LineEventKind::NoiseOn : LineEventKind::NoiseOff, -1, -1, m_noise_ppb);
+}
+
+void Line::set_power(AttachmentId id, bool on) {
+  auto& a = *m_atts.at(static_cast<std::size_t>(id));
+  if (a.powered == on) return;
+  const Ticks now = m_sched.now();
+  if (!on) {
+    a.powered = false;
+    a.pending.clear();
+    ++a.power_epoch;
+    ++a.timer_gen;
+    a.deadline = a.next_event = kNever;
+    ++a.babble_epoch;
+    truncate_in_flight();
+    emit_event(LineEventKind::PowerOff, id);
+    a.dev->on_power_off(now);
+  } else {
+    a.powered = true;
+    a.last_activity_end = kNeverHeard;
+    emit_event(LineEventKind::PowerOn, id);
+    a.dev->on_power_on(now);
+    if (a.babbling) babble_burst(a);
+  }
+}
+
+void Line::set_transceiver_ok(AttachmentId id, bool ok) {
+  auto& a = *m_atts.at(static_cast<std::size_t>(id));
+  if (a.xcvr_ok == ok) return;
+  a.xcvr_ok = ok;
+  if (!ok) truncate_in_flight();
+  emit_event(ok ? LineEventKind::TransceiverRepaired : LineEventKind::TransceiverFailed, id);
+}
+
+void Line::set_babbling(AttachmentId id, bool on) {
+  auto& a = *m_atts.at(static_cast<std::size_t>(id));
+  if (a.babbling == on) return;
+  a.babbling = on;
+  ++a.babble_epoch;
+  emit_event(on ? LineEventKind::BabbleOn : LineEventKind::BabbleOff, id);
+  if (on && a.powered) babble_burst(a);
+}
+
+void Line::babble_burst(Attachment& a) {
+  if (!a.babbling || !a.powered) return;
+  // Garbage in bursts of 32 characters, back to back: the line never goes idle.
+  std::vector<std::uint8_t> junk(32);
+  for (auto& b : junk) b = static_cast<std::uint8_t>(next_random());
+  const Ticks end = m_sched.now() + chars_to_ticks(static_cast<std::int64_t>(junk.size()), m_baud);
+  start_transmission(a, std::move(junk));
+  m_sched.schedule(end, a, (a.babble_epoch << 2) | kTagBabble);
+}
+
+}  // namespace pbvbus::bus

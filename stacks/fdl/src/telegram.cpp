@@ -1,0 +1,337 @@
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::fdl {
+
+std::string_view to_string(FrameType t) {
+  switch (t) {
+    case FrameType::SD1: return "SD1";
+    case FrameType::SD2: return "SD2";
+    case FrameType::SD3: return "SD3";
+    case FrameType::SD4: return "SD4";
+    case FrameType::SC: return "SC";
+  }
+  return "?";
+}
+
+bool request_fn_valid(std::uint8_t fn) {
+  switch (fn & 0x0F) {
+    case 0x1:
+    case 0x2:
+    case 0x8:
+    case 0xA:
+    case 0xB: return false;
+    default: return true;
+  }
+}
+
+bool response_status_valid(std::uint8_t status) {
+  switch (status & 0x0F) {
+    case 0x0:
+    case 0x1:
+    case 0x2:
+    case 0x3:
+    case 0x8:
+    case 0x9:
+    case 0xA:
+    case 0xC:
+    case 0xD: return true;
+    default: return false;
+  }
+}
+
+std::string_view to_string(RequestFn f) {
+  switch (f) {
+    case RequestFn::TimeEvent: return "TE";
+    case RequestFn::SdaLow: return "SDA_low";
+    case RequestFn::SdnLow: return "SDN_low";
+    case RequestFn::SdaHigh: return "SDA_high";
+    case RequestFn::SdnHigh: return "SDN_high";
+    case RequestFn::Msrd: return "MSRD";
+    case RequestFn::FdlStatus: return "FDL_Status";
+    case RequestFn::SrdLow: return "SRD_low";
+    case RequestFn::SrdHigh: return "SRD_high";
+    case RequestFn::Ident: return "Ident";
+    case RequestFn::LsapStatus: return "LSAP_Status";
+  }
+  return "reserved";
+}
+
+std::string_view to_string(ResponseStatus s) {
+  switch (s) {
+    case ResponseStatus::OK: return "OK";
+    case ResponseStatus::UE: return "UE";
+    case ResponseStatus::RR: return "RR";
+    case ResponseStatus::RS: return "RS";
+    case ResponseStatus::DL: return "DL";
+    case ResponseStatus::NR: return "NR";
+    case ResponseStatus::DH: return "DH";
+    case ResponseStatus::RDL: return "RDL";
+    case ResponseStatus::RDH: return "RDH";
+  }
+  return "reserved";
+}
+
+std::string_view to_string(StationType s) {
+  switch (s) {
+    case StationType::Slave: return "slave";
+    case StationType::MasterNotReady: return "master not ready";
+    case StationType::MasterReady: return "master ready";
+    case StationType::MasterInRing: return "master in ring";
+  }
+  return "?";
+}
+
+std::string_view to_string(DecodeError e) {
+  switch (e) {
+    case DecodeError::None: return "ok";
+    case DecodeError::Empty: return "empty frame";
+    case DecodeError::UnknownDelimiter: return "unknown start delimiter";
+    case DecodeError::Truncated: return "frame truncated";
+    case DecodeError::TrailingOctets: return "octets after the end of the frame";
+    case DecodeError::LengthMismatch: return "LE and LEr differ";
+    case DecodeError::LengthOutOfRange: return "LE outside 4..249";
+    case DecodeError::BadSecondDelimiter: return "second SD2 delimiter is not 0x68";
+    case DecodeError::BadFcs: return "FCS mismatch";
+    case DecodeError::BadEndDelimiter: return "end delimiter is not 0x16";
+    case DecodeError::BadSourceAddress: return "source address 127";
+    case DecodeError::BadExtension: return "bad address extension";
+    case DecodeError::ReservedFunction: return "reserved request function";
+    case DecodeError::ReservedStatus: return "reserved response status";
+    case DecodeError::BroadcastNotSdn: return "broadcast address with a function other than SDN";
+  }
+  return "?";
+}
+
+std::string_view to_string(EncodeError e) {
+  switch (e) {
+    case EncodeError::None: return "ok";
+    case EncodeError::DataTooLong: return "data unit too long";
+    case EncodeError::BadAddress: return "address out of range";
+    case EncodeError::BadSap: return "SAP or segment out of range";
+  }
+  return "?";
+}
+
+std::uint8_t fcs(std::span<const std::uint8_t> bytes) {
+  unsigned sum = 0;
+  for (auto b : bytes) sum += b;
+  return static_cast<std::uint8_t>(sum);
+}
+
+namespace {
+
+// Reads one extension chain (DAE or SAE) starting at body[pos]: octets while bit 7 is set, the
+// SAP being the octet with bit 6 clear (§B.2).
+bool read_chain(std::span<const std::uint8_t> body, std::size_t& pos, std::optional<std::uint8_t>& sap,
+                std::optional<std::uint8_t>& segment) {
+  for (;;) {
+    if (pos >= body.size()) return false;
+    const std::uint8_t o = body[pos++];
+    if (o & kExtSegment) {
+      if (segment) return false;
+      segment = static_cast<std::uint8_t>(o & 0x3F);
+    } else {
+      if (sap) return false;
+      sap = static_cast<std::uint8_t>(o & 0x3F);
+    }
+    if (!(o & kExt)) break;
+  }
+  return sap.has_value();
+}
+
+// Checks and splits DA SA FC [ext...] DU.
+DecodeError decode_body(std::span<const std::uint8_t> body, Telegram& t) {
+  const std::uint8_t da = body[0], sa = body[1], fc = body[2];
+  t.da = da & 0x7F;
+  t.sa = sa & 0x7F;
+  t.fc = fc;
+  if (t.sa == kBroadcast) return DecodeError::BadSourceAddress;
+  if (fc_is_request(fc)) {
+    if ((fc & 0x80) && fc != kFcClockValue) return DecodeError::ReservedFunction;
+    if (!request_fn_valid(fc)) return DecodeError::ReservedFunction;
+    if (t.da == kBroadcast && fn_expects_reply(fc_request_fn(fc))) return DecodeError::BroadcastNotSdn;
+  } else {
+    if ((fc & 0x80) || !response_status_valid(fc)) return DecodeError::ReservedStatus;
+    if (t.da == kBroadcast) return DecodeError::BroadcastNotSdn;
+  }
+  std::size_t pos = 3;
+  if (da & kExt) {
+    if (!read_chain(body, pos, t.dsap, t.da_segment)) return DecodeError::BadExtension;
+  }
+  if (sa & kExt) {
+    if (!read_chain(body, pos, t.ssap, t.sa_segment)) return DecodeError::BadExtension;
+  }
+  t.data = body.subspan(pos);
+  return DecodeError::None;
+}
+
+}  // namespace
+
+DecodeError decode(std::span<const std::uint8_t> b, Telegram& t) {
+  t = Telegram{};
+  if (b.empty()) return DecodeError::Empty;
+  switch (b[0]) {
+    case kSC:
+      if (b.size() > 1) return DecodeError::TrailingOctets;
+      t.type = FrameType::SC;
+      return DecodeError::None;
+    case kSD4:
+      if (b.size() < 3) return DecodeError::Truncated;
+      if (b.size() > 3) return DecodeError::TrailingOctets;
+      t.type = FrameType::SD4;
+      // A token carries bare addresses: no extension, no broadcast.
+      if ((b[1] & kExt) || (b[2] & kExt)) return DecodeError::BadExtension;
+      t.da = b[1];
+      t.sa = b[2];
+      if (t.sa == kBroadcast || t.da == kBroadcast) return DecodeError::BadSourceAddress;
+      return DecodeError::None;
+    case kSD1:
+    case kSD3: {
+      const bool sd1 = b[0] == kSD1;
+      const std::size_t total = sd1 ? 6 : 14;
+      if (b.size() < total) return DecodeError::Truncated;
+      if (b.size() > total) return DecodeError::TrailingOctets;
+      t.type = sd1 ? FrameType::SD1 : FrameType::SD3;
+      auto body = b.subspan(1, total - 3);
+      if (b[total - 1] != kED) return DecodeError::BadEndDelimiter;
+      if (fcs(body) != b[total - 2]) return DecodeError::BadFcs;
+      return decode_body(body, t);
+    }
+    case kSD2: {
+      if (b.size() < 4) return DecodeError::Truncated;
+      const std::size_t le = b[1];
+      if (b[2] != le) return DecodeError::LengthMismatch;
+      if (b[3] != kSD2) return DecodeError::BadSecondDelimiter;
+      if (le < kMinLe || le > kMaxLe) return DecodeError::LengthOutOfRange;
+      const std::size_t total = le + 6;
+      if (b.size() < total) return DecodeError::Truncated;
+      if (b.size() > total) return DecodeError::TrailingOctets;
+      t.type = FrameType::SD2;
+      auto body = b.subspan(4, le);
+      if (b[total - 1] != kED) return DecodeError::BadEndDelimiter;
+      if (fcs(body) != b[total - 2]) return DecodeError::BadFcs;
+      return decode_body(body, t);
+    }
+    default: return DecodeError::UnknownDelimiter;
+  }
+}
+
+int frame_length(std::span<const std::uint8_t> b) {
+  if (b.empty()) return 0;
+  switch (b[0]) {
+    case kSC: return 1;
+    case kSD4: return 3;
+    case kSD1: return 6;
+    case kSD3: return 14;
+    case kSD2: {
+      if (b.size() < 4) {
+        if (b.size() >= 3 && b[1] != b[2]) return -1;
+        return 0;
+      }
+      if (b[1] != b[2] || b[3] != kSD2 || b[1] < kMinLe || b[1] > kMaxLe) return -1;
+      return b[1] + 6;
+    }
+    default: return -1;
+  }
+}
+
+namespace {
+// Writes DA SA FC [DAE..] [SAE..] DU into `body`; returns its length, or 0 on error.
+std::size_t write_body(const FrameSpec& s, std::uint8_t* body, std::size_t cap, EncodeError& err) {
+  if (s.da > 127 || s.sa > 126) {
+    err = EncodeError::BadAddress;
+    return 0;
+  }
+  if ((s.dsap && *s.dsap > 63) || (s.ssap && *s.ssap > 63) || (s.da_segment && *s.da_segment > 63) ||
+      (s.sa_segment && *s.sa_segment > 63) || (s.da_segment && !s.dsap) || (s.sa_segment && !s.ssap)) {
+    err = EncodeError::BadSap;
+    return 0;
+  }
+  std::size_t n = 0;
+  const std::size_t ext = (s.dsap ? 1u : 0u) + (s.ssap ? 1u : 0u) + (s.da_segment ? 1u : 0u) +
+                          (s.sa_segment ? 1u : 0u);
+  if (3 + ext + s.data.size() > cap) {
+    err = EncodeError::DataTooLong;
+    return 0;
+  }
+  body[n++] = static_cast<std::uint8_t>(s.da | (s.dsap ? kExt : 0));
+  body[n++] = static_cast<std::uint8_t>(s.sa | (s.ssap ? kExt : 0));
+  body[n++] = s.fc;
+  if (s.dsap) {
+    if (s.da_segment) body[n++] = static_cast<std::uint8_t>(kExt | kExtSegment | *s.da_segment);
+    body[n++] = *s.dsap;
+  }
+  if (s.ssap) {
+    if (s.sa_segment) body[n++] = static_cast<std::uint8_t>(kExt | kExtSegment | *s.sa_segment);
+    body[n++] = *s.ssap;
+  }
+  for (auto d : s.data) body[n++] = d;
+  err = EncodeError::None;
+  return n;
+}
+}  // namespace
+
+EncodeError encode_as(FrameType type, const FrameSpec& s, Frame& out) {
+  out.len = 0;
+  EncodeError err = EncodeError::None;
+  auto& b = out.buf;
+  switch (type) {
+    case FrameType::SD1: {
+      const std::size_t n = write_body(s, b.data() + 1, 3, err);
+      if (!n) return err;
+      b[0] = kSD1;
+      b[4] = fcs({b.data() + 1, 3});
+      b[5] = kED;
+      out.len = 6;
+      return EncodeError::None;
+    }
+    case FrameType::SD3: {
+      const std::size_t n = write_body(s, b.data() + 1, 11, err);
+      if (!n) return err;
+      if (n != 11) return EncodeError::DataTooLong;
+      b[0] = kSD3;
+      b[12] = fcs({b.data() + 1, 11});
+      b[13] = kED;
+      out.len = 14;
+      return EncodeError::None;
+    }
+    case FrameType::SD2: {
+      const std::size_t n = write_body(s, b.data() + 4, kMaxLe, err);
+      if (!n) return err;
+      if (n < kMinLe) return EncodeError::DataTooLong;  // would be an SD1
+      b[0] = kSD2;
+      b[1] = b[2] = static_cast<std::uint8_t>(n);
+      b[3] = kSD2;
+      b[4 + n] = fcs({b.data() + 4, n});
+      b[5 + n] = kED;
+      out.len = static_cast<std::uint16_t>(n + 6);
+      return EncodeError::None;
+    }
+    default: return EncodeError::DataTooLong;
+  }
+}
+
+EncodeError encode(const FrameSpec& s, Frame& out) {
+  const std::size_t after_fc = (s.dsap ? 1u : 0u) + (s.ssap ? 1u : 0u) + (s.da_segment ? 1u : 0u) +
+                               (s.sa_segment ? 1u : 0u) + s.data.size();
+  const FrameType t = after_fc == 0 ? FrameType::SD1 : after_fc == 8 ? FrameType::SD3 : FrameType::SD2;
+  return encode_as(t, s, out);
+}
+
+Frame encode_token(std::uint8_t da, std::uint8_t sa) {
+  Frame f;
+  f.buf[0] = kSD4;
+  f.buf[1] = static_cast<std::uint8_t>(da & 0x7F);
+  f.buf[2] = static_cast<std::uint8_t>(sa & 0x7F);
+  f.len = 3;
+  return f;
+}
+
+Frame encode_sc() {
+  Frame f;
+  f.buf[0] = kSC;
+  f.len = 1;
+  return f;
+}
+
+}  // namespace pbvbus::fdl

@@ -1,0 +1,347 @@
+#include "pbvbus/captures/pcapng_writer.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+
+#include "pbvbus/bus/device.hpp"
+#include "pbvbus/bus/line.hpp"
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::captures {
+
+namespace {
+
+constexpr std::size_t kBufferSize = 1u << 20;
+
+inline void put16(std::uint8_t* p, std::uint16_t v) { std::memcpy(p, &v, 2); }
+inline void put32(std::uint8_t* p, std::uint32_t v) { std::memcpy(p, &v, 4); }
+inline void put64(std::uint8_t* p, std::uint64_t v) { std::memcpy(p, &v, 8); }
+static_assert(std::endian::native == std::endian::little,
+              "the writer emits native-order (little-endian) sections");
+
+constexpr std::size_t pad4(std::size_t n) { return (n + 3) & ~std::size_t{3}; }
+constexpr std::size_t option_size(std::size_t value_len) { return 4 + pad4(value_len); }
+
+/// Writes an option at p; returns the octets used (padding zeroed).
+std::size_t put_option(std::uint8_t* p, std::uint16_t code, const void* value, std::size_t len) {
+  put16(p, code);
+  put16(p + 2, static_cast<std::uint16_t>(len));
+  if (len > 0) std::memcpy(p + 4, value, len);
+  const std::size_t total = option_size(len);
+  std::memset(p + 4 + len, 0, total - 4 - len);
+  return total;
+}
+
+std::string baud_description(std::uint64_t speed) {
+  // "PROFIBUS-DP 1.5 Mbit/s", "PROFIBUS-DP 187.5 kbit/s"; integer arithmetic only.
+  auto frac = [](std::uint64_t v, std::uint64_t unit) {
+    std::string s = std::to_string(v / unit);
+    std::uint64_t rest = v % unit;
+    if (rest != 0) {
+      std::string digits;
+      for (std::uint64_t u = unit / 10; u > 0 && rest != 0; u /= 10) {
+        digits += static_cast<char>('0' + rest / u);
+        rest %= u;
+      }
+      s += "." + digits;
+    }
+    return s;
+  };
+  if (speed >= 1'000'000) return "PROFIBUS-DP " + frac(speed, 1'000'000) + " Mbit/s";
+  if (speed >= 1'000) return "PROFIBUS-DP " + frac(speed, 1'000) + " kbit/s";
+  return "PROFIBUS-DP " + std::to_string(speed) + " bit/s";
+}
+
+void append_reason(std::string& s, std::string_view r) {
+  if (!s.empty()) s += ", ";
+  s += r;
+}
+
+std::string station_name(const bus::Line& line, int a) {
+  if (a < 0 || a >= line.attachment_count()) return "station #" + std::to_string(a);
+  const std::string& l = line.label(a);
+  if (!l.empty()) return l;
+  return std::string(const_cast<bus::Line&>(line).device(a).kind()) + " #" + std::to_string(a);
+}
+
+}  // namespace
+
+std::uint32_t classify_frame(std::span<const std::uint8_t> bytes, std::uint16_t rx_flags,
+                             std::uint32_t sent_len, std::string& comment) {
+  comment.clear();
+  std::uint32_t flags = 0;
+  if (rx_flags & bus::kRxCollision) {
+    flags |= pcapng::kFlagSymbolError;
+    append_reason(comment, "collision");
+  }
+  if (rx_flags & bus::kRxParity) {
+    flags |= pcapng::kFlagCrcError;
+    append_reason(comment, "parity error");
+  }
+  if (rx_flags & bus::kRxFraming) {
+    flags |= pcapng::kFlagCrcError;
+    append_reason(comment, "framing error");
+  }
+  if (rx_flags & bus::kRxPartial) {
+    flags |= pcapng::kFlagTooShort;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "partial: %zu of %u octets", bytes.size(),
+                  static_cast<unsigned>(std::max<std::size_t>(sent_len, bytes.size())));
+    append_reason(comment, buf);
+  }
+  if (rx_flags & bus::kRxBabble) {
+    flags |= pcapng::kFlagWrongIfg;
+    append_reason(comment, "babbling transmitter");
+  }
+  fdl::Telegram t;
+  const fdl::DecodeError err = fdl::decode(bytes, t);
+  switch (err) {
+    case fdl::DecodeError::None: break;
+    case fdl::DecodeError::BadFcs: flags |= pcapng::kFlagCrcError; break;
+    case fdl::DecodeError::Empty:
+    case fdl::DecodeError::Truncated: flags |= pcapng::kFlagTooShort; break;
+    case fdl::DecodeError::TrailingOctets: flags |= pcapng::kFlagTooLong; break;
+    case fdl::DecodeError::UnknownDelimiter:
+    case fdl::DecodeError::BadSecondDelimiter:
+    case fdl::DecodeError::BadEndDelimiter: flags |= pcapng::kFlagStartDelimiterError; break;
+    default: break;  // well formed on the wire, invalid for FDL: comment only
+  }
+  // A partial frame is truncated by definition; saying so twice helps nobody.
+  if (err != fdl::DecodeError::None &&
+      !(err == fdl::DecodeError::Truncated && (rx_flags & bus::kRxPartial)))
+    append_reason(comment, fdl::to_string(err));
+  return flags;
+}
+
+std::string describe_line_event(const bus::LineEvent& e) {
+  std::string s;
+  if (e.line) s = e.line->name() + ": ";
+  auto name = [&](int a) { return e.line ? station_name(*e.line, a) : "station #" + std::to_string(a); };
+  switch (e.kind) {
+    case bus::LineEventKind::CableCut:
+    case bus::LineEventKind::CableRepaired:
+      s += e.kind == bus::LineEventKind::CableCut ? "cable cut" : "cable repaired";
+      if (e.b >= 0)
+        s += " between '" + name(e.a) + "' and '" + name(e.b) + "'";
+      else
+        s += " after '" + name(e.a) + "' (end of the line)";
+      break;
+    case bus::LineEventKind::NoiseOn:
+      s += "noise on: " + std::to_string(e.value) + " bit errors per 10^9 bits";
+      break;
+    case bus::LineEventKind::ShortCircuit:
+    case bus::LineEventKind::ShortRepaired:
+    case bus::LineEventKind::NoiseOff: s += bus::to_string(e.kind); break;
+    default:
+      s += bus::to_string(e.kind);
+      if (e.a >= 0) s += ": '" + name(e.a) + "'";
+      break;
+  }
+  return s;
+}
+
+PcapngWriter::PcapngWriter(Sink sink, PcapngWriterOptions opts)
+    : m_sink(std::move(sink)), m_opts(std::move(opts)) {
+  m_buf.resize(kBufferSize);
+  m_event_buf.resize(kEventHeaderSize + kEventMaxText);
+  m_comment.reserve(256);
+  m_lines.reserve(16);
+  write_shb();
+}
+
+PcapngWriter::~PcapngWriter() { flush(); }
+
+std::unique_ptr<PcapngWriter> PcapngWriter::open(const std::string& path,
+                                                 PcapngWriterOptions opts, std::string* error) {
+  if (path == "-") {
+    opts.streaming = true;
+    return std::make_unique<PcapngWriter>(
+        [](std::span<const std::uint8_t> b) {
+          return std::fwrite(b.data(), 1, b.size(), stdout) == b.size() && std::fflush(stdout) == 0;
+        },
+        std::move(opts));
+  }
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) {
+    if (error) *error = "cannot open '" + path + "' for writing: " + std::strerror(errno);
+    return nullptr;
+  }
+  std::shared_ptr<std::FILE> file(f, [](std::FILE* p) { std::fclose(p); });
+  const bool streaming = opts.streaming;
+  return std::make_unique<PcapngWriter>(
+      [file, streaming](std::span<const std::uint8_t> b) {
+        if (std::fwrite(b.data(), 1, b.size(), file.get()) != b.size()) return false;
+        return !streaming || std::fflush(file.get()) == 0;
+      },
+      std::move(opts));
+}
+
+std::uint8_t* PcapngWriter::reserve(std::size_t n) {
+  if (m_len + n > m_buf.size()) {
+    flush();
+    if (n > m_buf.size()) m_buf.resize(n);
+  }
+  std::uint8_t* p = m_buf.data() + m_len;
+  m_len += n;
+  return p;
+}
+
+bool PcapngWriter::flush() {
+  if (m_len == 0) return m_ok;
+  if (m_ok && !m_sink(std::span<const std::uint8_t>(m_buf.data(), m_len))) {
+    m_ok = false;
+    m_error = "write failed";
+  }
+  m_len = 0;
+  return m_ok;
+}
+
+void PcapngWriter::block_done() {
+  if (m_opts.streaming) flush();
+}
+
+void PcapngWriter::write_shb() {
+  const std::string& app = m_opts.application;
+  const std::size_t opts = (app.empty() ? 0 : option_size(app.size()) + 4);
+  const std::size_t total = 28 + opts;
+  std::uint8_t* p = reserve(total);
+  put32(p, pcapng::kBlockShb);
+  put32(p + 4, static_cast<std::uint32_t>(total));
+  put32(p + 8, pcapng::kByteOrderMagic);
+  put16(p + 12, 1);
+  put16(p + 14, 0);
+  put64(p + 16, ~std::uint64_t{0});  // section length not specified
+  std::size_t o = 24;
+  if (!app.empty()) {
+    o += put_option(p + o, pcapng::kShbUserAppl, app.data(), app.size());
+    o += put_option(p + o, pcapng::kOptEndOfOpt, nullptr, 0);
+  }
+  put32(p + o, static_cast<std::uint32_t>(total));
+  block_done();
+}
+
+std::uint32_t PcapngWriter::add_interface(std::string_view name, std::string_view description,
+                                          pcapng::LinkType type, std::uint64_t speed) {
+  const std::size_t opts = option_size(name.size()) + option_size(description.size()) +
+                           (speed ? option_size(8) : 0) + option_size(1) + 4;
+  const std::size_t total = 20 + opts;
+  std::uint8_t* p = reserve(total);
+  put32(p, pcapng::kBlockIdb);
+  put32(p + 4, static_cast<std::uint32_t>(total));
+  put16(p + 8, static_cast<std::uint16_t>(type));
+  put16(p + 10, 0);
+  put32(p + 12, 0);  // snaplen: no limit
+  std::size_t o = 16;
+  o += put_option(p + o, pcapng::kIfName, name.data(), name.size());
+  o += put_option(p + o, pcapng::kIfDescription, description.data(), description.size());
+  if (speed) {
+    std::uint8_t v[8];
+    put64(v, speed);
+    o += put_option(p + o, pcapng::kIfSpeed, v, 8);
+  }
+  const std::uint8_t tsresol = 9;
+  o += put_option(p + o, pcapng::kIfTsresol, &tsresol, 1);
+  o += put_option(p + o, pcapng::kOptEndOfOpt, nullptr, 0);
+  put32(p + o, static_cast<std::uint32_t>(total));
+  block_done();
+  return m_next_if++;
+}
+
+std::uint32_t PcapngWriter::add_line(const bus::Line& line) { return interface_for(line); }
+
+std::uint32_t PcapngWriter::interface_for(const bus::Line& line) {
+  if (&line == m_last_line) return m_last_id;
+  for (const LineIf& l : m_lines)
+    if (l.line == &line) {
+      m_last_line = &line;
+      m_last_id = l.id;
+      return l.id;
+    }
+  const auto speed = static_cast<std::uint64_t>(line.baud());
+  const std::uint32_t id =
+      add_interface(line.name(), baud_description(speed), m_opts.line_link_type, speed);
+  m_lines.push_back({&line, id});
+  m_last_line = &line;
+  m_last_id = id;
+  return id;
+}
+
+std::uint32_t PcapngWriter::events_interface() {
+  if (m_events_if < 0)
+    m_events_if = add_interface("events", "pbvbus event records v1", pcapng::LinkType::User1, 0);
+  return static_cast<std::uint32_t>(m_events_if);
+}
+
+void PcapngWriter::write_epb(std::uint32_t if_id, std::int64_t ts_ns,
+                             std::span<const std::uint8_t> data, std::uint32_t flags,
+                             std::string_view comment) {
+  const std::size_t opts = (flags ? option_size(4) : 0) +
+                           (comment.empty() ? 0 : option_size(comment.size()));
+  const std::size_t total = 32 + pad4(data.size()) + (opts ? opts + 4 : 0);
+  std::uint8_t* p = reserve(total);
+  const auto ts = static_cast<std::uint64_t>(std::max<std::int64_t>(ts_ns, 0));
+  const auto len = static_cast<std::uint32_t>(data.size());
+  put32(p, pcapng::kBlockEpb);
+  put32(p + 4, static_cast<std::uint32_t>(total));
+  put32(p + 8, if_id);
+  put32(p + 12, static_cast<std::uint32_t>(ts >> 32));
+  put32(p + 16, static_cast<std::uint32_t>(ts));
+  put32(p + 20, len);
+  put32(p + 24, len);
+  if (!data.empty()) std::memcpy(p + 28, data.data(), data.size());
+  std::size_t o = 28 + data.size();
+  while (o & 3) p[o++] = 0;
+  if (opts) {
+    if (flags) {
+      std::uint8_t v[4];
+      put32(v, flags);
+      o += put_option(p + o, pcapng::kEpbFlags, v, 4);
+    }
+    if (!comment.empty()) o += put_option(p + o, pcapng::kOptComment, comment.data(), comment.size());
+    o += put_option(p + o, pcapng::kOptEndOfOpt, nullptr, 0);
+  }
+  put32(p + o, static_cast<std::uint32_t>(total));
+  block_done();
+}
+
+void PcapngWriter::write_frame(const bus::TapFrame& f) {
+  if (!m_ok) return;
+  if (!f.line && m_unknown_if < 0)
+    m_unknown_if = add_interface("unknown", "frames of no known line", m_opts.line_link_type, 0);
+  const std::uint32_t id =
+      f.line ? interface_for(*f.line) : static_cast<std::uint32_t>(m_unknown_if);
+  // Fast path: an intact frame that decodes needs neither flags nor comment.
+  std::uint32_t flags = 0;
+  std::string_view comment;
+  fdl::Telegram t;
+  if (f.flags != 0 || fdl::decode(f.bytes, t) != fdl::DecodeError::None) {
+    flags = classify_frame(f.bytes, f.flags, f.sent_len, m_comment);
+    comment = m_comment;
+  }
+  write_epb(id, bus::ticks_to_ns(f.start), f.bytes, flags, comment);
+  ++m_frames;
+}
+
+void PcapngWriter::write_event(bus::Ticks time, const EventRecord& e) {
+  if (!m_ok) return;
+  const std::uint32_t id = events_interface();
+  const std::size_t n = encode_event(e, m_event_buf);
+  write_epb(id, bus::ticks_to_ns(time), std::span<const std::uint8_t>(m_event_buf.data(), n), 0, {});
+  ++m_events;
+}
+
+void PcapngWriter::on_line_event(const bus::LineEvent& e) {
+  EventRecord r;
+  r.category = EventCategory::Line;
+  r.code = static_cast<std::uint16_t>(e.kind);
+  r.line = e.line ? e.line->index() : -1;
+  r.a = e.a;
+  r.b = e.b;
+  r.value = e.value;
+  r.text = describe_line_event(e);
+  write_event(e.time, r);
+}
+
+}  // namespace pbvbus::captures

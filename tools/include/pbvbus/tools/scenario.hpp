@@ -1,0 +1,110 @@
+#pragma once
+// Scenario files (design.md "Configuration and command line"): Protocol Buffers text format
+// against tools/proto/scenario.proto, loaded into a checked ScenarioPlan that the Simulation
+// builds from.
+//
+// Every error names the file, line and column (1-based) of the text it refers to, both for
+// syntax errors reported by the protobuf parser and for semantic errors found afterwards (the
+// parser's ParseInfoTree locates each field): `multimaster.textproto:12:5: address 127 is out of
+// range 0..126`. All errors are collected, not only the first.
+//
+// Decisions (documented for users in the .proto):
+//  - Stations are attached in the order in which they appear in the text, across kinds; that is
+//    their position along the cable. Scenarios built in code (no text) use the order masters,
+//    passive stations, serial attachments.
+//  - A Line without a baud runs at 1.5 Mbit/s; unset bus parameters take the DP-profile defaults
+//    of the baud rate (fdl::BusParams::defaults).
+//  - Polling an address where no station sits is allowed: it is how one exercises retries and
+//    "non-operational" handling. Polling the master's own address or 127 is not.
+//  - A fault (or repair) later than the scenario's own duration is an error (it would never
+//    happen); when the duration is overridden on the command line, faults past the end are
+//    simply not reached and the report says so.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+#include "pbvbus/fdl/bus_params.hpp"
+#include "scenario.pb.h"
+
+namespace pbvbus::tools {
+
+/// One problem in a scenario file. line/column are 1-based; 0 when unknown.
+struct Diagnostic {
+  std::string file;
+  int line = 0;
+  int column = 0;
+  std::string message;
+  /// "FILE:LINE:COLUMN: message" (or "FILE: message" without a position).
+  std::string str() const;
+};
+
+enum class StationKind : std::uint8_t { Master, Passive, SerialMonitor, SerialStation };
+std::string_view to_string(StationKind k);
+
+/// A station in cable order.
+struct PlanStation {
+  StationKind kind = StationKind::Passive;
+  int source = 0;                       ///< index into the Scenario's repeated field of `kind`
+  std::optional<std::uint8_t> address;  ///< none for a serial monitor
+  fdl::BusParams params;                ///< effective parameters (line's + a master's overrides)
+};
+
+struct PlanLine {
+  std::string name;
+  bus::Baud baud = bus::Baud::k1_5M;
+  fdl::BusParams params;
+  std::vector<PlanStation> stations;  ///< cable order = attachment order
+  /// Cable position of the station with FDL address `addr`, or -1.
+  int position_of(std::uint8_t addr) const;
+};
+
+struct PlanFault {
+  enum class Kind : std::uint8_t {
+    CableCut,
+    ShortCircuit,
+    Noise,
+    PowerLoss,
+    TransceiverFailure,
+    Babble
+  };
+  Kind kind = Kind::CableCut;
+  bus::Ticks at = 0;
+  std::optional<bus::Ticks> repair_at;
+  int line = 0;                  ///< index into ScenarioPlan::lines
+  int a = -1;                    ///< cable position (cut: the earlier one; station faults)
+  int b = -1;                    ///< cut: the later cable position
+  std::uint64_t noise_ppb = 0;   ///< noise: bit errors per 10^9 bits
+  std::string description;       ///< e.g. "cable cut on line A between 3 and 10"
+};
+
+struct ScenarioPlan {
+  scenario::Scenario proto;  ///< the parsed file, for the station details
+  std::string file;          ///< the name errors and reports use
+  std::string name;
+  std::uint64_t seed = 0;
+  std::optional<bus::Ticks> duration;  ///< from the file; the CLI may override it
+  std::vector<PlanLine> lines;
+  std::vector<PlanFault> faults;  ///< ordered by time of occurrence
+};
+
+struct LoadResult {
+  std::optional<ScenarioPlan> plan;  ///< set only if `errors` is empty
+  std::vector<Diagnostic> errors;
+  bool ok() const { return plan.has_value(); }
+};
+
+/// Parses and checks scenario text. `file` is the name used in diagnostics.
+LoadResult parse_scenario(std::string_view text, std::string_view file);
+/// Reads and parses a file ("cannot read FILE: reason" if it cannot be opened).
+LoadResult load_scenario_file(const std::string& path);
+/// Checks an already-built message (no positions in diagnostics).
+LoadResult plan_scenario(const scenario::Scenario& proto, std::string_view file);
+
+/// The built-in default scenario's text (what `pbvbus run` runs without a file).
+std::string_view default_scenario_text();
+
+}  // namespace pbvbus::tools

@@ -1,0 +1,550 @@
+#include "pbvbus/tools/scenario.hpp"
+
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::tools {
+
+namespace pb = google::protobuf;
+using bus::Ticks;
+
+std::string Diagnostic::str() const {
+  std::ostringstream os;
+  os << file;
+  if (line > 0) os << ':' << line << ':' << column;
+  os << ": " << message;
+  return os.str();
+}
+
+std::string_view to_string(StationKind k) {
+  switch (k) {
+    case StationKind::Master: return "master";
+    case StationKind::Passive: return "passive_station";
+    case StationKind::SerialMonitor: return "serial monitor";
+    case StationKind::SerialStation: return "serial station";
+  }
+  return "?";
+}
+
+int PlanLine::position_of(std::uint8_t addr) const {
+  for (std::size_t i = 0; i < stations.size(); ++i)
+    if (stations[i].address == addr) return static_cast<int>(i);
+  return -1;
+}
+
+namespace {
+
+constexpr std::uint32_t kMaxAddress = 126;
+// DU octets in an SD2 frame without address extensions.
+constexpr std::uint32_t kMaxData = static_cast<std::uint32_t>(fdl::kMaxDu);
+
+class Collector final : public pb::io::ErrorCollector {
+ public:
+  Collector(std::vector<Diagnostic>& out, std::string file) : m_out(out), m_file(std::move(file)) {}
+  void AddError(int line, pb::io::ColumnNumber column, const std::string& message) override {
+    // The tokenizer reports 0-based positions, or -1 for "end of input / unknown".
+    m_out.push_back({m_file, line < 0 ? 0 : line + 1, column < 0 ? 0 : column + 1, message});
+  }
+
+ private:
+  std::vector<Diagnostic>& m_out;
+  std::string m_file;
+};
+
+/// A message in the parsed text: its own position and the tree that locates its fields.
+/// Without text (a message built in code) everything is at "no position".
+struct Where {
+  const pb::TextFormat::ParseInfoTree* tree = nullptr;
+  int line = -1;  // 0-based, -1 unknown
+  int column = -1;
+};
+
+const pb::FieldDescriptor* field_of(const pb::Descriptor* d, const char* name) {
+  const pb::FieldDescriptor* f = d->FindFieldByName(name);
+  if (f == nullptr) std::abort();  // a typo in this file, not bad input
+  return f;
+}
+
+Where nested(const Where& w, const pb::Descriptor* d, const char* name, int index = -1) {
+  const pb::FieldDescriptor* f = field_of(d, name);
+  Where r;
+  if (w.tree != nullptr) {
+    r.tree = w.tree->GetTreeForNested(f, index);
+    const auto loc = w.tree->GetLocation(f, index);
+    r.line = loc.line;
+    r.column = loc.column;
+  }
+  if (r.line < 0) {
+    r.line = w.line;
+    r.column = w.column;
+  }
+  return r;
+}
+
+/// Position of a scalar field of the message at `w` (falls back to the message itself).
+Where at_field(const Where& w, const pb::Descriptor* d, const char* name, int index = -1) {
+  Where r = w;
+  if (w.tree != nullptr) {
+    const pb::FieldDescriptor* f = field_of(d, name);
+    auto loc = w.tree->GetLocation(f, index);
+    // A list value `address: [2, 1]` is recorded once, at its field name.
+    if (loc.line < 0 && index > 0) loc = w.tree->GetLocation(f, 0);
+    if (loc.line >= 0) {
+      r.line = loc.line;
+      r.column = loc.column;
+    }
+  }
+  return r;
+}
+
+std::string quoted(std::string_view s) { return "\"" + std::string(s) + "\""; }
+
+std::string baud_list() {
+  std::string s;
+  for (bus::Baud b : bus::kAllBauds) {
+    if (!s.empty()) s += ", ";
+    s += bus::baud_name(b);
+  }
+  return s;
+}
+
+struct StationEntry {
+  StationKind kind;
+  int source;
+  Where where;
+  std::string line;
+  std::optional<std::uint32_t> address;
+};
+
+class Planner {
+ public:
+  Planner(const scenario::Scenario& proto, std::string file, const pb::TextFormat::ParseInfoTree* tree,
+          std::vector<Diagnostic>& errors)
+      : m_proto(proto), m_file(std::move(file)), m_errors(errors) {
+    m_root.tree = tree;
+  }
+
+  std::optional<ScenarioPlan> run() {
+    ScenarioPlan plan;
+    plan.proto = m_proto;
+    plan.file = m_file;
+    plan.name = m_proto.name();
+    plan.seed = m_proto.seed();
+    const auto* sd = scenario::Scenario::descriptor();
+    if (!m_proto.duration().empty()) {
+      plan.duration = duration(at_field(m_root, sd, "duration"), m_proto.duration());
+      if (plan.duration && *plan.duration == 0) {
+        error(at_field(m_root, sd, "duration"), "duration must be longer than 0");
+        plan.duration.reset();
+      }
+    }
+    plan_lines(plan);
+    plan_stations(plan);
+    plan_faults(plan);
+    if (!m_errors.empty()) return std::nullopt;
+    return plan;
+  }
+
+ private:
+  void error(const Where& w, std::string msg) {
+    m_errors.push_back({m_file, w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1,
+                        std::move(msg)});
+  }
+
+  std::optional<Ticks> duration(const Where& w, const std::string& text) {
+    auto t = bus::parse_duration(text);
+    if (!t) {
+      error(w, "bad duration " + quoted(text) +
+                   " (expected a number and a unit: ns, us, ms, s, min, h, e.g. \"250ms\")");
+    }
+    return t;
+  }
+
+  /// Applies overrides; reports range errors that a narrowing cast would hide.
+  void apply(const Where& w, const scenario::BusParameters& o, fdl::BusParams& p) {
+    const auto* d = scenario::BusParameters::descriptor();
+    if (o.has_tsl()) p.tsl = o.tsl();
+    if (o.has_min_tsdr()) p.min_tsdr = o.min_tsdr();
+    if (o.has_max_tsdr()) p.max_tsdr = o.max_tsdr();
+    if (o.has_tqui()) p.tqui = o.tqui();
+    if (o.has_tset()) p.tset = o.tset();
+    if (o.has_ttr()) p.ttr = o.ttr();
+    if (o.has_gap_factor()) p.gap_factor = o.gap_factor();
+    if (o.has_hsa()) {
+      if (o.hsa() < 1 || o.hsa() > kMaxAddress)
+        error(at_field(w, d, "hsa"), "hsa " + std::to_string(o.hsa()) + " is out of range 1..126");
+      else
+        p.hsa = static_cast<std::uint8_t>(o.hsa());
+    }
+    if (o.has_max_retry()) {
+      if (o.max_retry() > 15)
+        error(at_field(w, d, "max_retry"),
+              "max_retry " + std::to_string(o.max_retry()) + " is out of range 0..15");
+      else
+        p.max_retry = static_cast<std::uint8_t>(o.max_retry());
+    }
+  }
+
+  void plan_lines(ScenarioPlan& plan) {
+    const auto* sd = scenario::Scenario::descriptor();
+    const auto* ld = scenario::Line::descriptor();
+    for (int i = 0; i < m_proto.line_size(); ++i) {
+      const auto& l = m_proto.line(i);
+      const Where w = nested(m_root, sd, "line", i);
+      PlanLine pl;
+      pl.name = l.name();
+      if (l.name().empty()) {
+        error(w, "line needs a name");
+      } else if (m_line_index.count(l.name())) {
+        error(at_field(w, ld, "name"), "line " + quoted(l.name()) + " is defined twice");
+      }
+      if (l.speed_case() == scenario::Line::kBaud) {
+        if (auto b = bus::parse_baud(l.baud())) {
+          pl.baud = *b;
+        } else {
+          error(at_field(w, ld, "baud"), quoted(l.baud()) + " is not a PROFIBUS baud rate (" +
+                                             baud_list() + ")");
+        }
+      } else if (l.speed_case() == scenario::Line::kBitRate) {
+        if (auto b = bus::parse_baud(std::to_string(l.bit_rate()))) {
+          pl.baud = *b;
+        } else {
+          error(at_field(w, ld, "bit_rate"), std::to_string(l.bit_rate()) +
+                                                 " bit/s is not a PROFIBUS baud rate (" +
+                                                 baud_list() + ")");
+        }
+      }
+      pl.params = fdl::BusParams::defaults(pl.baud);
+      if (l.has_bus_params()) {
+        const Where bw = nested(w, ld, "bus_params");
+        apply(bw, l.bus_params(), pl.params);
+        if (std::string why = pl.params.validate(); !why.empty())
+          error(bw, "bus parameters of line " + quoted(l.name()) + ": " + why);
+      }
+      m_line_index.emplace(l.name(), static_cast<int>(plan.lines.size()));
+      plan.lines.push_back(std::move(pl));
+    }
+    if (m_proto.line_size() == 0) error(m_root, "the scenario has no line");
+  }
+
+  /// Index of the line named by field `name` of the message at `w`, or -1 (error reported).
+  int line_ref(const Where& w, const pb::Descriptor* d, const std::string& name,
+               std::string_view what) {
+    if (name.empty()) {
+      error(w, std::string(what) + " needs a line");
+      return -1;
+    }
+    auto it = m_line_index.find(name);
+    if (it == m_line_index.end()) {
+      error(at_field(w, d, "line"), "unknown line " + quoted(name));
+      return -1;
+    }
+    return it->second;
+  }
+
+  void plan_stations(ScenarioPlan& plan) {
+    const auto* sd = scenario::Scenario::descriptor();
+    std::vector<StationEntry> entries;
+    for (int i = 0; i < m_proto.master_size(); ++i) {
+      const auto& m = m_proto.master(i);
+      entries.push_back({StationKind::Master, i, nested(m_root, sd, "master", i), m.line(),
+                         m.has_address() ? std::optional(m.address()) : std::nullopt});
+    }
+    for (int i = 0; i < m_proto.passive_station_size(); ++i) {
+      const auto& p = m_proto.passive_station(i);
+      entries.push_back({StationKind::Passive, i, nested(m_root, sd, "passive_station", i),
+                         p.line(), p.has_address() ? std::optional(p.address()) : std::nullopt});
+    }
+    for (int i = 0; i < m_proto.serial_size(); ++i) {
+      const auto& s = m_proto.serial(i);
+      const bool station = s.mode() == scenario::Serial::STATION;
+      entries.push_back({station ? StationKind::SerialStation : StationKind::SerialMonitor, i,
+                         nested(m_root, sd, "serial", i), s.line(),
+                         s.has_address() ? std::optional(s.address()) : std::nullopt});
+    }
+    // Cable order = order of appearance in the text. Without text, the order above.
+    if (m_root.tree != nullptr) {
+      std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
+        return std::pair(a.where.line, a.where.column) < std::pair(b.where.line, b.where.column);
+      });
+    }
+
+    std::map<std::pair<int, std::uint32_t>, Where> used;  // (line, address) -> first user
+    for (const auto& e : entries) {
+      const pb::Descriptor* d = e.kind == StationKind::Master    ? scenario::Master::descriptor()
+                                : e.kind == StationKind::Passive ? scenario::PassiveStation::descriptor()
+                                                                 : scenario::Serial::descriptor();
+      const std::string what(to_string(e.kind));
+      const int li = line_ref(e.where, d, e.line, what);
+      const Where aw = at_field(e.where, d, "address");
+      bool addr_ok = false;
+      if (!e.address) {
+        if (e.kind == StationKind::Master || e.kind == StationKind::Passive)
+          error(e.where, what + " needs an address");
+      } else if (e.kind == StationKind::SerialMonitor) {
+        error(aw, "a serial MONITOR has no address (only a STATION has one)");
+      } else if (*e.address > kMaxAddress) {
+        error(aw, "address " + std::to_string(*e.address) + " is out of range 0..126");
+      } else {
+        addr_ok = true;
+      }
+      if (li < 0) continue;
+      PlanLine& line = plan.lines[static_cast<std::size_t>(li)];
+      PlanStation ps;
+      ps.kind = e.kind;
+      ps.source = e.source;
+      ps.params = line.params;
+      if (addr_ok) {
+        ps.address = static_cast<std::uint8_t>(*e.address);
+        auto [it, fresh] = used.emplace(std::pair(li, *e.address), aw);
+        if (!fresh) {
+          error(aw, "address " + std::to_string(*e.address) + " is already used on line " +
+                        quoted(line.name) + " (at " + std::to_string(it->second.line + 1) + ":" +
+                        std::to_string(it->second.column + 1) + ")");
+        }
+      }
+      if (e.kind == StationKind::Master) check_master(e, line, ps);
+      if (e.kind == StationKind::Passive) check_passive(e, line);
+      line.stations.push_back(ps);
+    }
+  }
+
+  void check_master(const StationEntry& e, const PlanLine& line, PlanStation& ps) {
+    const auto& m = m_proto.master(e.source);
+    const auto* md = scenario::Master::descriptor();
+    if (m.has_bus_params()) {
+      const Where bw = nested(e.where, md, "bus_params");
+      apply(bw, m.bus_params(), ps.params);
+      if (std::string why = ps.params.validate(); !why.empty())
+        error(bw, "bus parameters of master " + std::to_string(m.address()) + ": " + why);
+    }
+    if (ps.address && *ps.address >= ps.params.hsa) {
+      error(at_field(e.where, md, "address"),
+            "master address " + std::to_string(*ps.address) + " is not below HSA " +
+                std::to_string(ps.params.hsa) + " of line " + quoted(line.name));
+    }
+    const auto* pd = scenario::Poll::descriptor();
+    for (int i = 0; i < m.poll_size(); ++i) {
+      const auto& p = m.poll(i);
+      const Where pw = nested(e.where, md, "poll", i);
+      if (p.address_size() == 0) error(pw, "poll needs at least one address");
+      for (int k = 0; k < p.address_size(); ++k) {
+        const std::uint32_t a = p.address(k);
+        if (a > kMaxAddress)
+          error(at_field(pw, pd, "address", k), "poll address " + std::to_string(a) +
+                                                     " is out of range 0..126");
+        else if (m.has_address() && a == m.address())
+          error(at_field(pw, pd, "address", k),
+                "master " + std::to_string(a) + " cannot poll itself");
+      }
+      if (p.length() > kMaxData)
+        error(at_field(pw, pd, "length"), "poll length " + std::to_string(p.length()) +
+                                              " is over the maximum of " +
+                                              std::to_string(kMaxData) + " octets");
+    }
+  }
+
+  void check_passive(const StationEntry& e, const PlanLine& line) {
+    const auto& p = m_proto.passive_station(e.source);
+    const auto* pd = scenario::PassiveStation::descriptor();
+    if (p.has_response_delay() &&
+        (p.response_delay() < line.params.min_tsdr || p.response_delay() > line.params.max_tsdr)) {
+      error(at_field(e.where, pd, "response_delay"),
+            "response_delay " + std::to_string(p.response_delay()) +
+                " bit times is outside [min TSDR, max TSDR] = [" +
+                std::to_string(line.params.min_tsdr) + ", " + std::to_string(line.params.max_tsdr) +
+                "] of line " + quoted(line.name));
+    }
+    if (p.response_length() > kMaxData)
+      error(at_field(e.where, pd, "response_length"),
+            "response_length " + std::to_string(p.response_length()) +
+                " is over the maximum of " + std::to_string(kMaxData) + " octets");
+  }
+
+  /// Cable position of station `addr` on line `li`, or -1 with an error that says where it is.
+  int station_ref(const ScenarioPlan& plan, const Where& w, int li, std::uint32_t addr,
+                  std::string_view what) {
+    const PlanLine& line = plan.lines[static_cast<std::size_t>(li)];
+    if (addr <= kMaxAddress) {
+      const int pos = line.position_of(static_cast<std::uint8_t>(addr));
+      if (pos >= 0) return pos;
+      for (const auto& other : plan.lines) {
+        if (other.position_of(static_cast<std::uint8_t>(addr)) >= 0) {
+          error(w, std::string(what) + " on line " + quoted(line.name) + ": station " +
+                       std::to_string(addr) + " is on line " + quoted(other.name));
+          return -1;
+        }
+      }
+    }
+    error(w, std::string(what) + ": no station " + std::to_string(addr) + " on line " +
+                 quoted(line.name));
+    return -1;
+  }
+
+  void plan_faults(ScenarioPlan& plan) {
+    const auto* sd = scenario::Scenario::descriptor();
+    const auto* fd = scenario::Fault::descriptor();
+    for (int i = 0; i < m_proto.fault_size(); ++i) {
+      const auto& f = m_proto.fault(i);
+      const Where w = nested(m_root, sd, "fault", i);
+      PlanFault pf;
+      bool ok = true;
+      if (f.at().empty()) {
+        error(w, "fault needs a time: at: \"2s\"");
+        ok = false;
+      } else if (auto t = duration(at_field(w, fd, "at"), f.at())) {
+        pf.at = *t;
+        if (plan.duration && pf.at > *plan.duration) {
+          error(at_field(w, fd, "at"), "fault at " + f.at() + " is after the end of the run (" +
+                                           m_proto.duration() + ")");
+        }
+      } else {
+        ok = false;
+      }
+      if (!f.repair_at().empty()) {
+        if (auto t = duration(at_field(w, fd, "repair_at"), f.repair_at())) {
+          pf.repair_at = *t;
+          if (ok && *t <= pf.at) {
+            error(at_field(w, fd, "repair_at"), "repair_at " + f.repair_at() +
+                                                    " is not after the fault (at " + f.at() + ")");
+          } else if (plan.duration && *t > *plan.duration) {
+            error(at_field(w, fd, "repair_at"), "repair_at " + f.repair_at() +
+                                                    " is after the end of the run (" +
+                                                    m_proto.duration() + ")");
+          }
+        }
+      }
+      using K = PlanFault::Kind;
+      using FK = scenario::Fault::KindCase;
+      std::string line_name;
+      const char* kind_field = nullptr;
+      switch (f.kind_case()) {
+        case FK::kCableCut: pf.kind = K::CableCut; line_name = f.cable_cut().line(); kind_field = "cable_cut"; break;
+        case FK::kShortCircuit: pf.kind = K::ShortCircuit; line_name = f.short_circuit().line(); kind_field = "short_circuit"; break;
+        case FK::kNoise: pf.kind = K::Noise; line_name = f.noise().line(); kind_field = "noise"; break;
+        case FK::kPowerLoss: pf.kind = K::PowerLoss; line_name = f.power_loss().line(); kind_field = "power_loss"; break;
+        case FK::kTransceiverFailure: pf.kind = K::TransceiverFailure; line_name = f.transceiver_failure().line(); kind_field = "transceiver_failure"; break;
+        case FK::kBabble: pf.kind = K::Babble; line_name = f.babble().line(); kind_field = "babble"; break;
+        case FK::KIND_NOT_SET:
+          error(w, "fault needs a kind: cable_cut, short_circuit, noise, power_loss, "
+                   "transceiver_failure or babble");
+          continue;
+      }
+      const Where kw = nested(w, fd, kind_field);
+      const pb::Descriptor* kd = fd->FindFieldByName(kind_field)->message_type();
+      const int li = line_ref(kw, kd, line_name, kind_field);
+      if (li < 0) continue;
+      pf.line = li;
+      const std::string& ln = plan.lines[static_cast<std::size_t>(li)].name;
+      switch (pf.kind) {
+        case K::CableCut: {
+          const auto& c = f.cable_cut();
+          if (!c.has_between_a() || !c.has_between_b()) {
+            error(kw, "cable_cut needs two stations: between_a and between_b");
+            continue;
+          }
+          const int pa = station_ref(plan, at_field(kw, kd, "between_a"), li, c.between_a(), "cable_cut");
+          const int pb_ = station_ref(plan, at_field(kw, kd, "between_b"), li, c.between_b(), "cable_cut");
+          if (pa < 0 || pb_ < 0) continue;
+          if (pa == pb_) {
+            error(at_field(kw, kd, "between_b"), "cable_cut between a station and itself");
+            continue;
+          }
+          pf.a = std::min(pa, pb_);
+          pf.b = std::max(pa, pb_);
+          pf.description = "cable cut on line " + ln + " between " + std::to_string(c.between_a()) +
+                           " and " + std::to_string(c.between_b());
+          break;
+        }
+        case K::ShortCircuit: pf.description = "short circuit on line " + ln; break;
+        case K::Noise: {
+          const auto v = f.noise().errors_per_billion_bits();
+          if (v == 0 || v > 1'000'000'000ULL) {
+            error(at_field(kw, kd, "errors_per_billion_bits"),
+                  "noise errors_per_billion_bits must be in 1..1000000000");
+            continue;
+          }
+          pf.noise_ppb = v;
+          pf.description = "noise on line " + ln + " (" + std::to_string(v) + " errors per 10^9 bits)";
+          break;
+        }
+        case K::PowerLoss:
+        case K::TransceiverFailure:
+        case K::Babble: {
+          const scenario::StationFault& s = pf.kind == K::PowerLoss            ? f.power_loss()
+                                            : pf.kind == K::TransceiverFailure ? f.transceiver_failure()
+                                                                               : f.babble();
+          if (!s.has_address()) {
+            error(kw, std::string(kind_field) + " needs the address of a station");
+            continue;
+          }
+          pf.a = station_ref(plan, at_field(kw, kd, "address"), li, s.address(), kind_field);
+          if (pf.a < 0) continue;
+          const char* what = pf.kind == K::PowerLoss            ? "power loss of station "
+                             : pf.kind == K::TransceiverFailure ? "transceiver failure of station "
+                                                                : "babbling transmitter at station ";
+          pf.description = what + std::to_string(s.address()) + " on line " + ln;
+          break;
+        }
+      }
+      if (ok) plan.faults.push_back(std::move(pf));
+    }
+    std::stable_sort(plan.faults.begin(), plan.faults.end(),
+                     [](const PlanFault& a, const PlanFault& b) { return a.at < b.at; });
+  }
+
+  const scenario::Scenario& m_proto;
+  std::string m_file;
+  std::vector<Diagnostic>& m_errors;
+  Where m_root;
+  std::map<std::string, int> m_line_index;
+};
+
+}  // namespace
+
+LoadResult parse_scenario(std::string_view text, std::string_view file) {
+  LoadResult r;
+  scenario::Scenario proto;
+  Collector collector(r.errors, std::string(file));
+  pb::TextFormat::ParseInfoTree tree;
+  pb::TextFormat::Parser parser;
+  parser.RecordErrorsTo(&collector);
+  parser.WriteLocationsTo(&tree);
+  if (!parser.ParseFromString(std::string(text), &proto)) {
+    if (r.errors.empty()) r.errors.push_back({std::string(file), 0, 0, "cannot parse the scenario"});
+    return r;
+  }
+  Planner planner(proto, std::string(file), &tree, r.errors);
+  r.plan = planner.run();
+  return r;
+}
+
+LoadResult load_scenario_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    LoadResult r;
+    r.errors.push_back({path, 0, 0, std::string("cannot read the file: ") + std::strerror(errno)});
+    return r;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_scenario(ss.str(), path);
+}
+
+LoadResult plan_scenario(const scenario::Scenario& proto, std::string_view file) {
+  LoadResult r;
+  Planner planner(proto, std::string(file), nullptr, r.errors);
+  r.plan = planner.run();
+  return r;
+}
+
+}  // namespace pbvbus::tools

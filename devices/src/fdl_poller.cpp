@@ -1,0 +1,74 @@
+#include "pbvbus/devices/fdl_poller.hpp"
+
+namespace pbvbus::devices {
+
+FdlPoller::FdlPoller(std::vector<PollItem> items)
+    : m_items(std::move(items)),
+      m_stats(m_items.size()),
+      m_visit_done(m_items.size(), 0),
+      m_seq(m_items.size(), 0) {}
+
+PollStats FdlPoller::total() const {
+  PollStats t;
+  for (const auto& s : m_stats) {
+    t.requests += s.requests;
+    t.ok += s.ok;
+    t.no_response += s.no_response;
+    t.sent += s.sent;
+    t.retries += s.retries;
+    t.data_octets += s.data_octets;
+  }
+  return t;
+}
+
+void FdlPoller::on_power_on(bus::Ticks) {
+  // A restarted master begins a fresh visit; counters stay (they describe the whole run).
+  ++m_visit;
+}
+
+bool FdlPoller::next_request(fdl::Priority prio, bus::Ticks, fdl::Request& out) {
+  const std::size_t n = m_items.size();
+  if (n == 0) return false;
+  const bool high = prio == fdl::Priority::High;
+  std::size_t& cursor = m_cursor[high ? 0 : 1];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t k = (cursor + i) % n;
+    const PollItem& it = m_items[k];
+    if (fdl::fn_is_high_priority(it.fn) != high || m_visit_done[k] == m_visit) continue;
+    m_visit_done[k] = m_visit;
+    cursor = (k + 1) % n;
+    out.da = it.da;
+    out.fn = it.fn;
+    out.dsap.reset();
+    out.ssap.reset();
+    out.data.resize(it.length);
+    const std::uint8_t seq = m_seq[k]++;
+    for (std::size_t j = 0; j < it.length; ++j) out.data[j] = static_cast<std::uint8_t>(seq + j);
+    out.tag = k;
+    return true;
+  }
+  return false;
+}
+
+void FdlPoller::on_confirmation(const fdl::Confirmation& con) {
+  if (con.tag >= m_stats.size()) return;
+  PollStats& s = m_stats[con.tag];
+  ++s.requests;
+  s.retries += con.retries;
+  switch (con.result) {
+    case fdl::Confirmation::Result::Ok:
+      ++s.ok;
+      s.data_octets += con.data.size();
+      break;
+    case fdl::Confirmation::Result::NoResponse: ++s.no_response; break;
+    case fdl::Confirmation::Result::Sent: ++s.sent; break;
+  }
+}
+
+void FdlPoller::on_token(bus::Ticks, bus::Ticks trr) {
+  ++m_tokens;
+  ++m_visit;
+  m_trr.push_back(trr);
+}
+
+}  // namespace pbvbus::devices

@@ -1,0 +1,34 @@
+#include "pbvbus/devices/fdl_responder.hpp"
+
+namespace pbvbus::devices {
+
+void FdlResponder::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
+  using fdl::RequestFn;
+  switch (ind.fn) {
+    case RequestFn::SrdLow:
+    case RequestFn::SrdHigh: {
+      ++m_srd;
+      if (m_data.empty()) {
+        reply.short_ack();
+        return;
+      }
+      const auto c = static_cast<std::uint8_t>(m_cycle++);
+      for (std::size_t i = 0; i < m_data.size(); ++i) m_data[i] = static_cast<std::uint8_t>(c + i);
+      reply.respond(fdl::ResponseStatus::DL, m_data);
+      return;
+    }
+    case RequestFn::SdaLow:
+    case RequestFn::SdaHigh:
+      ++m_sda;
+      reply.short_ack();
+      return;
+    case RequestFn::SdnLow:
+    case RequestFn::SdnHigh:
+      ++m_sdn;
+      reply.none();
+      return;
+    default: ++m_other; return;
+  }
+}
+
+}  // namespace pbvbus::devices

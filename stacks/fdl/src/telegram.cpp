@@ -107,7 +107,10 @@ std::string_view to_string(EncodeError e) {
     case EncodeError::None: return "ok";
     case EncodeError::DataTooLong: return "data unit too long";
     case EncodeError::BadAddress: return "address out of range";
-    case EncodeError::BadSap: return "SAP or segment out of range";
+    case EncodeError::BadSap: return "SAP or segment out of range, or segment without SAP";
+    case EncodeError::BadFunction: return "reserved function code or status";
+    case EncodeError::DataTooShort: return "too few octets for the frame type";
+    case EncodeError::WrongFrameType: return "frame type has no FC (token or short acknowledgement)";
   }
   return "?";
 }
@@ -183,7 +186,8 @@ DecodeError decode(std::span<const std::uint8_t> b, Telegram& t) {
       if ((b[1] & kExt) || (b[2] & kExt)) return DecodeError::BadExtension;
       t.da = b[1];
       t.sa = b[2];
-      if (t.sa == kBroadcast || t.da == kBroadcast) return DecodeError::BadSourceAddress;
+      if (t.sa == kBroadcast) return DecodeError::BadSourceAddress;
+      if (t.da == kBroadcast) return DecodeError::BroadcastNotSdn;
       return DecodeError::None;
     case kSD1:
     case kSD3: {
@@ -224,10 +228,9 @@ int frame_length(std::span<const std::uint8_t> b) {
     case kSD1: return 6;
     case kSD3: return 14;
     case kSD2: {
-      if (b.size() < 4) {
-        if (b.size() >= 3 && b[1] != b[2]) return -1;
-        return 0;
-      }
+      if (b.size() >= 2 && (b[1] < kMinLe || b[1] > kMaxLe)) return -1;
+      if (b.size() >= 3 && b[1] != b[2]) return -1;
+      if (b.size() < 4) return 0;
       if (b[1] != b[2] || b[3] != kSD2 || b[1] < kMinLe || b[1] > kMaxLe) return -1;
       return b[1] + 6;
     }
@@ -236,12 +239,25 @@ int frame_length(std::span<const std::uint8_t> b) {
 }
 
 namespace {
+// The FC and address checks decode_body() applies, so that encode never makes what decode
+// rejects.
+EncodeError check_header(const FrameSpec& s) {
+  if (s.da > kBroadcast || s.sa >= kBroadcast) return EncodeError::BadAddress;
+  if (fc_is_request(s.fc)) {
+    if ((s.fc & 0x80) && s.fc != kFcClockValue) return EncodeError::BadFunction;
+    if (!request_fn_valid(s.fc)) return EncodeError::BadFunction;
+    if (s.da == kBroadcast && fn_expects_reply(fc_request_fn(s.fc))) return EncodeError::BadAddress;
+  } else {
+    if ((s.fc & 0x80) || !response_status_valid(s.fc)) return EncodeError::BadFunction;
+    if (s.da == kBroadcast) return EncodeError::BadAddress;
+  }
+  return EncodeError::None;
+}
+
 // Writes DA SA FC [DAE..] [SAE..] DU into `body`; returns its length, or 0 on error.
 std::size_t write_body(const FrameSpec& s, std::uint8_t* body, std::size_t cap, EncodeError& err) {
-  if (s.da > 127 || s.sa > 126) {
-    err = EncodeError::BadAddress;
-    return 0;
-  }
+  err = check_header(s);
+  if (err != EncodeError::None) return 0;
   if ((s.dsap && *s.dsap > 63) || (s.ssap && *s.ssap > 63) || (s.da_segment && *s.da_segment > 63) ||
       (s.sa_segment && *s.sa_segment > 63) || (s.da_segment && !s.dsap) || (s.sa_segment && !s.ssap)) {
     err = EncodeError::BadSap;
@@ -288,7 +304,7 @@ EncodeError encode_as(FrameType type, const FrameSpec& s, Frame& out) {
     case FrameType::SD3: {
       const std::size_t n = write_body(s, b.data() + 1, 11, err);
       if (!n) return err;
-      if (n != 11) return EncodeError::DataTooLong;
+      if (n != 11) return EncodeError::DataTooShort;
       b[0] = kSD3;
       b[12] = fcs({b.data() + 1, 11});
       b[13] = kED;
@@ -298,7 +314,7 @@ EncodeError encode_as(FrameType type, const FrameSpec& s, Frame& out) {
     case FrameType::SD2: {
       const std::size_t n = write_body(s, b.data() + 4, kMaxLe, err);
       if (!n) return err;
-      if (n < kMinLe) return EncodeError::DataTooLong;  // would be an SD1
+      if (n < kMinLe) return EncodeError::DataTooShort;  // LE 3 is an SD1
       b[0] = kSD2;
       b[1] = b[2] = static_cast<std::uint8_t>(n);
       b[3] = kSD2;
@@ -307,8 +323,10 @@ EncodeError encode_as(FrameType type, const FrameSpec& s, Frame& out) {
       out.len = static_cast<std::uint16_t>(n + 6);
       return EncodeError::None;
     }
-    default: return EncodeError::DataTooLong;
+    case FrameType::SD4:
+    case FrameType::SC: return EncodeError::WrongFrameType;
   }
+  return EncodeError::WrongFrameType;
 }
 
 EncodeError encode(const FrameSpec& s, Frame& out) {
@@ -332,6 +350,33 @@ Frame encode_sc() {
   f.buf[0] = kSC;
   f.len = 1;
   return f;
+}
+
+FrameSpec to_spec(const Telegram& t) {
+  FrameSpec s;
+  s.da = t.da;
+  s.sa = t.sa;
+  s.fc = t.fc;
+  s.dsap = t.dsap;
+  s.ssap = t.ssap;
+  s.da_segment = t.da_segment;
+  s.sa_segment = t.sa_segment;
+  s.data = t.data;
+  return s;
+}
+
+EncodeError reencode(const Telegram& t, Frame& out) {
+  switch (t.type) {
+    case FrameType::SD4:
+      if (t.da >= kBroadcast || t.sa >= kBroadcast) {
+        out.len = 0;
+        return EncodeError::BadAddress;
+      }
+      out = encode_token(t.da, t.sa);
+      return EncodeError::None;
+    case FrameType::SC: out = encode_sc(); return EncodeError::None;
+    default: return encode_as(t.type, to_spec(t), out);
+  }
 }
 
 }  // namespace pbvbus::fdl

@@ -4,7 +4,22 @@
 // decode() accepts exactly one whole frame and checks everything a receiver checks: start and
 // end delimiters, LE = LEr within 4..249, FCS, address extension chains, reserved function and
 // status codes, broadcast only with SDN. It never throws; errors are values with a reason.
-// encode() picks SD1/SD2/SD3 by the rules of §B.1 and never produces an invalid frame.
+// encode() picks SD1/SD2/SD3 by the rules of §B.1 and never produces an invalid frame: whatever
+// it accepts, decode() accepts and returns the same fields.
+//
+// Canonical form. Every frame decode() accepts is re-encoded to the identical bytes by
+// reencode() (checked by the fuzz target tests/fuzz and tests/fdl/telegram_mutation_parser_test),
+// with one deliberate exception: within one extension chain (DAE or SAE) the receiver accepts
+// the region/segment octet before or after the SAP octet, because the parsing rule of §B.2 is
+// order-free ("read octets while bit 7 is set; the SAP is the octet with bit 6 = 0"), while the
+// encoder always writes the segment first. Both orders carry the same fields and the same FCS.
+// A chain holds at most one SAP and one segment octet, and must hold a SAP (§B.2: a DAE/SAE
+// names a SAP); anything else is BadExtension.
+//
+// Decisions where the spec is silent: a token (SD4) to DA 127 is BroadcastNotSdn (a token is not
+// an SDN); a token with the extension bit in DA or SA is BadExtension; SA 127 is
+// BadSourceAddress in every frame type. An SD2 frame whose DU is exactly 8 octets (the SD3 case)
+// is accepted: §B.1 says a receiver must accept all three formats.
 
 #include <array>
 #include <cstdint>
@@ -163,7 +178,15 @@ struct FrameSpec {
   std::span<const std::uint8_t> data;
 };
 
-enum class EncodeError : std::uint8_t { None = 0, DataTooLong, BadAddress, BadSap };
+enum class EncodeError : std::uint8_t {
+  None = 0,
+  DataTooLong,     ///< more octets after FC than the frame type holds (SD2: DU > 246)
+  BadAddress,      ///< DA > 127, SA > 126, or DA 127 with a function other than SDN / time event
+  BadSap,          ///< SAP or segment > 63, or a segment without its SAP
+  BadFunction,     ///< reserved request function, reserved response status, or a bad bit 7
+  DataTooShort,    ///< fewer octets after FC than the frame type needs (SD3: 8, SD2: 1)
+  WrongFrameType,  ///< encode_as() with SD4 or SC (use encode_token() / encode_sc())
+};
 std::string_view to_string(EncodeError e);
 
 /// Encodes with the shortest legal frame type: SD1 if there is nothing after FC, SD3 if exactly
@@ -171,7 +194,15 @@ std::string_view to_string(EncodeError e);
 EncodeError encode(const FrameSpec& spec, Frame& out);
 /// Encodes with a given type (SD1, SD2 or SD3); fails if the content does not fit that type.
 EncodeError encode_as(FrameType type, const FrameSpec& spec, Frame& out);
+/// A token frame. da and sa are masked to 7 bits; the caller keeps them below 127.
 Frame encode_token(std::uint8_t da, std::uint8_t sa);
 Frame encode_sc();
+
+/// The FrameSpec that carries a decoded telegram's fields (its `data` points where t.data does).
+FrameSpec to_spec(const Telegram& t);
+/// Encodes a decoded telegram again in its own frame type, SD4 and SC included. For every frame
+/// decode() accepts this gives the same bytes, except for the chain-order case described at the
+/// top of this header.
+EncodeError reencode(const Telegram& t, Frame& out);
 
 }  // namespace pbvbus::fdl

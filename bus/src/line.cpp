@@ -1,6 +1,7 @@
 #include "pbvbus/bus/line.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <stdexcept>
 
@@ -9,6 +10,9 @@ namespace pbvbus::bus {
 namespace {
 constexpr Ticks kNeverHeard = INT64_MIN / 4;
 constexpr std::uint64_t kTagTimer = 0, kTagTxStart = 1, kTagBabble = 2;
+/// Octets per babble burst: long enough to keep the event rate low, short enough that a fault
+/// repair (babble off) takes effect within a few character times.
+constexpr std::size_t kBabbleBurst = 32;
 
 /// Destination address octet of an FDL frame, or -1 if the frame has none (SC, garbage).
 int frame_da(std::span<const std::uint8_t> b) {
@@ -31,7 +35,10 @@ struct Line::Transmission {
   Ticks start = 0;
   Ticks end = 0;
   std::uint16_t flags = 0;
+  bool cut_counted = false;  // counted in LineStats::partial already
   std::bitset<kMaxAttachments> rx;
+  /// Idle time each receiver had seen when this frame started (valid where rx is set).
+  std::array<Ticks, kMaxAttachments> idle_before{};
 };
 
 class Line::Port final : public DevicePort {
@@ -61,17 +68,22 @@ struct Line::Attachment final : EventTarget {
         deadline = kNever;
         dev->on_timer(now);
       } else if (deadline != kNever) {
-        arm(deadline);
+        arm(deadline);  // the deadline was postponed after this wake-up was queued
       }
     } else if (kind == kTagTxStart) {
       if (value != power_epoch || pending.empty()) return;
+      if (uart_busy_until > now) {
+        // The UART is still shifting out the previous telegram: this one follows back to back.
+        line.m_sched.schedule(uart_busy_until, *this, tag);
+        return;
+      }
       // The pending transmission due now: earliest start, then order of request.
       auto it = std::min_element(pending.begin(), pending.end(), [](const auto& a, const auto& b) {
         return a.start != b.start ? a.start < b.start : a.seq < b.seq;
       });
       std::vector<std::uint8_t> bytes = std::move(it->bytes);
       pending.erase(it);
-      line.start_transmission(*this, std::move(bytes));
+      line.start_transmission(*this, bytes, false);
     } else if (kind == kTagBabble) {
       if (value == babble_epoch) line.babble_burst(*this);
     }
@@ -98,7 +110,13 @@ struct Line::Attachment final : EventTarget {
   bool babbling = false;
   bool cut_after = false;
   int segment = 0;
-  Ticks last_activity_end = kNeverHeard;
+  /// End of every activity this attachment has heard completely or partly (frames delivered,
+  /// frames cut short for it, its own transmissions).
+  Ticks done_until = kNeverHeard;
+  /// done_until, extended by the scheduled end of frames it is hearing right now.
+  Ticks heard_until = kNeverHeard;
+  /// End of the device's own current telegram (not babble): a UART sends one at a time.
+  Ticks uart_busy_until = kNeverHeard;
   // Timer: one wanted deadline; `next_event` is the earliest wake-up still valid in the queue.
   Ticks deadline = kNever;
   Ticks next_event = kNever;
@@ -115,7 +133,9 @@ void Line::Port::transmit(Ticks start, std::span<const std::uint8_t> bytes) {
   if (start < now) start = now;
   // Always through the queue, even at `now`: a device answering from inside on_frame() must not
   // start a transmission while the line is still delivering the previous one.
-  m_att.pending.push_back({start, m_att.pending_seq++, {bytes.begin(), bytes.end()}});
+  std::vector<std::uint8_t> buf = m_line.take_buffer();
+  buf.assign(bytes.begin(), bytes.end());
+  m_att.pending.push_back({start, m_att.pending_seq++, std::move(buf)});
   m_line.m_sched.schedule(start, m_att, (m_att.power_epoch << 2) | kTagTxStart);
 }
 
@@ -155,6 +175,22 @@ void Line::start() {
 void Line::add_tap(Tap& tap) { m_taps.push_back(&tap); }
 void Line::remove_tap(Tap& tap) { std::erase(m_taps, &tap); }
 
+std::vector<std::uint8_t> Line::take_buffer() {
+  if (m_buffers.empty()) {
+    std::vector<std::uint8_t> b;
+    b.reserve(256);  // the longest FDL telegram (SD2, LE = 249) is 255 octets
+    return b;
+  }
+  std::vector<std::uint8_t> b = std::move(m_buffers.back());
+  m_buffers.pop_back();
+  return b;
+}
+
+void Line::give_buffer(std::vector<std::uint8_t>&& b) {
+  b.clear();
+  m_buffers.push_back(std::move(b));
+}
+
 std::uint64_t Line::next_random() {
   // splitmix64: small, fast and the same on every platform (std distributions are not).
   std::uint64_t z = (m_rng += 0x9E3779B97F4A7C15ULL);
@@ -168,7 +204,7 @@ bool Line::can_hear(const Attachment& rx, const Attachment& tx) const {
 }
 
 bool Line::connected(AttachmentId a, AttachmentId b) const {
-  return can_hear(*m_atts[a], *m_atts[b]);
+  return can_hear(*m_atts.at(static_cast<std::size_t>(a)), *m_atts.at(static_cast<std::size_t>(b)));
 }
 
 void Line::recompute_segments() {
@@ -187,6 +223,7 @@ static void garble(std::vector<std::uint8_t>& bytes, Ticks t_start, Ticks char_t
   Ticks first = std::max<Ticks>(0, (from - t_start) / char_ticks);
   Ticks last = std::min<Ticks>(n, (to - t_start + char_ticks - 1) / char_ticks);
   for (Ticks i = first; i < last; ++i) {
+    // "| 1": the XOR mask is never zero, so an overlapped character always differs.
     bytes[static_cast<std::size_t>(i)] ^= static_cast<std::uint8_t>((noise >> ((i % 8) * 8)) | 1);
   }
 }
@@ -212,15 +249,21 @@ void Line::apply_noise(Transmission& t) {
   if (any) ++m_stats.noisy;
 }
 
-void Line::start_transmission(Attachment& from, std::vector<std::uint8_t> bytes) {
-  if (!from.powered) return;
+void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes, bool babble) {
+  if (!from.powered) {
+    give_buffer(std::move(bytes));
+    return;
+  }
   const Ticks now = m_sched.now();
   const Ticks char_ticks = chars_to_ticks(1, m_baud);
+  const Ticks end = now + static_cast<Ticks>(bytes.size()) * char_ticks;
   ++m_stats.frames;
   m_stats.octets += bytes.size();
+  if (!babble) from.uart_busy_until = end;
   if (m_short || !from.xcvr_ok) {
     // Nothing reaches the cable (or the cable carries nothing readable).
     ++m_stats.lost;
+    give_buffer(std::move(bytes));
     return;
   }
   std::unique_ptr<Transmission> t;
@@ -232,14 +275,25 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t> bytes)
   }
   t->id = ++m_next_tx_id;
   t->from = &from;
-  t->bytes = std::move(bytes);
+  std::swap(t->bytes, bytes);
+  give_buffer(std::move(bytes));
   t->sent_len = t->bytes.size();
   t->start = now;
-  t->end = now + static_cast<Ticks>(t->bytes.size()) * char_ticks;
-  t->flags = from.babbling ? kRxBabble : 0;
+  t->end = end;
+  t->flags = babble ? kRxBabble : 0;
+  t->cut_counted = false;
   t->rx.reset();
-  for (auto& a : m_atts)
-    if (a.get() != &from && can_hear(*a, from)) t->rx.set(static_cast<std::size_t>(a->id));
+  for (auto& a : m_atts) {
+    if (a.get() == &from || !can_hear(*a, from)) continue;
+    const auto i = static_cast<std::size_t>(a->id);
+    t->rx.set(i);
+    // Idle as this receiver's UART saw it when the first start bit arrived: zero if it was
+    // still hearing something (a collision), "forever" if nothing since power-on.
+    t->idle_before[i] = a->heard_until == kNeverHeard ? kIdleForever : std::max<Ticks>(0, now - a->heard_until);
+    a->heard_until = std::max(a->heard_until, end);
+  }
+  from.heard_until = std::max(from.heard_until, end);  // RS-485 transceivers hear themselves
+  from.done_until = std::max(from.done_until, end);
 
   // Overlap with anything else on the same segment corrupts both.
   for (auto& o : m_in_flight) {
@@ -252,14 +306,12 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t> bytes)
     garble(t->bytes, t->start, char_ticks, now, std::min(o->end, t->end), next_random());
   }
   apply_noise(*t);
-  from.last_activity_end = std::max(from.last_activity_end, t->end);
   m_sched.schedule(t->end, *this, t->id);
   m_in_flight.push_back(std::move(t));
 }
 
 void Line::deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags, Ticks end) {
-  const Ticks prev = to.last_activity_end;
-  to.last_activity_end = std::max(prev, end);
+  to.done_until = std::max(to.done_until, end);
   std::span<const std::uint8_t> bytes(t.bytes.data(), len);
   const int filter = to.dev->receive_filter();
   if (filter != kReceiveAll) {
@@ -270,7 +322,7 @@ void Line::deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16
   f.bytes = bytes;
   f.start = t.start;
   f.end = end;
-  f.idle_before = prev == kNeverHeard ? kIdleForever : std::max<Ticks>(0, t.start - prev);
+  f.idle_before = t.idle_before[static_cast<std::size_t>(to.id)];
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
   to.dev->on_frame(f);
 }
@@ -303,9 +355,18 @@ void Line::end_transmission(std::uint64_t id) {
   m_pool.push_back(std::move(owned));
 }
 
+void Line::recompute_heard(Attachment& a) {
+  Ticks h = a.done_until;
+  const auto i = static_cast<std::size_t>(a.id);
+  for (const auto& t : m_in_flight)
+    if (t->from == &a || t->rx.test(i)) h = std::max(h, t->end);
+  a.heard_until = h;
+}
+
 void Line::truncate_in_flight() {
   const Ticks now = m_sched.now();
   const Ticks char_ticks = chars_to_ticks(1, m_baud);
+  bool changed = false;
   for (std::size_t i = 0; i < m_in_flight.size();) {
     Transmission& t = *m_in_flight[i];
     const auto done = static_cast<std::size_t>(std::clamp<Ticks>((now - t.start) / char_ticks, 0,
@@ -316,21 +377,61 @@ void Line::truncate_in_flight() {
       if (!t.rx.test(bit)) continue;
       if (sender_gone || !can_hear(*a, *t.from)) {
         t.rx.reset(bit);
-        ++m_stats.partial;
-        if (done > 0 && a->powered && a->xcvr_ok) deliver(t, *a, done, kRxPartial, now);
+        changed = true;
+        if (!t.cut_counted) {
+          t.cut_counted = true;
+          ++m_stats.partial;
+        }
+        if (a->powered && a->xcvr_ok) {
+          // It heard the line up to now (a power loss resets this anyway).
+          if (done > 0) deliver(t, *a, done, kRxPartial, now);
+          a->done_until = std::max(a->done_until, now);
+        }
       }
     }
     if (sender_gone) {
       // The frame ends here for everybody, the tap included.
-      t.sent_len = t.bytes.size();
+      if (!t.cut_counted) ++m_stats.partial;
       tap_frame(t, done, kRxPartial, now);
-      t.from->last_activity_end = now;
+      t.from->done_until = now;
+      t.from->uart_busy_until = std::min(t.from->uart_busy_until, now);
       std::unique_ptr<Transmission> owned = std::move(m_in_flight[i]);
       m_in_flight.erase(m_in_flight.begin() + static_cast<std::ptrdiff_t>(i));
       m_pool.push_back(std::move(owned));
+      changed = true;
       continue;
     }
     ++i;
+  }
+  if (changed)
+    for (auto& a : m_atts) recompute_heard(*a);
+}
+
+void Line::join_in_flight() {
+  const Ticks now = m_sched.now();
+  const Ticks char_ticks = chars_to_ticks(1, m_baud);
+  for (auto& t : m_in_flight) {
+    if (t->end <= now) continue;
+    // Stations that can now hear the sender hear the rest of the frame: not a frame they can
+    // receive (they missed its start), but activity that keeps them from counting idle.
+    for (auto& a : m_atts)
+      if (a.get() != t->from && !t->rx.test(static_cast<std::size_t>(a->id)) && can_hear(*a, *t->from))
+        a->heard_until = std::max(a->heard_until, t->end);
+  }
+  // Frames from formerly separate segments that are both still on the wire now overlap.
+  for (std::size_t i = 0; i < m_in_flight.size(); ++i) {
+    for (std::size_t j = i + 1; j < m_in_flight.size(); ++j) {
+      Transmission& x = *m_in_flight[i];
+      Transmission& y = *m_in_flight[j];
+      if (x.end <= now || y.end <= now || x.from->segment != y.from->segment) continue;
+      if ((x.flags & kRxCollision) && (y.flags & kRxCollision)) continue;  // already damaged
+      if (!(x.flags & kRxCollision)) ++m_stats.collisions;
+      if (!(y.flags & kRxCollision)) ++m_stats.collisions;
+      x.flags |= kRxCollision;
+      y.flags |= kRxCollision;
+      garble(x.bytes, x.start, char_ticks, now, std::min(x.end, y.end), next_random());
+      garble(y.bytes, y.start, char_ticks, now, std::min(x.end, y.end), next_random());
+    }
   }
 }
 
@@ -345,6 +446,7 @@ void Line::set_cut_after(AttachmentId a, bool cut) {
   att.cut_after = cut;
   recompute_segments();
   if (cut) truncate_in_flight();
+  else join_in_flight();
   emit_event(cut ? LineEventKind::CableCut : LineEventKind::CableRepaired, a,
              a + 1 < attachment_count() ? a + 1 : -1);
 }
@@ -371,6 +473,7 @@ void Line::set_power(AttachmentId id, bool on) {
   const Ticks now = m_sched.now();
   if (!on) {
     a.powered = false;
+    for (auto& p : a.pending) give_buffer(std::move(p.bytes));
     a.pending.clear();
     ++a.power_epoch;
     ++a.timer_gen;
@@ -381,7 +484,8 @@ void Line::set_power(AttachmentId id, bool on) {
     a.dev->on_power_off(now);
   } else {
     a.powered = true;
-    a.last_activity_end = kNeverHeard;
+    a.done_until = a.heard_until = a.uart_busy_until = kNeverHeard;
+    join_in_flight();  // the rest of a frame already on the wire is activity it does hear
     emit_event(LineEventKind::PowerOn, id);
     a.dev->on_power_on(now);
     if (a.babbling) babble_burst(a);
@@ -393,6 +497,7 @@ void Line::set_transceiver_ok(AttachmentId id, bool ok) {
   if (a.xcvr_ok == ok) return;
   a.xcvr_ok = ok;
   if (!ok) truncate_in_flight();
+  else join_in_flight();
   emit_event(ok ? LineEventKind::TransceiverRepaired : LineEventKind::TransceiverFailed, id);
 }
 
@@ -407,11 +512,12 @@ void Line::set_babbling(AttachmentId id, bool on) {
 
 void Line::babble_burst(Attachment& a) {
   if (!a.babbling || !a.powered) return;
-  // Garbage in bursts of 32 characters, back to back: the line never goes idle.
-  std::vector<std::uint8_t> junk(32);
+  // Garbage in bursts, back to back: the line never goes idle while it lasts.
+  std::vector<std::uint8_t> junk = take_buffer();
+  junk.resize(kBabbleBurst);
   for (auto& b : junk) b = static_cast<std::uint8_t>(next_random());
   const Ticks end = m_sched.now() + chars_to_ticks(static_cast<std::int64_t>(junk.size()), m_baud);
-  start_transmission(a, std::move(junk));
+  start_transmission(a, junk, true);
   m_sched.schedule(end, a, (a.babble_epoch << 2) | kTagBabble);
 }
 

@@ -1,6 +1,5 @@
 #include "pbvbus/bus/time.hpp"
 
-#include <charconv>
 #include <cstdio>
 
 namespace pbvbus::bus {
@@ -25,23 +24,45 @@ std::string_view baud_name(Baud b) {
 }
 
 std::optional<Baud> parse_baud(std::string_view s) {
-  for (std::string_view suffix : {"bit/s", "bps", "baud"}) {
+  while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+  while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+  for (std::string_view suffix : {"bit/s", "bps", "baud", "Bd"}) {
     if (s.size() > suffix.size() && s.substr(s.size() - suffix.size()) == suffix) {
       s.remove_suffix(suffix.size());
       break;
     }
   }
-  for (Baud b : kAllBauds) {
-    std::string_view name = baud_name(b);
-    if (s == name) return b;
-    // "12M" also as "12000k"; plain numbers as bit/s.
+  while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+  // A decimal number of bit/s, kbit/s or Mbit/s, converted exactly: "1.5M", "1500k", "1500000",
+  // "45.45k". Anything that is not exactly one of the PROFIBUS rates is rejected.
+  std::uint64_t scale = 1;
+  if (!s.empty() && (s.back() == 'k' || s.back() == 'K')) {
+    scale = 1'000;
+    s.remove_suffix(1);
+  } else if (!s.empty() && s.back() == 'M') {
+    scale = 1'000'000;
+    s.remove_suffix(1);
   }
-  std::uint64_t v = 0;
-  auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec == std::errc() && p == s.data() + s.size()) {
-    for (Baud b : kAllBauds)
-      if (static_cast<std::uint64_t>(b) == v) return b;
+  while (!s.empty() && s.back() == ' ') s.remove_suffix(1);  // "19.2 kbit/s"
+  std::uint64_t whole = 0, frac = 0, frac_div = 1;
+  std::size_t i = 0;
+  bool any = false;
+  for (; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i, any = true) {
+    if (whole > 100'000'000) return std::nullopt;
+    whole = whole * 10 + static_cast<std::uint64_t>(s[i] - '0');
   }
+  if (i < s.size() && s[i] == '.') {
+    for (++i; i < s.size() && s[i] >= '0' && s[i] <= '9'; ++i, any = true) {
+      if (frac_div >= 1'000'000) return std::nullopt;
+      frac = frac * 10 + static_cast<std::uint64_t>(s[i] - '0');
+      frac_div *= 10;
+    }
+  }
+  if (!any || i != s.size()) return std::nullopt;
+  if ((frac * scale) % frac_div != 0) return std::nullopt;
+  const std::uint64_t v = whole * scale + frac * scale / frac_div;
+  for (Baud b : kAllBauds)
+    if (static_cast<std::uint64_t>(b) == v) return b;
   return std::nullopt;
 }
 

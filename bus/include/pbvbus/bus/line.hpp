@@ -14,6 +14,9 @@
 // Propagation delay is taken as zero: at 12 Mbit/s 100 m of cable is ~6 bit times, less than
 // min TSDR, and PROFIBUS timing is specified at the stations.
 //
+// A device's own telegrams never overlap each other: if it asks for a start while its previous
+// telegram is still going out, the new one follows back to back (one UART per station).
+//
 // Attachments keep the order in which they were attached: that is their position along the
 // cable, which is what a cable cut between two stations refers to.
 
@@ -35,7 +38,7 @@ struct LineStats {
   std::uint64_t frames = 0;       ///< transmissions started
   std::uint64_t collisions = 0;   ///< transmissions damaged by overlap
   std::uint64_t noisy = 0;        ///< transmissions with at least one flipped bit
-  std::uint64_t partial = 0;      ///< transmissions cut short by a fault
+  std::uint64_t partial = 0;      ///< transmissions cut short by a fault (for anyone)
   std::uint64_t lost = 0;         ///< transmissions nobody could hear (short, dead transceiver)
   std::uint64_t octets = 0;       ///< octets put on the wire
 };
@@ -100,7 +103,16 @@ class Line final : private EventTarget {
   friend class Port;
 
   void on_event(Ticks now, std::uint64_t tag) override;  // end of transmission `tag`
-  void start_transmission(Attachment& from, std::vector<std::uint8_t> bytes);
+  /// Puts `bytes` on the wire now; takes the buffer (it goes back to the pool afterwards).
+  void start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes, bool babble);
+  std::vector<std::uint8_t> take_buffer();
+  void give_buffer(std::vector<std::uint8_t>&& b);
+  /// After a receiver stopped hearing something early: what it last heard is re-derived.
+  void recompute_heard(Attachment& a);
+  /// After a repair that joins segments or revives a transceiver: receivers start hearing the
+  /// rest of frames already on the wire (as garbage), and frames that now share the cable
+  /// corrupt each other from here on.
+  void join_in_flight();
   void end_transmission(std::uint64_t id);
   void deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags,
                Ticks end);
@@ -123,8 +135,9 @@ class Line final : private EventTarget {
   std::vector<Tap*> m_taps;
   std::vector<std::unique_ptr<Transmission>> m_in_flight;
   std::vector<std::unique_ptr<Transmission>> m_pool;
-  /// End of the last activity per segment (index = segment id); kIdleForever-based idle.
-  std::vector<Ticks> m_segment_last_end;
+  /// Byte buffers recycled between pending transmissions and transmissions, so that the
+  /// per-frame path does not allocate once the line has warmed up.
+  std::vector<std::vector<std::uint8_t>> m_buffers;
   bool m_short = false;
   std::uint64_t m_noise_ppb = 0;
   std::uint64_t m_rng;

@@ -69,13 +69,15 @@ constexpr std::int64_t ticks_to_us(Ticks t) { return t / kTicksPerUs; }
 
 /// "1.5M", "187.5k", ... as written in GSD files and reports.
 std::string_view baud_name(Baud b);
-/// Accepts 1500000, "1.5M", "1.5Mbit/s", "187.5k", "187.5kbit/s", "12M" ...
+/// Accepts 1500000, "1.5M", "1.5Mbit/s", "187.5k", "187.5kbit/s", "12M", "12000k" ...: any
+/// decimal spelling whose value is exactly one of the PROFIBUS rates.
 std::optional<Baud> parse_baud(std::string_view s);
 
 /// Parses a duration with unit: "250ms", "5s", "2min", "100us", "1500ns", "3ticks".
 /// Returns nullopt for a missing or unknown unit, a negative value or overflow.
 std::optional<Ticks> parse_duration(std::string_view s);
-/// Human form of a duration, e.g. "2.5 s", "250 ms", "12.345 us".
+/// Human form of a duration with three decimals, rounded down: "2.500 s", "250.000 ms",
+/// "12.345 us".
 std::string format_duration(Ticks t);
 
 }  // namespace pbvbus::bus

@@ -1,0 +1,87 @@
+#pragma once
+// What a DP slave is (IEC 61158-6 DP; protocol-facts.md §D, §E): identity, supported features,
+// parameter limits and its real configuration. A plain struct, independent of GSD files; the
+// GSD-driven builder in devices/ fills it.
+//
+// Conventions decided here:
+// - The user prm data limits and the check callback see Set_Prm octets 8.. (GSD
+//   User_Prm_Data, which for a DP-V1 slave begins with DPV1_Status_1..3).
+// - A module is one or more configuration identifiers; its data is the concatenation of its
+//   identifiers' data in the Data_Exchange telegram. The identifier-related diagnosis and the
+//   DP-V1 Module_Status count modules. DP-V1 slot numbers: slot 0 = the device itself, slot
+//   n (1-based) = module n-1.
+// - Every module is handed over as one unit between bus and device (a seqlock per module), so
+//   it is consistent over its whole length whether or not the identifiers ask for it.
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "pbvbus/dp/cfg_identifier.hpp"
+
+namespace pbvbus::dp {
+
+struct SlaveFeatures {
+  bool sync = false;           ///< Sync_Supp
+  bool freeze = false;         ///< Freeze_Supp
+  bool fail_safe = false;      ///< Fail_Safe: zero-length outputs in Clear accepted
+  bool set_slave_add = false;  ///< Set_Slave_Add_supp
+  bool dpv1 = false;           ///< DPV1_Slave: DPV1_Enable may be set
+  bool c1_read_write = false;  ///< C1_Read_Write_supp
+  bool c2 = false;             ///< C2_Read_Write_supp
+  std::uint8_t c2_connections = 1;      ///< C2_Max_Count_Channels
+  std::uint8_t alarms_supported = 0;    ///< kEnable*Alarm bits of DPV1_Status_2 it accepts
+  std::uint8_t max_alarm_mode = 0;      ///< highest Alarm_Mode (0..7) it accepts
+  bool wd_base_1ms = false;             ///< WD_Base_1ms_supp
+  bool check_cfg_mode = false;          ///< Check_Cfg_Mode_supp
+};
+
+struct SlaveModule {
+  std::vector<std::uint8_t> cfg;  ///< identifier octets as in Get_Cfg
+  std::string name;               ///< for reports only
+};
+
+/// User check of User_Prm_Data (octets 8..); false → Prm_Fault.
+using UserPrmCheck = std::function<bool(std::span<const std::uint8_t> user_prm)>;
+/// User check of a Chk_Cfg in Check_Cfg_Mode (DPV1_Status_2 bit 0); true = accepted.
+using UserCfgCheck = std::function<bool(std::span<const std::uint8_t> chk_cfg)>;
+
+struct SlaveConfig {
+  std::uint16_t ident = 0;
+  SlaveFeatures features;
+  std::size_t min_user_prm_len = 0;  ///< GSD User_Prm_Data_Len bounds
+  std::size_t max_user_prm_len = 0;
+  UserPrmCheck check_user_prm;       ///< optional
+  UserCfgCheck check_cfg_user;       ///< optional; used only in Check_Cfg_Mode
+  std::vector<SlaveModule> modules;  ///< the real configuration, in Get_Cfg order
+  std::uint16_t min_slave_interval = 1;  ///< 100 us units (GSD Min_Slave_Intervall)
+  std::size_t max_diag_len = 244;        ///< GSD Max_Diag_Data_Len (6..244)
+};
+
+/// Where a module's data sits in the Data_Exchange telegrams.
+struct ModuleLayout {
+  std::size_t in_offset = 0;
+  std::size_t in_len = 0;
+  std::size_t out_offset = 0;
+  std::size_t out_len = 0;
+  bool consistent = false;     ///< some identifier says "consistent over the whole length"
+  std::size_t first_id = 0;    ///< index of its first identifier in SlaveLayout::identifiers
+  std::size_t id_count = 0;
+};
+
+/// The real configuration decoded once.
+struct SlaveLayout {
+  std::vector<std::uint8_t> cfg;               ///< Get_Cfg DU
+  std::vector<CfgIdentifier> identifiers;
+  std::vector<std::size_t> module_of_id;       ///< identifier index → module index
+  std::vector<ModuleLayout> modules;
+  std::size_t inputs = 0;
+  std::size_t outputs = 0;
+};
+
+/// Decodes and checks a configuration; returns an empty string if it is usable, else why not.
+std::string build_layout(const SlaveConfig& cfg, SlaveLayout& out);
+
+}  // namespace pbvbus::dp

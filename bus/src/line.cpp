@@ -48,6 +48,7 @@ class Line::Port final : public DevicePort {
   Baud baud() const override { return m_line.m_baud; }
   void transmit(Ticks start, std::span<const std::uint8_t> bytes) override;
   void set_timer(Ticks at) override;
+  bool receiving() const override;
 
  private:
   Line& m_line;
@@ -143,6 +144,14 @@ void Line::Port::set_timer(Ticks at) {
   m_att.deadline = at;
   if (!m_att.powered || at == kNever) return;
   if (at < m_att.next_event) m_att.arm(at);
+}
+
+bool Line::Port::receiving() const {
+  const Ticks now = m_line.m_sched.now();
+  const auto bit = static_cast<std::size_t>(m_att.id);
+  for (const auto& t : m_line.m_in_flight)
+    if (t->start <= now && t->rx.test(bit)) return true;
+  return false;
 }
 
 // --------------------------------------------------------------------------------------------

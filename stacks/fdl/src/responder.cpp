@@ -3,18 +3,6 @@
 namespace pbvbus::fdl {
 
 namespace {
-// Action frames that carry a frame count bit (§C.6): SDA, SRD and MSRD. SDN, FDL Status, Ident
-// and the time event go with FCV = FCB = 0.
-bool uses_fcb(RequestFn fn) {
-  switch (fn) {
-    case RequestFn::SdaLow:
-    case RequestFn::SdaHigh:
-    case RequestFn::SrdLow:
-    case RequestFn::SrdHigh:
-    case RequestFn::Msrd: return true;
-    default: return false;
-  }
-}
 const Frame kEmptyFrame{};
 }  // namespace
 
@@ -28,7 +16,7 @@ void Responder::reset() {
 Responder::Check Responder::check(const Telegram& req) {
   if (!m_initialised) reset();
   const RequestFn fn = fc_request_fn(req.fc);
-  if (!uses_fcb(fn) || !fc_fcv(req.fc)) return Check::Execute;
+  if (!fn_uses_fcb(fn) || !fc_fcv(req.fc)) return Check::Execute;
   const std::uint8_t fcb = fc_fcb(req.fc) ? 1 : 0;
   if (m_fcb[req.sa] == fcb) return Check::Repeat;
   return Check::Execute;
@@ -91,7 +79,7 @@ const Frame& Responder::finish(const Telegram& req, std::uint8_t own, StationTyp
     }
   }
   const RequestFn fn = fc_request_fn(req.fc);
-  if (uses_fcb(fn) && (fc_fcv(req.fc) || fc_fcb(req.fc))) {
+  if (fn_uses_fcb(fn) && (fc_fcv(req.fc) || fc_fcb(req.fc))) {
     // First frame (FCV=0, FCB=1) or a new action frame: remember its FCB and our answer.
     m_fcb[req.sa] = fc_fcb(req.fc) ? 1 : 0;
     if (m_slot[req.sa] == kNone) {

@@ -47,6 +47,11 @@ class DevicePort {
   virtual void transmit(Ticks start, std::span<const std::uint8_t> bytes) = 0;
   /// Asks for one on_timer() call at `at`, replacing any earlier request; kNever cancels.
   virtual void set_timer(Ticks at) = 0;
+  /// Carrier sense: whether a frame that this device is going to receive is on the line now
+  /// (its first start bit has gone out; it has not been delivered yet). A UART sees the start
+  /// bit; with whole-frame delivery the device asks instead, e.g. a master whose slot time
+  /// expires while a long reply is still arriving. Default for ports without a line: false.
+  virtual bool receiving() const { return false; }
 
  protected:
   ~DevicePort() = default;

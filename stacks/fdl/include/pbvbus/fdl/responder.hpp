@@ -24,6 +24,13 @@
 
 namespace pbvbus::fdl {
 
+/// Action frames that carry a frame count bit (§C.6): SDA, SRD and MSRD. SDN, FDL Status,
+/// Ident and the time event go with FCV = FCB = 0.
+constexpr bool fn_uses_fcb(RequestFn fn) {
+  return fn == RequestFn::SdaLow || fn == RequestFn::SdaHigh || fn == RequestFn::SrdLow ||
+         fn == RequestFn::SrdHigh || fn == RequestFn::Msrd;
+}
+
 class Responder {
  public:
   enum class Check : std::uint8_t {

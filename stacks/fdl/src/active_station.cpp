@@ -187,7 +187,7 @@ void ActiveStation::discovery_token(std::uint8_t sa) {
 
 void ActiveStation::leave_ring(bus::Ticks now) {
   if (m_state == MacState::Await_Data_Response) {
-    finish_request(now, Confirmation::Result::Rejected);
+    finish_request(now, Confirmation::Result::NoResponse);
   } else if (m_sdn_pending) {
     finish_request(now, Confirmation::Result::Sent);
   }
@@ -499,7 +499,7 @@ ActiveStation::Ask ActiveStation::ask(Priority prio, bus::Ticks now) {
   spec.ssap = m_req.ssap;
   spec.data = m_req.data;
   if (da > kBroadcast || da == m_ts || encode(spec, m_tx) != EncodeError::None) {
-    finish_request(now, Confirmation::Result::Rejected);
+    finish_request(now, Confirmation::Result::NoResponse);
     return Ask::Rejected;
   }
   transmit_request(now);

@@ -60,6 +60,10 @@
 //    reply; repeats keep the FCB. After max_retry repeats without a valid reply the responder is
 //    non-operational: requests to it go without repeats and with a first frame again, until it
 //    answers.
+//  - A request that cannot be encoded (data too long, bad address or SAP, addressed to this
+//    station) is not sent and confirmed NoResponse at once; so is a request whose reply was
+//    pending when the station dropped its token (duplicate token): neither marks the responder
+//    non-operational.
 //  - Requests addressed to this master are answered like a passive station would (FCB filter,
 //    SAP mirroring, TSDR = min TSDR), with the FC's station type bits telling our MAC state.
 //

@@ -92,8 +92,6 @@ struct Confirmation {
     Ok,          ///< an acknowledgement or response arrived (see status / short_ack / data)
     NoResponse,  ///< no valid reply after all retries: the responder is now "non-operational"
     Sent,        ///< SDN: sent, nothing expected
-    Rejected,    ///< not sent: the request could not be encoded (data too long, bad address
-                 ///< or SAP), or the station left the token ring before it could go out
   };
   bus::Ticks now = 0;
   std::uint64_t tag = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cassert>
 #include <stdexcept>
 
@@ -36,7 +37,7 @@ struct Line::Transmission {
   Ticks end = 0;
   std::uint16_t flags = 0;
   bool cut_counted = false;  // counted in LineStats::partial already
-  std::bitset<kMaxAttachments> rx;
+  Mask rx;
   /// Idle time each receiver had seen when this frame started (valid where rx is set).
   std::array<Ticks, kMaxAttachments> idle_before{};
 };
@@ -49,6 +50,7 @@ class Line::Port final : public DevicePort {
   void transmit(Ticks start, std::span<const std::uint8_t> bytes) override;
   void set_timer(Ticks at) override;
   bool receiving() const override;
+  void receive_filter_changed() override;
 
  private:
   Line& m_line;
@@ -68,6 +70,7 @@ struct Line::Attachment final : EventTarget {
       if (deadline <= now) {
         deadline = kNever;
         dev->on_timer(now);
+        line.refresh_filter(static_cast<std::size_t>(id));
       } else if (deadline != kNever) {
         arm(deadline);  // the deadline was postponed after this wake-up was queued
       }
@@ -111,11 +114,6 @@ struct Line::Attachment final : EventTarget {
   bool babbling = false;
   bool cut_after = false;
   int segment = 0;
-  /// End of every activity this attachment has heard completely or partly (frames delivered,
-  /// frames cut short for it, its own transmissions).
-  Ticks done_until = kNeverHeard;
-  /// done_until, extended by the scheduled end of frames it is hearing right now.
-  Ticks heard_until = kNeverHeard;
   /// End of the device's own current telegram (not babble): a UART sends one at a time.
   Ticks uart_busy_until = kNeverHeard;
   // Timer: one wanted deadline; `next_event` is the earliest wake-up still valid in the queue.
@@ -139,6 +137,8 @@ void Line::Port::transmit(Ticks start, std::span<const std::uint8_t> bytes) {
   m_att.pending.push_back({start, m_att.pending_seq++, std::move(buf)});
   m_line.m_sched.schedule(start, m_att, (m_att.power_epoch << 2) | kTagTxStart);
 }
+
+void Line::Port::receive_filter_changed() { m_line.refresh_filter(static_cast<std::size_t>(m_att.id)); }
 
 void Line::Port::set_timer(Ticks at) {
   m_att.deadline = at;
@@ -167,7 +167,13 @@ AttachmentId Line::attach(Device& dev, std::string label) {
   const int id = static_cast<int>(m_atts.size());
   m_atts.push_back(std::make_unique<Attachment>(*this, id, dev, std::move(label)));
   dev.bind(m_atts.back()->port);
+  m_devs.push_back(&dev);
+  m_heard_until.push_back(kNeverHeard);
+  m_filter.push_back(kReceiveAll);
+  m_receive_all.set(static_cast<std::size_t>(id));
   recompute_segments();
+  refresh_listening();
+  refresh_filter(static_cast<std::size_t>(id));
   return id;
 }
 
@@ -214,6 +220,38 @@ bool Line::can_hear(const Attachment& rx, const Attachment& tx) const {
 
 bool Line::connected(AttachmentId a, AttachmentId b) const {
   return can_hear(*m_atts.at(static_cast<std::size_t>(a)), *m_atts.at(static_cast<std::size_t>(b)));
+}
+
+void Line::refresh_filter(std::size_t i) {
+  int f = m_devs[i]->receive_filter();
+  if (f < 0 || f > 126) f = kReceiveAll;
+  const int old = m_filter[i];
+  if (f == old) return;
+  if (old == kReceiveAll) {
+    m_receive_all.reset(i);
+    m_filtered.set(i);
+  } else {
+    m_by_addr[static_cast<std::size_t>(old)].reset(i);
+  }
+  if (f == kReceiveAll) {
+    m_receive_all.set(i);
+    m_filtered.reset(i);
+  } else {
+    m_by_addr[static_cast<std::size_t>(f)].set(i);
+  }
+  m_filter[i] = f;
+}
+
+bool Line::accepts(std::size_t i, int da) const {
+  const int f = m_filter[i];
+  return f == kReceiveAll || da == f || da == 127;
+}
+
+void Line::refresh_listening() {
+  m_listening.assign(m_atts.empty() ? 1 : static_cast<std::size_t>(m_atts.back()->segment) + 1, Mask{});
+  if (m_short) return;
+  for (auto& a : m_atts)
+    if (a->powered && a->xcvr_ok) m_listening[static_cast<std::size_t>(a->segment)].set(static_cast<std::size_t>(a->id));
 }
 
 void Line::recompute_segments() {
@@ -291,18 +329,18 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
   t->end = end;
   t->flags = babble ? kRxBabble : 0;
   t->cut_counted = false;
-  t->rx.reset();
-  for (auto& a : m_atts) {
-    if (a.get() == &from || !can_hear(*a, from)) continue;
-    const auto i = static_cast<std::size_t>(a->id);
-    t->rx.set(i);
+  // Everyone listening on the sender's segment (the sender is listening: it got this far).
+  t->rx = m_listening[static_cast<std::size_t>(from.segment)];
+  const auto self = static_cast<std::size_t>(from.id);
+  t->rx.reset(self);
+  t->rx.for_each([&](std::size_t i) {
     // Idle as this receiver's UART saw it when the first start bit arrived: zero if it was
     // still hearing something (a collision), "forever" if nothing since power-on.
-    t->idle_before[i] = a->heard_until == kNeverHeard ? kIdleForever : std::max<Ticks>(0, now - a->heard_until);
-    a->heard_until = std::max(a->heard_until, end);
-  }
-  from.heard_until = std::max(from.heard_until, end);  // RS-485 transceivers hear themselves
-  from.done_until = std::max(from.done_until, end);
+    const Ticks h = m_heard_until[i];
+    t->idle_before[i] = h == kNeverHeard ? kIdleForever : std::max<Ticks>(0, now - h);
+    m_heard_until[i] = std::max(h, end);
+  });
+  m_heard_until[self] = std::max(m_heard_until[self], end);  // RS-485 transceivers hear themselves
 
   // Overlap with anything else on the same segment corrupts both.
   for (auto& o : m_in_flight) {
@@ -319,21 +357,16 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
   m_in_flight.push_back(std::move(t));
 }
 
-void Line::deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags, Ticks end) {
-  to.done_until = std::max(to.done_until, end);
-  std::span<const std::uint8_t> bytes(t.bytes.data(), len);
-  const int filter = to.dev->receive_filter();
-  if (filter != kReceiveAll) {
-    const int da = frame_da(bytes);
-    if (da != filter && da != 127) return;
-  }
+void Line::deliver(Transmission& t, std::size_t to, std::size_t len, std::uint16_t extra_flags, Ticks end) {
+  Device& dev = *m_devs[to];
   RxFrame f;
-  f.bytes = bytes;
+  f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
   f.start = t.start;
   f.end = end;
-  f.idle_before = t.idle_before[static_cast<std::size_t>(to.id)];
+  f.idle_before = t.idle_before[to];
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
-  to.dev->on_frame(f);
+  dev.on_frame(f);
+  refresh_filter(to);
 }
 
 void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end) {
@@ -358,62 +391,73 @@ void Line::end_transmission(std::uint64_t id) {
   if (it == m_in_flight.end()) return;  // already ended early by a fault
   std::unique_ptr<Transmission> owned = std::move(*it);
   m_in_flight.erase(it);
-  for (auto& a : m_atts)
-    if (owned->rx.test(static_cast<std::size_t>(a->id))) deliver(*owned, *a, owned->bytes.size(), 0, owned->end);
+  const Ticks end = owned->end;
+  // Receivers whose filter takes this frame: receive-all, its DA, or everyone for DA 127.
+  const int da = frame_da(owned->bytes);
+  Mask to;
+  for (std::size_t k = 0; k < to.w.size(); ++k) {
+    std::uint64_t want = m_receive_all.w[k];
+    if (da >= 0) want |= m_by_addr[static_cast<std::size_t>(da)].w[k];
+    if (da == 127) want |= m_filtered.w[k];
+    to.w[k] = owned->rx.w[k] & want;
+  }
+  to.for_each([&](std::size_t i) { deliver(*owned, i, owned->bytes.size(), 0, end); });
   tap_frame(*owned, owned->bytes.size(), 0, owned->end);
   m_pool.push_back(std::move(owned));
-}
-
-void Line::recompute_heard(Attachment& a) {
-  Ticks h = a.done_until;
-  const auto i = static_cast<std::size_t>(a.id);
-  for (const auto& t : m_in_flight)
-    if (t->from == &a || t->rx.test(i)) h = std::max(h, t->end);
-  a.heard_until = h;
 }
 
 void Line::truncate_in_flight() {
   const Ticks now = m_sched.now();
   const Ticks char_ticks = chars_to_ticks(1, m_baud);
-  bool changed = false;
+  Mask touched;  // attachments that stopped hearing something at `now`
   for (std::size_t i = 0; i < m_in_flight.size();) {
     Transmission& t = *m_in_flight[i];
+    if (t.end <= now) {
+      // Completely on the wire already (its end event runs later in this tick): only a
+      // receiver that has just lost power or its transceiver misses it.
+      t.rx.for_each([&](std::size_t bit) {
+        if (!m_atts[bit]->powered || !m_atts[bit]->xcvr_ok) t.rx.reset(bit);
+      });
+      ++i;
+      continue;
+    }
     const auto done = static_cast<std::size_t>(std::clamp<Ticks>((now - t.start) / char_ticks, 0,
                                                                  static_cast<Ticks>(t.bytes.size())));
     const bool sender_gone = m_short || !t.from->powered || !t.from->xcvr_ok;
-    for (auto& a : m_atts) {
-      const auto bit = static_cast<std::size_t>(a->id);
-      if (!t.rx.test(bit)) continue;
-      if (sender_gone || !can_hear(*a, *t.from)) {
-        t.rx.reset(bit);
-        changed = true;
-        if (!t.cut_counted) {
-          t.cut_counted = true;
-          ++m_stats.partial;
-        }
-        if (a->powered && a->xcvr_ok) {
-          // It heard the line up to now (a power loss resets this anyway).
-          if (done > 0) deliver(t, *a, done, kRxPartial, now);
-          a->done_until = std::max(a->done_until, now);
-        }
+    const Mask rx = t.rx;
+    rx.for_each([&](std::size_t bit) {
+      Attachment& a = *m_atts[bit];
+      if (!sender_gone && can_hear(a, *t.from)) return;
+      t.rx.reset(bit);
+      touched.set(bit);
+      if (!t.cut_counted) {
+        t.cut_counted = true;
+        ++m_stats.partial;
       }
-    }
+      if (a.powered && a.xcvr_ok && done > 0 && accepts(bit, frame_da(std::span(t.bytes).first(done))))
+        deliver(t, bit, done, kRxPartial, now);
+    });
     if (sender_gone) {
       // The frame ends here for everybody, the tap included.
       if (!t.cut_counted) ++m_stats.partial;
       tap_frame(t, done, kRxPartial, now);
-      t.from->done_until = now;
+      touched.set(static_cast<std::size_t>(t.from->id));
       t.from->uart_busy_until = std::min(t.from->uart_busy_until, now);
       std::unique_ptr<Transmission> owned = std::move(m_in_flight[i]);
       m_in_flight.erase(m_in_flight.begin() + static_cast<std::ptrdiff_t>(i));
       m_pool.push_back(std::move(owned));
-      changed = true;
       continue;
     }
     ++i;
   }
-  if (changed)
-    for (auto& a : m_atts) recompute_heard(*a);
+  // What those attachments heard now ends here, or with the frames they still hear. (For one
+  // that lost power this does not matter: power-on starts from "never heard".)
+  touched.for_each([&](std::size_t bit) {
+    Ticks h = now;
+    for (const auto& t : m_in_flight)
+      if (t->from == m_atts[bit].get() || t->rx.test(bit)) h = std::max(h, t->end);
+    m_heard_until[bit] = h;
+  });
 }
 
 void Line::join_in_flight() {
@@ -424,8 +468,10 @@ void Line::join_in_flight() {
     // Stations that can now hear the sender hear the rest of the frame: not a frame they can
     // receive (they missed its start), but activity that keeps them from counting idle.
     for (auto& a : m_atts)
-      if (a.get() != t->from && !t->rx.test(static_cast<std::size_t>(a->id)) && can_hear(*a, *t->from))
-        a->heard_until = std::max(a->heard_until, t->end);
+      if (a.get() != t->from && !t->rx.test(static_cast<std::size_t>(a->id)) && can_hear(*a, *t->from)) {
+        Ticks& h = m_heard_until[static_cast<std::size_t>(a->id)];
+        h = std::max(h, t->end);
+      }
   }
   // Frames from formerly separate segments that are both still on the wire now overlap.
   for (std::size_t i = 0; i < m_in_flight.size(); ++i) {
@@ -454,6 +500,7 @@ void Line::set_cut_after(AttachmentId a, bool cut) {
   if (att.cut_after == cut) return;
   att.cut_after = cut;
   recompute_segments();
+  refresh_listening();
   if (cut) truncate_in_flight();
   else join_in_flight();
   emit_event(cut ? LineEventKind::CableCut : LineEventKind::CableRepaired, a,
@@ -467,6 +514,7 @@ void Line::set_cut_between(AttachmentId a, AttachmentId b, bool cut) {
 void Line::set_short_circuit(bool on) {
   if (m_short == on) return;
   m_short = on;
+  refresh_listening();
   if (on) truncate_in_flight();
   emit_event(on ? LineEventKind::ShortCircuit : LineEventKind::ShortRepaired);
 }
@@ -482,6 +530,7 @@ void Line::set_power(AttachmentId id, bool on) {
   const Ticks now = m_sched.now();
   if (!on) {
     a.powered = false;
+    refresh_listening();
     for (auto& p : a.pending) give_buffer(std::move(p.bytes));
     a.pending.clear();
     ++a.power_epoch;
@@ -491,12 +540,16 @@ void Line::set_power(AttachmentId id, bool on) {
     truncate_in_flight();
     emit_event(LineEventKind::PowerOff, id);
     a.dev->on_power_off(now);
+    refresh_filter(static_cast<std::size_t>(id));
   } else {
     a.powered = true;
-    a.done_until = a.heard_until = a.uart_busy_until = kNeverHeard;
+    a.uart_busy_until = kNeverHeard;
+    m_heard_until[static_cast<std::size_t>(id)] = kNeverHeard;
+    refresh_listening();
     join_in_flight();  // the rest of a frame already on the wire is activity it does hear
     emit_event(LineEventKind::PowerOn, id);
     a.dev->on_power_on(now);
+    refresh_filter(static_cast<std::size_t>(id));
     if (a.babbling) babble_burst(a);
   }
 }
@@ -505,6 +558,7 @@ void Line::set_transceiver_ok(AttachmentId id, bool ok) {
   auto& a = *m_atts.at(static_cast<std::size_t>(id));
   if (a.xcvr_ok == ok) return;
   a.xcvr_ok = ok;
+  refresh_listening();
   if (!ok) truncate_in_flight();
   else join_in_flight();
   emit_event(ok ? LineEventKind::TransceiverRepaired : LineEventKind::TransceiverFailed, id);

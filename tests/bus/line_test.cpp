@@ -171,6 +171,73 @@ TEST_F(LineTest, ReceiveFilterDeliversOnlyOwnAddressAndBroadcast) {
   EXPECT_EQ(slave.rx[3].idle_before, all.rx[7].idle_before);
 }
 
+TEST_F(LineTest, ReceiveFilterChangesTakeEffect) {
+  Probe master;
+  Probe slave(5);
+  line.attach(master);
+  line.attach(slave);
+  line.start();
+  // Changed from inside its own callback (like Set_Slave_Add): the line re-reads it.
+  slave.on_rx = [&](const bus::RxFrame&) { slave.set_filter(6); };
+  master.send(B(0), "10 05 01 49 4F 16");    // to 5: delivered, then the filter becomes 6
+  master.send(B(100), "10 05 01 49 4F 16");  // to 5: not any more
+  master.send(B(200), "10 06 01 49 50 16");  // to 6: delivered
+  sched.run_until(B(300));
+  ASSERT_EQ(slave.rx.size(), 2u);
+  EXPECT_EQ(slave.rx[1].hex(), "10 06 01 49 50 16");
+  // Changed from a timer callback.
+  slave.on_rx = nullptr;
+  slave.on_tick = [&](Ticks) { slave.set_filter(7); };
+  slave.timer(B(310));
+  master.send(B(400), "10 07 01 49 51 16");
+  sched.run_until(B(500));
+  ASSERT_EQ(slave.rx.size(), 3u);
+  EXPECT_EQ(slave.rx[2].hex(), "10 07 01 49 51 16");
+  // Changed from outside: takes effect once the port is told.
+  slave.set_filter(bus::kReceiveAll);
+  slave.the_port().receive_filter_changed();
+  master.send(B(600), kSc);
+  sched.run_until(B(700));
+  ASSERT_EQ(slave.rx.size(), 4u);
+  EXPECT_EQ(slave.rx[3].hex(), kSc);
+  slave.set_filter(9);
+  slave.the_port().receive_filter_changed();
+  master.send(B(800), kSc);
+  master.send(B(900), "10 7F 01 44 C4 16");  // broadcast still reaches a filtered station
+  sched.run_until(B(1000));
+  ASSERT_EQ(slave.rx.size(), 5u);
+  EXPECT_EQ(slave.rx[4].hex(), "10 7F 01 44 C4 16");
+}
+
+TEST_F(LineTest, FaultAtTheLastStopBitDoesNotCutAFinishedFrame) {
+  make(3);
+  line.start();
+  p(0).send(0, kSd1);
+  // Queued before the frame's end event exists (it is queued when the frame starts), so the cut
+  // runs first at B(66), when the last stop bit has just ended.
+  at(B(66), [&] { line.set_cut_after(0, true); });
+  sched.run_until(B(1000));
+  ASSERT_EQ(p(1).rx.size(), 1u);
+  EXPECT_EQ(p(1).rx[0].flags, 0);
+  EXPECT_EQ(p(1).rx[0].hex(), kSd1);
+}
+
+TEST_F(LineTest, FaultAtTheLastStopBitQueuedBeforeTheFrame) {
+  make(3);
+  line.start();
+  // These fault events are queued before the frame's own end event at the same tick.
+  at(B(66), [&] { line.set_power(0, false); });
+  at(B(66), [&] { line.set_power(2, false); });
+  p(0).send(0, kSd1);
+  sched.run_until(B(1000));
+  ASSERT_EQ(p(1).rx.size(), 1u);
+  EXPECT_EQ(p(1).rx[0].flags, 0) << "every character was on the wire before the power went";
+  EXPECT_TRUE(p(2).rx.empty()) << "an unpowered receiver gets nothing";
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_EQ(rec.frame(0).flags, 0);
+  EXPECT_EQ(line.stats().partial, 0u);
+}
+
 TEST_F(LineTest, CollisionGarblesOverlappingCharactersOfBothFrames) {
   make(3);
   line.start();

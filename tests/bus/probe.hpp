@@ -32,6 +32,8 @@ class Probe final : public bus::Device {
     if (on_tick) on_tick(now);
   }
   int receive_filter() const override { return m_filter; }
+  /// Changes the filter without telling the line (as from inside a callback).
+  void set_filter(int f) { m_filter = f; }
 
   void send(bus::Ticks at, std::string_view hex) { port().transmit(at, bytes_from_hex(hex)); }
   void send(bus::Ticks at, const std::vector<std::uint8_t>& b) { port().transmit(at, b); }

@@ -52,6 +52,11 @@ class DevicePort {
   /// bit; with whole-frame delivery the device asks instead, e.g. a master whose slot time
   /// expires while a long reply is still arriving. Default for ports without a line: false.
   virtual bool receiving() const { return false; }
+  /// Tells the medium that Device::receive_filter() now returns something else. The line reads
+  /// the filter again after every call it makes into the device (on_power_on, on_power_off,
+  /// on_frame, on_timer), so this is only needed for a change made from outside those calls
+  /// (a management action, a scenario step). Until then the line may use the old filter.
+  virtual void receive_filter_changed() {}
 
  protected:
   ~DevicePort() = default;
@@ -78,7 +83,8 @@ class Device {
   /// The time requested with DevicePort::set_timer() has come.
   virtual void on_timer(Ticks now) = 0;
   /// kReceiveAll, or an FDL address 0..126: then only frames whose DA is that address or 127
-  /// are delivered (frames without a DA, SC and garbage, are not).
+  /// are delivered (frames without a DA, SC and garbage, are not). Any other value counts as
+  /// kReceiveAll. See DevicePort::receive_filter_changed() for changing it at run time.
   virtual int receive_filter() const { return kReceiveAll; }
   /// Short label for reports and logs, e.g. "master 1" or "slave 10".
   virtual const char* kind() const { return "device"; }

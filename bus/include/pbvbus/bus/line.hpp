@@ -20,7 +20,8 @@
 // Attachments keep the order in which they were attached: that is their position along the
 // cable, which is what a cable cut between two stations refers to.
 
-#include <bitset>
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -99,6 +100,21 @@ class Line final : private EventTarget {
  private:
   struct Attachment;
   struct Transmission;
+  /// A set of attachments, iterable by set bit without scanning every attachment.
+  struct Mask {
+    std::array<std::uint64_t, kMaxAttachments / 64> w{};
+    void set(std::size_t i) { w[i >> 6] |= std::uint64_t{1} << (i & 63); }
+    void reset(std::size_t i) { w[i >> 6] &= ~(std::uint64_t{1} << (i & 63)); }
+    bool test(std::size_t i) const { return (w[i >> 6] >> (i & 63)) & 1; }
+    void clear() { w.fill(0); }
+    template <class F>
+    void for_each(F&& f) const {
+      for (std::size_t k = 0; k < w.size(); ++k)
+        for (std::uint64_t b = w[k]; b != 0; b &= b - 1)
+          f(k * 64 + static_cast<std::size_t>(std::countr_zero(b)));
+    }
+  };
+
   class Port;
   friend class Port;
 
@@ -107,18 +123,22 @@ class Line final : private EventTarget {
   void start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes, bool babble);
   std::vector<std::uint8_t> take_buffer();
   void give_buffer(std::vector<std::uint8_t>&& b);
-  /// After a receiver stopped hearing something early: what it last heard is re-derived.
-  void recompute_heard(Attachment& a);
   /// After a repair that joins segments or revives a transceiver: receivers start hearing the
   /// rest of frames already on the wire (as garbage), and frames that now share the cable
   /// corrupt each other from here on.
   void join_in_flight();
   void end_transmission(std::uint64_t id);
-  void deliver(Transmission& t, Attachment& to, std::size_t len, std::uint16_t extra_flags,
-               Ticks end);
+  /// Hands a frame (or its first `len` octets) to one receiver; filtering is the caller's job.
+  void deliver(Transmission& t, std::size_t to, std::size_t len, std::uint16_t extra_flags, Ticks end);
+  /// Re-reads attachment i's receive filter into the cache (after every call into the device).
+  void refresh_filter(std::size_t i);
+  /// Whether attachment i's (cached) filter takes a frame with destination `da` (-1: none).
+  bool accepts(std::size_t i, int da) const;
   void tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end);
   void apply_noise(Transmission& t);
   void recompute_segments();
+  /// Rebuilds m_listening after any change of power, transceiver, cut or short.
+  void refresh_listening();
   /// After a topology or power change: cut short every in-flight frame for receivers that can
   /// no longer hear its sender.
   void truncate_in_flight();
@@ -138,6 +158,20 @@ class Line final : private EventTarget {
   /// Byte buffers recycled between pending transmissions and transmissions, so that the
   /// per-frame path does not allocate once the line has warmed up.
   std::vector<std::vector<std::uint8_t>> m_buffers;
+  // Hot per-attachment state, indexed by attachment id, kept contiguous for the per-frame loops.
+  std::vector<Device*> m_devs;
+  /// End of the last activity an attachment has heard or is hearing (frames received, cut
+  /// short for it or still on the wire, its own transmissions); the start of its idle time.
+  std::vector<Ticks> m_heard_until;
+  /// Per segment: attachments that are powered and have a working transceiver (none while
+  /// the line is shorted).
+  std::vector<Mask> m_listening;
+  /// Cached receive filters (kReceiveAll or 0..126) and the masks built from them, so that a
+  /// frame reaches its addressee without asking 32 other stations whether they want it.
+  std::vector<int> m_filter;
+  std::vector<Mask> m_by_addr = std::vector<Mask>(128);
+  Mask m_receive_all;  ///< attachments with kReceiveAll
+  Mask m_filtered;     ///< attachments with an address filter
   bool m_short = false;
   std::uint64_t m_noise_ppb = 0;
   std::uint64_t m_rng;

@@ -53,7 +53,10 @@ class PassiveStation final : public bus::Device {
 
   std::uint8_t address() const { return m_address; }
   /// Changes the station address at once (management; Set_Slave_Add goes through Reply).
-  void set_address(std::uint8_t address) { m_address = address; }
+  void set_address(std::uint8_t address) {
+    m_address = address;
+    if (bound()) port().receive_filter_changed();  // the line caches receive filters
+  }
   std::uint32_t min_tsdr() const { return m_min_tsdr; }
   /// The delay actually used for the next reply, in t_bit.
   std::uint32_t response_delay() const;

@@ -23,8 +23,6 @@ std::uint32_t ConsistentBuffer::begin_write() {
     if (++spins > 64) std::this_thread::yield();
     s = m_seq.load(std::memory_order_relaxed);
   }
-  // Orders the odd sequence number before the data stores (seqlock writer protocol).
-  std::atomic_thread_fence(std::memory_order_release);
   return s;
 }
 
@@ -38,7 +36,7 @@ bool ConsistentBuffer::write(std::span<const std::uint8_t> data) {
     const std::size_t base = w * 8;
     const std::size_t n = m_len - base < 8 ? m_len - base : 8;
     for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(data[base + i]) << (8 * i);
-    m_data[w].store(v, std::memory_order_relaxed);
+    m_data[w].store(v, std::memory_order_release);
   }
   end_write(s);
   return true;
@@ -50,7 +48,7 @@ void ConsistentBuffer::fill(std::uint8_t value) {
     const std::size_t n = m_len - w * 8 < 8 ? m_len - w * 8 : 8;
     std::uint64_t v = 0;
     for (std::size_t i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(value) << (8 * i);
-    m_data[w].store(v, std::memory_order_relaxed);
+    m_data[w].store(v, std::memory_order_release);
   }
   end_write(s);
 }
@@ -62,13 +60,11 @@ bool ConsistentBuffer::read(std::span<std::uint8_t> out) const {
     const std::uint32_t s1 = m_seq.load(std::memory_order_acquire);
     if ((s1 & 1u) == 0) {
       for (std::size_t w = 0; w < m_words; ++w) {
-        const std::uint64_t v = m_data[w].load(std::memory_order_relaxed);
+        const std::uint64_t v = m_data[w].load(std::memory_order_acquire);
         const std::size_t base = w * 8;
         const std::size_t n = m_len - base < 8 ? m_len - base : 8;
         for (std::size_t i = 0; i < n; ++i) out[base + i] = static_cast<std::uint8_t>(v >> (8 * i));
       }
-      // Orders the data loads before the re-check of the sequence (seqlock reader protocol).
-      std::atomic_thread_fence(std::memory_order_acquire);
       if (m_seq.load(std::memory_order_relaxed) == s1) return true;
     }
     if (++spins > 64) std::this_thread::yield();

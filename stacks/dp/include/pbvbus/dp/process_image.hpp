@@ -3,11 +3,13 @@
 // another thread (design.md "Consistent data"; protocol-facts.md §F): a module's bytes are never
 // observed half old, half new.
 //
-// ConsistentBuffer is a sequence lock over relaxed atomic 64-bit words: writers (any number,
-// serialised by the sequence word) never wait for readers; a reader retries while a write is in
-// progress and never blocks the bus thread. The data words are atomics, so the scheme is free of
-// data races in the C++ memory model (and clean under ThreadSanitizer). Reads and writes never
-// allocate.
+// ConsistentBuffer is a sequence lock over atomic 64-bit words: writers (any number, serialised
+// by the sequence word) never wait for readers; a reader retries while a write is in progress
+// and never blocks the bus thread. Memory order without fences (which ThreadSanitizer cannot
+// model): the writer takes the odd sequence with an acquire RMW, stores data words with release;
+// the reader loads data words with acquire, so a reader that saw any new word also sees the
+// sequence move and retries. On x86 these are plain moves. The data words are atomics, so the
+// scheme is free of data races in the C++ memory model. Reads and writes never allocate.
 
 #include <atomic>
 #include <cstdint>

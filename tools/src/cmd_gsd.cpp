@@ -1,12 +1,347 @@
-#include <ostream>
+// `pbvbus gsd FILE [--json]`: reads a GSD file (PI 2.122) and prints what it describes: ident,
+// station type, vendor/model, baud rates with MaxTsdr, modules with their config bytes and
+// lengths, parameters (ExtUserPrmData), DP-V1 and redundancy features. Warnings go to stderr.
+// Exit 0 on success, 2 for bad usage or a broken file ("file:line: reason" on stderr).
 
+#include <cstdint>
+#include <cstdio>
+#include <ostream>
+#include <sstream>
+#include <string>
+
+#include "pbvbus/devices/gsd.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {
 
-int cmd_gsd(const Args&, std::ostream&, std::ostream& err) {
-  err << "pbvbus gsd: GSD reader not built yet\n";
-  return 2;
+namespace {
+
+using devices::GsdBytes;
+using devices::GsdFile;
+
+constexpr const char* kUsage =
+    "usage: pbvbus gsd FILE [--json]\n"
+    "\n"
+    "Reads a GSD device description (PI 2.122, ISO-8859-1) and prints its ident number,\n"
+    "station type, vendor and model, supported baud rates with MaxTsdr, modules (config bytes,\n"
+    "input/output lengths), parameters (ExtUserPrmData with defaults, ranges and texts), DP-V1\n"
+    "and redundancy features. Warnings go to stderr.\n"
+    "\n"
+    "  --json    print the same as one JSON object\n"
+    "  --help    this text\n"
+    "\n"
+    "Exit status: 0 success, 2 bad usage or a broken file (file:line: reason on stderr).\n";
+
+std::string hex_byte(std::uint8_t b) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%02X", b);
+  return buf;
+}
+
+std::string hex_list(const GsdBytes& bytes, const char* sep) {
+  std::string s;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (i) s += sep;
+    s += hex_byte(bytes[i]);
+  }
+  return s;
+}
+
+std::string hex_plain(const GsdBytes& bytes) {
+  std::string s;
+  char buf[4];
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%02X", bytes[i]);
+    if (i) s += ' ';
+    s += buf;
+  }
+  return s;
+}
+
+std::string hex16(std::uint16_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "0x%04X", v);
+  return buf;
+}
+
+const char* yn(bool b) { return b ? "1" : "0"; }
+
+std::string station_type_name(std::uint8_t t) { return t == 1 ? "DP master" : "DP slave"; }
+
+std::string allowed_text(const devices::GsdExtUserPrmData& e) {
+  if (e.allowed.empty()) return std::to_string(e.min_value) + "-" + std::to_string(e.max_value);
+  std::string s;
+  for (std::size_t i = 0; i < e.allowed.size(); ++i) {
+    if (i) s += ',';
+    s += std::to_string(e.allowed[i]);
+  }
+  return s;
+}
+
+std::string type_text(const devices::GsdExtUserPrmData& e) {
+  std::string t(devices::gsd_data_type_name(e.type));
+  if (e.type == devices::GsdDataType::Bit) t += "(" + std::to_string(e.bit_first) + ")";
+  if (e.type == devices::GsdDataType::BitArea)
+    t += "(" + std::to_string(e.bit_first) + "-" + std::to_string(e.bit_last) + ")";
+  return t;
+}
+
+// --- text output -------------------------------------------------------------------------------
+
+void print_text(const GsdFile& f, std::ostream& out) {
+  const auto& i = f.info();
+  out << "File:               " << f.file_name() << "\n";
+  out << "Ident_Number:       " << hex16(i.ident_number) << "\n";
+  out << "Station_Type:       " << int(i.station_type) << " (" << station_type_name(i.station_type) << ")\n";
+  out << "Vendor_Name:        " << i.vendor_name << "\n";
+  out << "Model_Name:         " << i.model_name << "\n";
+  out << "Revision:           " << i.revision << "\n";
+  out << "GSD_Revision:       " << int(i.gsd_revision) << "\n";
+  if (!i.order_number.empty()) out << "OrderNumber:        " << i.order_number << "\n";
+  if (!i.info_text.empty()) out << "Info_Text:          " << i.info_text << "\n";
+
+  out << "\nBaud rates (MaxTsdr in bit times):\n";
+  for (const auto& b : f.baud_rates()) {
+    std::string name(bus::baud_name(b.baud));
+    out << "  " << name << std::string(name.size() < 8 ? 8 - name.size() : 1, ' ') << "MaxTsdr "
+        << b.max_tsdr << "\n";
+  }
+
+  const auto& s = f.slave_features();
+  out << "\nSlave features:\n";
+  out << "  Freeze_Mode_supp " << yn(s.freeze_mode_supp) << ", Sync_Mode_supp " << yn(s.sync_mode_supp)
+      << ", Auto_Baud_supp " << yn(s.auto_baud_supp) << ", Set_Slave_Add_supp "
+      << yn(s.set_slave_add_supp) << ", Fail_Safe " << yn(s.fail_safe) << "\n";
+  out << "  Min_Slave_Intervall " << s.min_slave_intervall << " (x 100 us), Max_Diag_Data_Len "
+      << int(s.max_diag_data_len) << "\n";
+  out << "  Modular_Station " << yn(s.modular_station) << ", Max_Module " << int(s.max_module)
+      << ", Max_Input_Len " << int(s.max_input_len) << ", Max_Output_Len " << int(s.max_output_len)
+      << ", Max_Data_Len " << s.max_data_len << "\n";
+
+  out << "\nModules (" << f.modules().size() << "):\n";
+  for (std::size_t n = 0; n < f.modules().size(); ++n) {
+    const auto& m = f.modules()[n];
+    out << "  [" << n << "] \"" << m.name << "\"";
+    if (m.reference) out << " ref " << *m.reference;
+    out << ": cfg " << hex_list(m.config, ",") << ", in " << m.input_len << ", out " << m.output_len;
+    if (m.consistent) out << ", consistent";
+    const GsdBytes prm = f.prm_area_defaults(m.prm);
+    if (!prm.empty()) out << ", prm " << hex_plain(prm);
+    out << "\n";
+  }
+
+  out << "\nParameters:\n";
+  const auto& g = f.global_prm();
+  out << "  User_Prm_Data_Len "
+      << (g.declared_len ? std::to_string(*g.declared_len) : std::string("-"))
+      << ", Max_User_Prm_Data_Len " << int(f.max_user_prm_data_len()) << "\n";
+  out << "  station defaults: " << (hex_plain(f.prm_area_defaults(g)).empty() ? "(none)" : hex_plain(f.prm_area_defaults(g))) << "\n";
+  for (const auto& [ref, e] : f.ext_user_prm_data()) {
+    out << "  ExtUserPrmData " << ref << " \"" << e.name << "\": " << type_text(e) << ", default "
+        << e.default_value << ", allowed " << allowed_text(e);
+    if (!e.changeable) out << ", not changeable";
+    if (!e.visible) out << ", hidden";
+    out << "\n";
+    if (e.prm_text_ref) {
+      auto it = f.prm_texts().find(*e.prm_text_ref);
+      if (it != f.prm_texts().end())
+        for (const auto& [v, t] : it->second.texts) out << "      " << v << " = " << t << "\n";
+    }
+  }
+
+  const auto& d = f.dpv1();
+  out << "\nDP-V1:              " << (d.dpv1_slave ? "yes" : "no") << "\n";
+  if (d.dpv1_slave) {
+    out << "  C1_Read_Write_supp " << yn(d.c1_read_write_supp) << ", C1_Max_Data_Len "
+        << int(d.c1_max_data_len) << ", C1_Response_Timeout " << d.c1_response_timeout << "\n";
+    out << "  C2_Read_Write_supp " << yn(d.c2_read_write_supp) << ", C2_Max_Data_Len "
+        << int(d.c2_max_data_len) << ", C2_Response_Timeout " << d.c2_response_timeout
+        << ", C2_Max_Count_Channels " << int(d.c2_max_count_channels) << "\n";
+    out << "  alarms: Diagnostic " << yn(d.diagnostic_alarm_supp) << ", Process "
+        << yn(d.process_alarm_supp) << ", Pull_Plug " << yn(d.pull_plug_alarm_supp) << ", Status "
+        << yn(d.status_alarm_supp) << ", Update " << yn(d.update_alarm_supp)
+        << ", Manufacturer_Specific " << yn(d.manufacturer_specific_alarm_supp)
+        << "; Alarm_Sequence_Mode_Count " << int(d.alarm_sequence_mode_count) << "\n";
+    out << "  WD_Base_1ms_supp " << yn(d.wd_base_1ms_supp) << ", Check_Cfg_Mode "
+        << yn(d.check_cfg_mode) << ", Ident_Maintenance_supp " << yn(d.ident_maintenance_supp) << "\n";
+  }
+  const auto& r = f.redundancy();
+  out << "\nRedundancy:         Redundancy " << yn(r.redundancy) << ", PrmCmd_supp " << yn(r.prm_cmd_supp)
+      << ", Slave_Redundancy_supp " << int(r.slave_redundancy_supp)
+      << ", Slave_Max_Switch_Over_Time " << r.slave_max_switch_over_time << "\n";
+}
+
+// --- JSON output -------------------------------------------------------------------------------
+
+std::string js(std::string_view s) {
+  std::string o = "\"";
+  for (char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\r': o += "\\r"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (u < 0x20 || u == 0x7F) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04X", u);
+          o += buf;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+const char* jb(bool b) { return b ? "true" : "false"; }
+
+std::string jbytes(const GsdBytes& b) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (i) s += ",";
+    s += std::to_string(b[i]);
+  }
+  return s + "]";
+}
+
+void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnings, std::ostream& out) {
+  const auto& i = f.info();
+  out << "{\n";
+  out << "  \"file\": " << js(f.file_name()) << ",\n";
+  out << "  \"ident_number\": " << i.ident_number << ",\n";
+  out << "  \"ident_number_hex\": " << js(hex16(i.ident_number)) << ",\n";
+  out << "  \"station_type\": " << int(i.station_type) << ",\n";
+  out << "  \"gsd_revision\": " << int(i.gsd_revision) << ",\n";
+  out << "  \"vendor_name\": " << js(i.vendor_name) << ",\n";
+  out << "  \"model_name\": " << js(i.model_name) << ",\n";
+  out << "  \"revision\": " << js(i.revision) << ",\n";
+  out << "  \"hardware_release\": " << js(i.hardware_release) << ",\n";
+  out << "  \"software_release\": " << js(i.software_release) << ",\n";
+  out << "  \"order_number\": " << js(i.order_number) << ",\n";
+  out << "  \"info_text\": " << js(i.info_text) << ",\n";
+  out << "  \"baud_rates\": [";
+  for (std::size_t n = 0; n < f.baud_rates().size(); ++n) {
+    const auto& b = f.baud_rates()[n];
+    out << (n ? ", " : "") << "{\"baud\": " << js(bus::baud_name(b.baud))
+        << ", \"bit_per_s\": " << static_cast<std::uint32_t>(b.baud) << ", \"max_tsdr\": " << b.max_tsdr << "}";
+  }
+  out << "],\n";
+  const auto& s = f.slave_features();
+  out << "  \"slave\": {\"freeze_mode_supp\": " << jb(s.freeze_mode_supp)
+      << ", \"sync_mode_supp\": " << jb(s.sync_mode_supp) << ", \"auto_baud_supp\": " << jb(s.auto_baud_supp)
+      << ", \"set_slave_add_supp\": " << jb(s.set_slave_add_supp) << ", \"fail_safe\": " << jb(s.fail_safe)
+      << ", \"min_slave_intervall\": " << s.min_slave_intervall
+      << ", \"max_diag_data_len\": " << int(s.max_diag_data_len)
+      << ", \"modular_station\": " << jb(s.modular_station) << ", \"max_module\": " << int(s.max_module)
+      << ", \"max_input_len\": " << int(s.max_input_len) << ", \"max_output_len\": " << int(s.max_output_len)
+      << ", \"max_data_len\": " << s.max_data_len << "},\n";
+  out << "  \"modules\": [";
+  for (std::size_t n = 0; n < f.modules().size(); ++n) {
+    const auto& m = f.modules()[n];
+    out << (n ? "," : "") << "\n    {\"index\": " << n << ", \"name\": " << js(m.name) << ", \"reference\": "
+        << (m.reference ? std::to_string(*m.reference) : std::string("null")) << ", \"config\": "
+        << jbytes(m.config) << ", \"config_hex\": " << js(hex_list(m.config, ","))
+        << ", \"input_len\": " << m.input_len << ", \"output_len\": " << m.output_len
+        << ", \"consistent\": " << jb(m.consistent) << ", \"prm_defaults\": " << jbytes(f.prm_area_defaults(m.prm))
+        << ", \"info_text\": " << js(m.info_text) << "}";
+  }
+  out << "\n  ],\n";
+  const auto& g = f.global_prm();
+  out << "  \"parameters\": {\"user_prm_data_len\": "
+      << (g.declared_len ? std::to_string(*g.declared_len) : std::string("null"))
+      << ", \"max_user_prm_data_len\": " << int(f.max_user_prm_data_len())
+      << ", \"station_defaults\": " << jbytes(f.prm_area_defaults(g)) << ", \"ext_user_prm_data\": [";
+  bool first = true;
+  for (const auto& [ref, e] : f.ext_user_prm_data()) {
+    out << (first ? "" : ",") << "\n    {\"ref\": " << ref << ", \"name\": " << js(e.name)
+        << ", \"type\": " << js(devices::gsd_data_type_name(e.type)) << ", \"bit_first\": " << int(e.bit_first)
+        << ", \"bit_last\": " << int(e.bit_last) << ", \"default\": " << e.default_value
+        << ", \"min\": " << e.min_value << ", \"max\": " << e.max_value << ", \"allowed\": [";
+    for (std::size_t k = 0; k < e.allowed.size(); ++k) out << (k ? "," : "") << e.allowed[k];
+    out << "], \"changeable\": " << jb(e.changeable) << ", \"visible\": " << jb(e.visible) << ", \"texts\": [";
+    if (e.prm_text_ref) {
+      auto it = f.prm_texts().find(*e.prm_text_ref);
+      if (it != f.prm_texts().end()) {
+        bool ft = true;
+        for (const auto& [v, t] : it->second.texts) {
+          out << (ft ? "" : ", ") << "{\"value\": " << v << ", \"text\": " << js(t) << "}";
+          ft = false;
+        }
+      }
+    }
+    out << "]}";
+    first = false;
+  }
+  out << "\n  ]},\n";
+  const auto& d = f.dpv1();
+  out << "  \"dpv1\": {\"dpv1_slave\": " << jb(d.dpv1_slave) << ", \"c1_read_write_supp\": " << jb(d.c1_read_write_supp)
+      << ", \"c1_max_data_len\": " << int(d.c1_max_data_len) << ", \"c1_response_timeout\": " << d.c1_response_timeout
+      << ", \"c2_read_write_supp\": " << jb(d.c2_read_write_supp) << ", \"c2_max_data_len\": " << int(d.c2_max_data_len)
+      << ", \"c2_response_timeout\": " << d.c2_response_timeout
+      << ", \"c2_max_count_channels\": " << int(d.c2_max_count_channels)
+      << ", \"max_initiate_pdu_length\": " << int(d.max_initiate_pdu_length)
+      << ", \"diagnostic_alarm_supp\": " << jb(d.diagnostic_alarm_supp)
+      << ", \"process_alarm_supp\": " << jb(d.process_alarm_supp)
+      << ", \"pull_plug_alarm_supp\": " << jb(d.pull_plug_alarm_supp)
+      << ", \"status_alarm_supp\": " << jb(d.status_alarm_supp) << ", \"update_alarm_supp\": " << jb(d.update_alarm_supp)
+      << ", \"manufacturer_specific_alarm_supp\": " << jb(d.manufacturer_specific_alarm_supp)
+      << ", \"extra_alarm_sap_supp\": " << jb(d.extra_alarm_sap_supp)
+      << ", \"alarm_sequence_mode_count\": " << int(d.alarm_sequence_mode_count)
+      << ", \"wd_base_1ms_supp\": " << jb(d.wd_base_1ms_supp) << ", \"check_cfg_mode\": " << jb(d.check_cfg_mode)
+      << ", \"ident_maintenance_supp\": " << jb(d.ident_maintenance_supp) << "},\n";
+  const auto& r = f.redundancy();
+  out << "  \"redundancy\": {\"redundancy\": " << jb(r.redundancy) << ", \"prm_cmd_supp\": " << jb(r.prm_cmd_supp)
+      << ", \"slave_redundancy_supp\": " << int(r.slave_redundancy_supp)
+      << ", \"slave_max_switch_over_time\": " << r.slave_max_switch_over_time << "},\n";
+  out << "  \"warnings\": [";
+  for (std::size_t n = 0; n < warnings.size(); ++n) out << (n ? ", " : "") << js(warnings[n].to_string());
+  out << "]\n}\n";
+}
+
+}  // namespace
+
+int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err) {
+  bool json = false;
+  std::string file;
+  for (const auto& a : args) {
+    if (a == "--help" || a == "-h") {
+      out << kUsage;
+      return 0;
+    }
+    if (a == "--json") {
+      json = true;
+    } else if (!a.empty() && a[0] == '-' && a != "-") {
+      err << "pbvbus gsd: unknown option '" << a << "'\n" << kUsage;
+      return 2;
+    } else if (!file.empty()) {
+      err << "pbvbus gsd: only one FILE, got '" << file << "' and '" << a << "'\n";
+      return 2;
+    } else {
+      file = a;
+    }
+  }
+  if (file.empty()) {
+    err << kUsage;
+    return 2;
+  }
+  const devices::GsdParseResult r = devices::load_gsd(file);
+  for (const auto& w : r.warnings) {
+    devices::GsdMessage m = w;
+    m.reason = "warning: " + m.reason;
+    err << m.to_string() << "\n";
+  }
+  if (!r.ok()) {
+    for (const auto& e : r.errors) err << e.to_string() << "\n";
+    return 2;
+  }
+  if (json)
+    print_json(*r.file, r.warnings, out);
+  else
+    print_text(*r.file, out);
+  return 0;
 }
 
 }  // namespace pbvbus::tools

@@ -1,0 +1,382 @@
+#pragma once
+// GSD files (PROFIBUS "Specification for PROFIBUS Device Description and Device Integration",
+// PI 2.122): the typed model of a device description, and the reader that builds it from the
+// bytes of a real vendor file (protocol-facts.md §I; baud keywords and MaxTsdr §C.1; Set_Prm and
+// User_Prm_Data incl. DPV1_Status_1..3 §D.2; configuration identifiers §D.3; DP-V1 keywords §E;
+// redundancy keywords §G.7).
+//
+// The reader never throws and never crashes on garbage: parse_gsd() returns either a GsdFile or
+// a list of errors, each "file:line: reason". Keywords it does not know are kept (name, raw value,
+// line) and reported as warnings.
+//
+// Decisions where PI 2.122 (or our reading of it) is silent, as a PROFIBUS engineer would expect:
+// - Encoding: ISO-8859-1; strings are converted to UTF-8 in the model. A file that starts with a
+//   UTF-8 byte order mark and is valid UTF-8 is read as UTF-8 (with a warning).
+// - Only the `#Profibus_DP` section is read; text before it is ignored, a later `#...` line ends
+//   it (warning).
+// - Booleans must be 0 or 1. Numbers are decimal or 0x hex; a value out of the keyword's range is
+//   an error. A keyword given twice: the later value wins, with a warning.
+// - User_Prm_Data assembly (user_prm_data()): the global area is User_Prm_Data_Len bytes (or, when
+//   absent, as long as its data), initialised from User_Prm_Data, then the
+//   Ext_User_Prm_Data_Const(o) overlays, then the Ext_User_Prm_Data_Ref(o) defaults; every
+//   selected module appends an area of Ext_Module_Prm_Data_Len bytes built the same way. An overlay
+//   beyond the declared length extends the area (with a parse warning). The whole is truncated to
+//   Max_User_Prm_Data_Len (reported in the outcome's notes).
+// - DP-V1 slaves: the first three bytes of the global area are DPV1_Status_1..3 as the file writes
+//   them (vendors put them in Ext_User_Prm_Data_Const(0)). A DP-V1 file whose global area is
+//   shorter than 3 bytes gets a warning, and the assembly fills the missing status bytes with the
+//   minimal DP-V1 values 0x80 (DPV1_Enable), 0x00, 0x00.
+// - Multi-byte parameters (Unsigned16/32, Signed16/32) are big-endian, as everything on PROFIBUS.
+// - Mandatory keywords: Ident_Number missing, a `*_supp = 1` baud rate without its MaxTsdr, no
+//   baud rate at all, a slave without any Module, and Modular_Station = 1 without Max_Module are
+//   errors; missing Station_Type, Min_Slave_Intervall or Max_Diag_Data_Len only warn.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+
+namespace pbvbus::devices {
+
+using GsdBytes = std::vector<std::uint8_t>;
+
+/// One error or warning, located in the file.
+struct GsdMessage {
+  std::string file;
+  std::uint32_t line = 0;  ///< 1-based; 0 = the file as a whole (e.g. cannot be read)
+  std::string reason;
+  /// "file:line: reason" (or "file: reason" for line 0).
+  std::string to_string() const;
+};
+
+/// A keyword as written, kept raw: unknown keywords, and every keyword for keyword() look-ups.
+struct GsdKeyword {
+  std::string name;   ///< as written, without the index, e.g. "Bitmap_Device"
+  std::string index;  ///< the text inside "(...)" if the keyword is indexed, else empty
+  std::string value;  ///< the raw value text after '=' (UTF-8), trimmed
+  std::uint32_t line = 0;
+};
+
+/// A supported baud rate and the slave's (or master's) max TSDR there, in bit times (§C.1).
+struct GsdBaudRate {
+  bus::Baud baud{};
+  std::uint16_t max_tsdr = 0;
+};
+
+/// Identification and general keywords.
+struct GsdInfo {
+  std::uint8_t gsd_revision = 0;
+  std::string vendor_name;
+  std::string model_name;
+  std::string revision;
+  std::optional<std::uint8_t> revision_number;
+  std::uint16_t ident_number = 0;
+  std::uint8_t protocol_ident = 0;  ///< 0 = DP
+  std::uint8_t station_type = 0;    ///< 0 = DP slave, 1 = DP master (class 1)
+  bool fms_supp = false;
+  std::string hardware_release;
+  std::string software_release;
+  std::string order_number;
+  std::string info_text;
+  std::string slave_family;         ///< raw "main@sub@..."
+  std::string implementation_type;  ///< e.g. "VPC3"
+};
+
+/// DP-V0 slave features.
+struct GsdSlaveFeatures {
+  bool freeze_mode_supp = false;
+  bool sync_mode_supp = false;
+  bool auto_baud_supp = false;
+  bool set_slave_add_supp = false;
+  bool fail_safe = false;
+  std::uint8_t repeater_ctrl_sig = 0;  ///< 0 none, 1 RS-485, 2 TTL
+  std::uint8_t pins_24v = 0;            ///< 24V_Pins
+  std::uint16_t min_slave_intervall = 0;  ///< unit 100 us
+  std::uint8_t max_diag_data_len = 6;
+  bool modular_station = false;
+  std::uint8_t max_module = 1;
+  std::uint8_t max_input_len = 244;
+  std::uint8_t max_output_len = 244;
+  std::uint16_t max_data_len = 488;
+  std::uint16_t modul_offset = 0;
+};
+
+/// Data types of ExtUserPrmData (PI 2.122).
+enum class GsdDataType { Bit, BitArea, Unsigned8, Unsigned16, Unsigned32, Signed8, Signed16, Signed32 };
+std::string_view gsd_data_type_name(GsdDataType t);
+
+/// PrmText = n ... EndPrmText: names for parameter values.
+struct GsdPrmText {
+  std::uint16_t ref = 0;
+  std::vector<std::pair<std::int64_t, std::string>> texts;  ///< Text(value) = "..."
+  std::uint32_t line = 0;
+  const std::string* text_for(std::int64_t value) const;
+};
+
+/// ExtUserPrmData = ref "name" ... EndExtUserPrmData: one parameter's type, default and range.
+struct GsdExtUserPrmData {
+  std::uint16_t ref = 0;
+  std::string name;
+  GsdDataType type = GsdDataType::Unsigned8;
+  std::uint8_t bit_first = 0;  ///< Bit(b): b; BitArea(a-b): a
+  std::uint8_t bit_last = 0;   ///< Bit(b): b; BitArea(a-b): b
+  std::int64_t default_value = 0;
+  std::int64_t min_value = 0;  ///< range form (also set to the extremes of an enumeration)
+  std::int64_t max_value = 0;
+  std::vector<std::int64_t> allowed;  ///< enumerated form "a,b,c"; empty for the range form
+  std::optional<std::uint16_t> prm_text_ref;
+  bool changeable = true;
+  bool visible = true;
+  std::uint32_t line = 0;
+
+  /// Bytes the parameter occupies in User_Prm_Data (1 for Bit/BitArea).
+  std::size_t size() const;
+  bool accepts(std::int64_t v) const;
+};
+
+/// Ext_User_Prm_Data_Const(offset) = bytes.
+struct GsdPrmConst {
+  std::uint16_t offset = 0;
+  GsdBytes data;
+  std::uint32_t line = 0;
+};
+
+/// Ext_User_Prm_Data_Ref(offset) = ref.
+struct GsdPrmRef {
+  std::uint16_t offset = 0;
+  std::uint16_t ref = 0;
+  std::uint32_t line = 0;
+};
+
+/// One area of User_Prm_Data: the global one or a module's.
+struct GsdPrmArea {
+  std::optional<std::uint16_t> declared_len;  ///< User_Prm_Data_Len / Ext_Module_Prm_Data_Len
+  GsdBytes initial;                           ///< User_Prm_Data (global area only)
+  std::vector<GsdPrmConst> consts;
+  std::vector<GsdPrmRef> refs;
+  /// Length the area takes in User_Prm_Data (declared length, extended to cover every overlay).
+  std::size_t length(const std::map<std::uint16_t, GsdExtUserPrmData>& defs) const;
+};
+
+/// Module = "name" cfg bytes ... EndModule.
+struct GsdModule {
+  std::string name;
+  GsdBytes config;  ///< identifier bytes as sent in Chk_Cfg (§D.3)
+  std::optional<std::uint32_t> reference;  ///< the module reference number line
+  std::size_t input_len = 0;   ///< bytes, derived from the identifiers (§D.3)
+  std::size_t output_len = 0;  ///< bytes
+  bool consistent = false;     ///< any identifier asks for consistency over the whole length
+  GsdPrmArea prm;
+  std::string info_text;
+  std::vector<GsdKeyword> other_keywords;  ///< module-local keywords not modelled (raw)
+  std::uint32_t line = 0;
+};
+
+/// Unit_Diag_Area = first-last / Value(n) = "..." / Unit_Diag_Area_End (also X_Unit_Diag_Area).
+struct GsdUnitDiagArea {
+  std::uint16_t first_bit = 0;
+  std::uint16_t last_bit = 0;
+  std::vector<std::pair<std::int64_t, std::string>> values;
+  bool x_variant = false;
+  std::uint32_t line = 0;
+};
+
+/// SlotDefinition: Slot(n) = "name" default allowed.
+struct GsdSlot {
+  std::uint16_t number = 0;
+  std::string name;
+  std::uint32_t default_ref = 0;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> allowed;  ///< inclusive ranges of refs
+  std::uint32_t line = 0;
+};
+
+/// DP-V1 features (§E and I.2).
+struct GsdDpv1Features {
+  bool dpv1_slave = false;
+  bool c1_read_write_supp = false;
+  bool c1_read_write_required = false;
+  std::uint8_t c1_max_data_len = 0;       ///< <= 240
+  std::uint16_t c1_response_timeout = 0;  ///< unit 10 ms [U]
+  bool c2_read_write_supp = false;
+  bool c2_read_write_required = false;
+  std::uint8_t c2_max_data_len = 0;  ///< 0 or 48..240
+  std::uint16_t c2_response_timeout = 0;
+  std::uint8_t c2_max_count_channels = 0;
+  std::uint8_t max_initiate_pdu_length = 0;  ///< 0 or 52..244
+  bool diagnostic_alarm_supp = false;
+  bool process_alarm_supp = false;
+  bool pull_plug_alarm_supp = false;
+  bool status_alarm_supp = false;
+  bool update_alarm_supp = false;
+  bool manufacturer_specific_alarm_supp = false;
+  bool diagnostic_alarm_required = false;
+  bool process_alarm_required = false;
+  bool pull_plug_alarm_required = false;
+  bool status_alarm_required = false;
+  bool update_alarm_required = false;
+  bool manufacturer_specific_alarm_required = false;
+  bool extra_alarm_sap_supp = false;
+  bool alarm_type_mode_supp = false;
+  std::uint8_t alarm_sequence_mode_count = 0;
+  bool wd_base_1ms_supp = false;
+  bool check_cfg_mode = false;
+  bool dpv1_data_types = false;
+  bool publisher_supp = false;
+  bool ident_maintenance_supp = false;
+  bool time_sync_supp = false;
+  bool prm_block_structure_supp = false;
+  bool prm_block_structure_req = false;
+  bool fail_safe_required = false;
+};
+
+/// Redundancy keywords (§G.7).
+struct GsdRedundancy {
+  bool redundancy = false;  ///< redundant transmission medium, not slave redundancy
+  bool prm_cmd_supp = false;
+  std::uint8_t slave_redundancy_supp = 0;
+  std::uint16_t slave_max_switch_over_time = 0;
+};
+
+/// Master GSD keywords (Station_Type = 1), §I.2.
+struct GsdMasterFeatures {
+  std::optional<std::uint8_t> max_slaves_supp;
+  std::optional<std::uint8_t> las_len;
+  std::map<bus::Baud, std::uint16_t> trdy, tqui, tset, tsdi;  ///< bit times
+  std::optional<std::uint16_t> min_poll_timeout;  ///< unit 10 ms
+  std::optional<std::uint8_t> max_mps_length;
+  std::optional<std::uint8_t> max_lsdu_ms;
+  std::optional<std::uint8_t> max_lsdu_mm;
+  bool dpv1_master = false;
+  bool c1_master_read_write_supp = false;
+  bool master_diagnostic_alarm_supp = false;
+  bool master_process_alarm_supp = false;
+  bool master_pull_plug_alarm_supp = false;
+  bool master_status_alarm_supp = false;
+  bool master_update_alarm_supp = false;
+  bool master_manufacturer_specific_alarm_supp = false;
+  bool master_freeze_mode_supp = false;
+  bool master_sync_mode_supp = false;
+  bool master_fail_safe_supp = false;
+  bool download_supp = false;
+  bool upload_supp = false;
+  bool act_para_brct_supp = false;
+  bool act_param_supp = false;
+};
+
+/// Result of an assembly or a check on a module selection.
+template <class T>
+struct GsdOutcome {
+  std::optional<T> value;           ///< set when errors is empty
+  std::vector<std::string> errors;  ///< why the selection cannot be used
+  std::vector<std::string> notes;   ///< e.g. truncation to Max_User_Prm_Data_Len
+  bool ok() const { return errors.empty(); }
+};
+
+/// A parsed GSD file.
+class GsdFile {
+ public:
+  const std::string& file_name() const { return m_file_name; }
+  const GsdInfo& info() const { return m_info; }
+  std::uint16_t ident_number() const { return m_info.ident_number; }
+  std::uint8_t station_type() const { return m_info.station_type; }
+  bool is_master() const { return m_info.station_type == 1; }
+
+  /// Supported baud rates in ascending order, each with its MaxTsdr.
+  const std::vector<GsdBaudRate>& baud_rates() const { return m_baud_rates; }
+  bool supports(bus::Baud b) const;
+  /// MaxTsdr for a supported rate (bit times), nullopt if the rate is not supported.
+  std::optional<std::uint16_t> max_tsdr(bus::Baud b) const;
+
+  const GsdSlaveFeatures& slave_features() const { return m_slave; }
+  const GsdDpv1Features& dpv1() const { return m_dpv1; }
+  const GsdRedundancy& redundancy() const { return m_redundancy; }
+  const GsdMasterFeatures& master() const { return m_master; }
+
+  const std::vector<GsdModule>& modules() const { return m_modules; }
+  /// Index of the first module with this name (exact, UTF-8) or reference number.
+  std::optional<std::size_t> find_module(std::string_view name) const;
+  std::optional<std::size_t> find_module_by_reference(std::uint32_t reference) const;
+
+  /// Global parameter area (User_Prm_Data_Len, User_Prm_Data, Ext_User_Prm_Data_Const/Ref).
+  const GsdPrmArea& global_prm() const { return m_global_prm; }
+  std::uint8_t max_user_prm_data_len() const { return m_max_user_prm_data_len; }
+  const std::map<std::uint16_t, GsdExtUserPrmData>& ext_user_prm_data() const { return m_ext_prm; }
+  const std::map<std::uint16_t, GsdPrmText>& prm_texts() const { return m_prm_texts; }
+
+  const std::map<std::uint32_t, std::string>& unit_diag_bits() const { return m_unit_diag_bits; }
+  const std::vector<GsdUnitDiagArea>& unit_diag_areas() const { return m_unit_diag_areas; }
+  const std::map<std::uint32_t, std::string>& channel_diag() const { return m_channel_diag; }
+  const std::vector<GsdSlot>& slots() const { return m_slots; }
+
+  /// Every top-level keyword as written, in file order (including modelled ones).
+  const std::vector<GsdKeyword>& keywords() const { return m_keywords; }
+  /// The last top-level occurrence of a keyword (case-insensitive; name without index).
+  const GsdKeyword* keyword(std::string_view name) const;
+  /// Keywords the reader does not know (also reported as warnings).
+  const std::vector<GsdKeyword>& unknown_keywords() const { return m_unknown; }
+
+  /// User_Prm_Data for Set_Prm (octets 8..) with every parameter at its default, for the modules
+  /// at these indices (into modules()), in this order (§I.1). Errors: an index out of range.
+  GsdOutcome<GsdBytes> user_prm_data(const std::vector<std::size_t>& modules) const;
+  /// The bytes one parameter area (global_prm() or a module's prm) contributes, all defaults.
+  GsdBytes prm_area_defaults(const GsdPrmArea& area) const;
+  /// Chk_Cfg data: the concatenated config bytes of these modules. Errors: index out of range.
+  GsdOutcome<GsdBytes> cfg_data(const std::vector<std::size_t>& modules) const;
+  /// Checks a module selection against Max_Module, Max_Input_Len, Max_Output_Len, Max_Data_Len
+  /// (and, for a non-modular station, that exactly one module is chosen). value = {in, out}.
+  GsdOutcome<std::pair<std::size_t, std::size_t>> check_modules(
+      const std::vector<std::size_t>& modules) const;
+
+ private:
+  friend class GsdParser;
+
+  std::string m_file_name;
+  GsdInfo m_info;
+  std::vector<GsdBaudRate> m_baud_rates;
+  GsdSlaveFeatures m_slave;
+  GsdDpv1Features m_dpv1;
+  GsdRedundancy m_redundancy;
+  GsdMasterFeatures m_master;
+  std::vector<GsdModule> m_modules;
+  GsdPrmArea m_global_prm;
+  std::uint8_t m_max_user_prm_data_len = 237;
+  std::map<std::uint16_t, GsdExtUserPrmData> m_ext_prm;
+  std::map<std::uint16_t, GsdPrmText> m_prm_texts;
+  std::map<std::uint32_t, std::string> m_unit_diag_bits;
+  std::vector<GsdUnitDiagArea> m_unit_diag_areas;
+  std::map<std::uint32_t, std::string> m_channel_diag;
+  std::vector<GsdSlot> m_slots;
+  std::vector<GsdKeyword> m_keywords;
+  std::vector<GsdKeyword> m_unknown;
+};
+
+/// What parse_gsd() returns: a model, or errors; warnings either way.
+struct GsdParseResult {
+  std::optional<GsdFile> file;  ///< set iff errors is empty
+  std::vector<GsdMessage> errors;
+  std::vector<GsdMessage> warnings;
+  bool ok() const { return file.has_value(); }
+};
+
+/// Parses the raw bytes of a GSD file; `file_name` is used in messages only.
+GsdParseResult parse_gsd(std::string_view bytes, std::string_view file_name);
+/// Reads and parses a file. A file that cannot be read is an error at line 0.
+GsdParseResult load_gsd(const std::filesystem::path& path);
+
+/// Input and output bytes described by a list of configuration identifiers (§D.3), or an error
+/// text if the list is malformed (a special identifier cut short, etc.).
+struct GsdCfgLengths {
+  std::size_t input_len = 0;
+  std::size_t output_len = 0;
+  bool consistent = false;
+};
+std::optional<GsdCfgLengths> gsd_cfg_lengths(const GsdBytes& config, std::string* error = nullptr);
+
+}  // namespace pbvbus::devices

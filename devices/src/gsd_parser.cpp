@@ -1,0 +1,1388 @@
+// The GSD reader (PI 2.122; protocol-facts.md §I.1 syntax, §I.2 keywords). It works in three
+// passes: bytes -> UTF-8 text, physical lines -> logical lines (comments and `\` continuations
+// removed), logical lines -> statements applied to the model by a small block state machine.
+// Semantic checks that need the whole file (references, mandatory keywords) run at the end.
+// Decisions where the specification is silent are listed in gsd.hpp.
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+
+#include "pbvbus/devices/gsd.hpp"
+
+namespace pbvbus::devices {
+
+namespace {
+
+constexpr std::size_t kMaxErrors = 50;
+constexpr std::size_t kMaxWarnings = 500;
+
+std::string lower(std::string_view s) {
+  std::string r(s);
+  for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return r;
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f' || c == '\r' || c == '\0'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// ISO-8859-1 maps byte b to code point b; UTF-8 needs two bytes for 0x80..0xFF.
+std::string latin1_to_utf8(std::string_view in) {
+  std::string out;
+  out.reserve(in.size() + in.size() / 8);
+  for (char ch : in) {
+    const auto b = static_cast<unsigned char>(ch);
+    if (b < 0x80) {
+      out += ch;
+    } else {
+      out += static_cast<char>(0xC0 | (b >> 6));
+      out += static_cast<char>(0x80 | (b & 0x3F));
+    }
+  }
+  return out;
+}
+
+bool valid_utf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto b = static_cast<unsigned char>(s[i]);
+    std::size_t n = 0;
+    std::uint32_t cp = 0;
+    if (b < 0x80) {
+      ++i;
+      continue;
+    } else if ((b & 0xE0) == 0xC0) {
+      n = 1;
+      cp = b & 0x1Fu;
+    } else if ((b & 0xF0) == 0xE0) {
+      n = 2;
+      cp = b & 0x0Fu;
+    } else if ((b & 0xF8) == 0xF0) {
+      n = 3;
+      cp = b & 0x07u;
+    } else {
+      return false;
+    }
+    if (s.size() - i <= n) return false;
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto c = static_cast<unsigned char>(s[i + k]);
+      if ((c & 0xC0) != 0x80) return false;
+      cp = (cp << 6) | (c & 0x3Fu);
+    }
+    static constexpr std::uint32_t kMin[4] = {0, 0x80, 0x800, 0x10000};
+    if (cp < kMin[n] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+// Baud keyword suffixes as GSD files spell them ("9.6_supp", "MaxTsdr_1.5M").
+struct BaudName {
+  std::string_view gsd;
+  bus::Baud baud;
+};
+constexpr std::array<BaudName, 11> kBaudNames{{
+    {"9.6", bus::Baud::k9_6},     {"19.2", bus::Baud::k19_2},   {"31.25", bus::Baud::k31_25},
+    {"45.45", bus::Baud::k45_45}, {"93.75", bus::Baud::k93_75}, {"187.5", bus::Baud::k187_5},
+    {"500", bus::Baud::k500},     {"1.5m", bus::Baud::k1_5M},   {"3m", bus::Baud::k3M},
+    {"6m", bus::Baud::k6M},       {"12m", bus::Baud::k12M},
+}};
+
+std::optional<bus::Baud> baud_from_gsd(std::string_view lower_name) {
+  for (const auto& b : kBaudNames)
+    if (b.gsd == lower_name) return b.baud;
+  return std::nullopt;
+}
+
+std::string gsd_baud_spelling(bus::Baud b) {
+  for (const auto& n : kBaudNames)
+    if (n.baud == b) {
+      std::string s(n.gsd);
+      if (!s.empty() && s.back() == 'm') s.back() = 'M';
+      return s;
+    }
+  return "?";
+}
+
+
+// Keywords that take a plain value and map onto one field of the model.
+enum class Kind { Bool, Uint, String };
+struct ScalarKeyword {
+  std::string_view name;  // canonical spelling, used in messages
+  Kind kind;
+  std::uint64_t max;  // for Uint
+  void (*set_uint)(GsdFile&, std::uint64_t);
+  std::string& (*string_field)(GsdFile&);
+};
+
+}  // namespace
+
+class GsdParser {
+ public:
+  GsdParser(std::string_view bytes, std::string_view file_name) : m_bytes(bytes) {
+    m_result_file.m_file_name = std::string(file_name);
+    m_file = std::string(file_name);
+  }
+
+  GsdParseResult run();
+
+ private:
+  struct Stmt {
+    std::string keyword;  // as written
+    std::string key;      // lower case
+    bool has_index = false;
+    std::string index;
+    bool has_eq = false;
+    std::string value;  // after '=' (or the rest of the line when there is no '=')
+    std::uint32_t line = 0;
+  };
+
+  enum class Block { Top, Module, PrmText, ExtPrm, DiagArea, Slots, Opaque };
+
+  // --- messages
+  void error(std::uint32_t line, std::string reason) {
+    if (m_errors.size() < kMaxErrors) m_errors.push_back({m_file, line, std::move(reason)});
+  }
+  void warning(std::uint32_t line, std::string reason) {
+    if (m_warnings.size() < kMaxWarnings) m_warnings.push_back({m_file, line, std::move(reason)});
+  }
+  bool too_many_errors() const { return m_errors.size() >= kMaxErrors; }
+
+  // --- lexical
+  std::string decode();
+  void split_logical(const std::string& text);
+  std::optional<Stmt> parse_stmt(std::string_view text, std::uint32_t line);
+
+  // --- values
+  std::optional<std::int64_t> number(std::string_view tok, std::uint32_t line);
+  std::optional<std::uint64_t> unsigned_value(const Stmt& s, std::string_view name, std::uint64_t max);
+  std::optional<bool> boolean(const Stmt& s, std::string_view name);
+  std::optional<std::string> quoted(std::string_view v, std::uint32_t line, std::string* rest);
+  std::optional<std::string> string_value(const Stmt& s, std::string_view name);
+  std::optional<GsdBytes> byte_list(std::string_view v, std::uint32_t line, std::string_view what);
+  std::optional<std::uint16_t> index_value(const Stmt& s, std::uint64_t max);
+  bool need_value(const Stmt& s);
+
+  // --- statements
+  void statement(const Stmt& s);
+  void top(const Stmt& s);
+  void in_module(const Stmt& s);
+  void in_prm_text(const Stmt& s);
+  void in_ext_prm(const Stmt& s);
+  void in_diag_area(const Stmt& s);
+  void in_slots(const Stmt& s);
+  bool scalar(const Stmt& s);
+  bool baud_keyword(const Stmt& s);
+  void prm_const(const Stmt& s, GsdPrmArea& area);
+  void prm_ref(const Stmt& s, GsdPrmArea& area);
+  void data_type_line(const Stmt& s);
+  bool block_start(const Stmt& s) const;
+  void unknown(const Stmt& s, std::string_view where);
+  void remember(const Stmt& s);
+  void close_block_at_end();
+  void finish();
+  static const std::unordered_map<std::string, ScalarKeyword>& table();
+
+  std::string m_file;
+  std::string_view m_bytes;
+  GsdFile m_result_file;
+  std::vector<GsdMessage> m_errors;
+  std::vector<GsdMessage> m_warnings;
+  std::uint32_t m_section_line = 0;
+  std::vector<std::pair<std::string, std::uint32_t>> m_logical;
+
+  Block m_block = Block::Top;
+  std::uint32_t m_block_line = 0;
+  std::string m_opaque_end;  // end keyword (lower case) of an opaque block
+  Block m_opaque_return = Block::Top;
+  std::size_t m_module_stmts = 0;
+  GsdModule m_module;
+  GsdPrmText m_prm_text;
+  GsdExtUserPrmData m_ext;
+  bool m_ext_has_type = false;
+  GsdUnitDiagArea m_diag_area;
+
+  std::unordered_map<std::string, std::uint32_t> m_seen;  // key(+index) -> line
+  std::map<bus::Baud, std::uint32_t> m_supp_line;         // supported (= 1) rates
+  std::map<bus::Baud, std::uint16_t> m_max_tsdr;
+  std::map<std::uint16_t, std::uint32_t> m_prm_text_lines;
+};
+
+
+// ---------------------------------------------------------------------------------------------
+// Keyword table
+
+const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
+  // Lambdas written here share GsdParser's access to GsdFile's members.
+#define PBV_U(NAME, MAX, FIELD)                                                                  \
+  ScalarKeyword {                                                                                \
+    NAME, Kind::Uint, MAX,                                                                       \
+        [](GsdFile& f, std::uint64_t v) { f.FIELD = static_cast<std::remove_reference_t<decltype(f.FIELD)>>(v); }, \
+        nullptr                                                                                  \
+  }
+#define PBV_OPT(NAME, MAX, FIELD)                                                                \
+  ScalarKeyword {                                                                                \
+    NAME, Kind::Uint, MAX,                                                                       \
+        [](GsdFile& f, std::uint64_t v) { f.FIELD = static_cast<typename decltype(f.FIELD)::value_type>(v); }, \
+        nullptr                                                                                  \
+  }
+#define PBV_B(NAME, FIELD) \
+  ScalarKeyword { NAME, Kind::Bool, 1, [](GsdFile& f, std::uint64_t v) { f.FIELD = v != 0; }, nullptr }
+#define PBV_S(NAME, FIELD) \
+  ScalarKeyword { NAME, Kind::String, 0, nullptr, [](GsdFile& f) -> std::string& { return f.FIELD; } }
+  static const std::unordered_map<std::string, ScalarKeyword> kTable = [] {
+    const ScalarKeyword list[] = {
+        // Identification
+        PBV_U("GSD_Revision", 255, m_info.gsd_revision),
+        PBV_S("Vendor_Name", m_info.vendor_name),
+        PBV_S("Model_Name", m_info.model_name),
+        PBV_S("Revision", m_info.revision),
+        PBV_OPT("Revision_Number", 63, m_info.revision_number),
+        PBV_U("Ident_Number", 0xFFFF, m_info.ident_number),
+        PBV_U("Protocol_Ident", 255, m_info.protocol_ident),
+        PBV_U("Station_Type", 1, m_info.station_type),
+        PBV_B("FMS_supp", m_info.fms_supp),
+        PBV_S("Hardware_Release", m_info.hardware_release),
+        PBV_S("Software_Release", m_info.software_release),
+        PBV_S("OrderNumber", m_info.order_number),
+        PBV_S("Info_Text", m_info.info_text),
+        PBV_S("Implementation_Type", m_info.implementation_type),
+        // DP-V0 slave features
+        PBV_B("Freeze_Mode_supp", m_slave.freeze_mode_supp),
+        PBV_B("Sync_Mode_supp", m_slave.sync_mode_supp),
+        PBV_B("Auto_Baud_supp", m_slave.auto_baud_supp),
+        PBV_B("Set_Slave_Add_supp", m_slave.set_slave_add_supp),
+        PBV_B("Fail_Safe", m_slave.fail_safe),
+        PBV_U("Repeater_Ctrl_Sig", 2, m_slave.repeater_ctrl_sig),
+        PBV_U("24V_Pins", 2, m_slave.pins_24v),
+        PBV_U("Min_Slave_Intervall", 0xFFFF, m_slave.min_slave_intervall),
+        PBV_U("Max_Diag_Data_Len", 244, m_slave.max_diag_data_len),
+        PBV_B("Modular_Station", m_slave.modular_station),
+        PBV_U("Max_Module", 255, m_slave.max_module),
+        PBV_U("Max_Input_Len", 244, m_slave.max_input_len),
+        PBV_U("Max_Output_Len", 244, m_slave.max_output_len),
+        PBV_U("Max_Data_Len", 488, m_slave.max_data_len),
+        PBV_U("Modul_Offset", 255, m_slave.modul_offset),
+        // DP-V1
+        PBV_B("DPV1_Slave", m_dpv1.dpv1_slave),
+        PBV_B("C1_Read_Write_supp", m_dpv1.c1_read_write_supp),
+        PBV_B("C1_Read_Write_required", m_dpv1.c1_read_write_required),
+        PBV_U("C1_Max_Data_Len", 240, m_dpv1.c1_max_data_len),
+        PBV_U("C1_Response_Timeout", 0xFFFF, m_dpv1.c1_response_timeout),
+        PBV_B("C2_Read_Write_supp", m_dpv1.c2_read_write_supp),
+        PBV_B("C2_Read_Write_required", m_dpv1.c2_read_write_required),
+        PBV_U("C2_Max_Data_Len", 240, m_dpv1.c2_max_data_len),
+        PBV_U("C2_Response_Timeout", 0xFFFF, m_dpv1.c2_response_timeout),
+        PBV_U("C2_Max_Count_Channels", 32, m_dpv1.c2_max_count_channels),
+        PBV_U("Max_Initiate_PDU_Length", 244, m_dpv1.max_initiate_pdu_length),
+        PBV_B("Diagnostic_Alarm_supp", m_dpv1.diagnostic_alarm_supp),
+        PBV_B("Process_Alarm_supp", m_dpv1.process_alarm_supp),
+        PBV_B("Pull_Plug_Alarm_supp", m_dpv1.pull_plug_alarm_supp),
+        PBV_B("Status_Alarm_supp", m_dpv1.status_alarm_supp),
+        PBV_B("Update_Alarm_supp", m_dpv1.update_alarm_supp),
+        PBV_B("Manufacturer_Specific_Alarm_supp", m_dpv1.manufacturer_specific_alarm_supp),
+        PBV_B("Diagnostic_Alarm_required", m_dpv1.diagnostic_alarm_required),
+        PBV_B("Process_Alarm_required", m_dpv1.process_alarm_required),
+        PBV_B("Pull_Plug_Alarm_required", m_dpv1.pull_plug_alarm_required),
+        PBV_B("Status_Alarm_required", m_dpv1.status_alarm_required),
+        PBV_B("Update_Alarm_required", m_dpv1.update_alarm_required),
+        PBV_B("Manufacturer_Specific_Alarm_required", m_dpv1.manufacturer_specific_alarm_required),
+        PBV_B("Extra_Alarm_SAP_supp", m_dpv1.extra_alarm_sap_supp),
+        PBV_B("Alarm_Type_Mode_supp", m_dpv1.alarm_type_mode_supp),
+        PBV_U("Alarm_Sequence_Mode_Count", 32, m_dpv1.alarm_sequence_mode_count),
+        PBV_B("WD_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),
+        PBV_B("WB_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),  // misspelling found in real files
+        PBV_B("Check_Cfg_Mode", m_dpv1.check_cfg_mode),
+        PBV_B("DPV1_Data_Types", m_dpv1.dpv1_data_types),
+        PBV_B("Publisher_supp", m_dpv1.publisher_supp),
+        PBV_B("Ident_Maintenance_supp", m_dpv1.ident_maintenance_supp),
+        PBV_B("Time_Sync_supp", m_dpv1.time_sync_supp),
+        PBV_B("Prm_Block_Structure_supp", m_dpv1.prm_block_structure_supp),
+        PBV_B("Prm_Block_Structure_req", m_dpv1.prm_block_structure_req),
+        PBV_B("Fail_Safe_required", m_dpv1.fail_safe_required),
+        // Redundancy (§G.7)
+        PBV_B("Redundancy", m_redundancy.redundancy),
+        PBV_B("PrmCmd_supp", m_redundancy.prm_cmd_supp),
+        PBV_U("Slave_Redundancy_supp", 255, m_redundancy.slave_redundancy_supp),
+        PBV_U("Slave_Max_Switch_Over_Time", 0xFFFF, m_redundancy.slave_max_switch_over_time),
+        // Master GSD
+        PBV_OPT("Max_Slaves_supp", 125, m_master.max_slaves_supp),
+        PBV_OPT("LAS_Len", 255, m_master.las_len),
+        PBV_OPT("Min_Poll_Timeout", 0xFFFF, m_master.min_poll_timeout),
+        PBV_OPT("Max_MPS_Length", 255, m_master.max_mps_length),
+        PBV_OPT("Max_Lsdu_MS", 255, m_master.max_lsdu_ms),
+        PBV_OPT("Max_Lsdu_MM", 255, m_master.max_lsdu_mm),
+        PBV_B("DPV1_Master", m_master.dpv1_master),
+        PBV_B("C1_Master_Read_Write_supp", m_master.c1_master_read_write_supp),
+        PBV_B("Master_Diagnostic_Alarm_supp", m_master.master_diagnostic_alarm_supp),
+        PBV_B("Master_Process_Alarm_supp", m_master.master_process_alarm_supp),
+        PBV_B("Master_Pull_Plug_Alarm_supp", m_master.master_pull_plug_alarm_supp),
+        PBV_B("Master_Status_Alarm_supp", m_master.master_status_alarm_supp),
+        PBV_B("Master_Update_Alarm_supp", m_master.master_update_alarm_supp),
+        PBV_B("Master_Manufacturer_Specific_Alarm_supp", m_master.master_manufacturer_specific_alarm_supp),
+        PBV_B("Master_Freeze_Mode_supp", m_master.master_freeze_mode_supp),
+        PBV_B("Master_Sync_Mode_supp", m_master.master_sync_mode_supp),
+        PBV_B("Master_Fail_Safe_supp", m_master.master_fail_safe_supp),
+        PBV_B("Download_supp", m_master.download_supp),
+        PBV_B("Upload_supp", m_master.upload_supp),
+        PBV_B("Act_Para_Brct_supp", m_master.act_para_brct_supp),
+        PBV_B("Act_Param_supp", m_master.act_param_supp),
+    };
+    std::unordered_map<std::string, ScalarKeyword> m;
+    for (const auto& k : list) m.emplace(lower(k.name), k);
+    return m;
+  }();
+#undef PBV_U
+#undef PBV_OPT
+#undef PBV_B
+#undef PBV_S
+  return kTable;
+}
+
+namespace {
+
+// Keywords of PI 2.122 that the model does not interpret; kept raw, no warning.
+bool known_raw(std::string_view key) {
+  static const std::array<std::string_view, 42> kKnown = {
+      "slave_family",         "bitmap_device",        "bitmap_diag",
+      "bitmap_sf",            "unit_diag_not_bit",    "x_unit_diag_bit",
+      "x_unit_diag_not_bit",  "unit_diag_bit_help",   "x_unit_diag_bit_help",
+      "unit_diag_not_bit_help", "channel_diag_help",  "diag_update_delay",
+      "isochron_mode_supp",   "isochron_mode_required", "tbase_dp",
+      "tdp_max",              "tdp_min",              "tbase_io",
+      "tio_input",            "tio_output",           "to_min",
+      "ti_min",               "t_pll_w_max",          "fixpresetmodules",
+      "preset",               "max_master_input_len", "max_master_output_len",
+      "max_master_data_len",  "dxb_max_link_count",   "dxb_max_data_length",
+      "dxb_subscribertable_block_location", "isom_sync_mode_supp", "subsys_dir_index",
+      "subsys_module_dir_index", "max_iso_input_len",  "max_iso_output_len",
+      "info_text_help",       "webpage",              "gsd_file_version",
+      "x_channel_diag",       "prm_text_help",        "order_number",
+  };
+  return std::find(kKnown.begin(), kKnown.end(), key) != kKnown.end();
+}
+
+bool known_module_raw(std::string_view key) {
+  static const std::array<std::string_view, 12> kKnown = {
+      "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
+      "x_ext_module_prm_data_len", "x_ext_user_prm_data_const", "x_ext_user_prm_data_ref",
+      "preset",                    "channel_diag",              "module_reference",
+      "ordernumber",               "bitmap_device",             "alarm_type_mode_supp",
+  };
+  return std::find(kKnown.begin(), kKnown.end(), key) != kKnown.end();
+}
+
+std::string shorten(std::string_view s) {
+  if (s.size() <= 40) return std::string(s);
+  return std::string(s.substr(0, 40)) + "...";
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Lexical passes
+
+std::string GsdParser::decode() {
+  std::string_view b = m_bytes;
+  if (b.size() >= 3 && static_cast<unsigned char>(b[0]) == 0xEF &&
+      static_cast<unsigned char>(b[1]) == 0xBB && static_cast<unsigned char>(b[2]) == 0xBF) {
+    b.remove_prefix(3);
+    if (valid_utf8(b)) {
+      warning(1, "file starts with a UTF-8 byte order mark: read as UTF-8, not ISO-8859-1");
+      return std::string(b);
+    }
+    warning(1, "UTF-8 byte order mark but invalid UTF-8: read as ISO-8859-1");
+  }
+  return latin1_to_utf8(b);
+}
+
+void GsdParser::split_logical(const std::string& text) {
+  std::vector<std::string_view> phys;
+  {
+    std::size_t start = 0;
+    std::string_view t(text);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] == '\n' || t[i] == '\r') {
+        phys.push_back(t.substr(start, i - start));
+        if (t[i] == '\r' && i + 1 < t.size() && t[i + 1] == '\n') ++i;
+        start = i + 1;
+      }
+    }
+    if (start < t.size()) phys.push_back(t.substr(start));
+  }
+
+  std::size_t first = phys.size();
+  for (std::size_t i = 0; i < phys.size(); ++i) {
+    const std::string l = lower(trim(phys[i]));
+    if (l.rfind("#profibus_dp", 0) == 0 &&
+        (l.size() == 12 || is_space(l[12]) || l[12] == ';')) {
+      first = i;
+      break;
+    }
+  }
+  if (first == phys.size()) {
+    error(0, "#Profibus_DP section missing");
+    return;
+  }
+  m_section_line = static_cast<std::uint32_t>(first + 1);
+
+  std::string acc;
+  bool continuing = false;
+  bool in_quote = false;
+  std::uint32_t start_line = 0;
+  auto emit = [&]() {
+    if (in_quote) {
+      error(start_line, "unterminated string");
+      in_quote = false;
+    } else if (!trim(acc).empty()) {
+      m_logical.emplace_back(acc, start_line);
+    }
+    acc.clear();
+    continuing = false;
+  };
+  for (std::size_t i = first + 1; i < phys.size(); ++i) {
+    const auto lineno = static_cast<std::uint32_t>(i + 1);
+    std::string_view line = phys[i];
+    const bool quote_at_start = in_quote;
+    if (!continuing) {
+      start_line = lineno;
+      const std::string_view t = trim(line);
+      if (!t.empty() && t.front() == '#') {
+        warning(lineno, "section '" + shorten(t) + "' ignored (only #Profibus_DP is read)");
+        break;
+      }
+    }
+    std::string part;
+    part.reserve(line.size());
+    for (char c : line) {
+      if (c == '"') {
+        in_quote = !in_quote;
+      } else if (c == ';' && !in_quote) {
+        break;
+      }
+      part += c;
+    }
+    std::string_view p = part;
+    while (!p.empty() && is_space(p.back())) p.remove_suffix(1);
+    if (continuing && !quote_at_start)
+      while (!p.empty() && is_space(p.front())) p.remove_prefix(1);
+    if (!p.empty() && p.back() == '\\') {
+      p.remove_suffix(1);
+      acc += p;
+      if (!in_quote) acc += ' ';
+      continuing = true;
+      continue;
+    }
+    acc += p;
+    emit();
+  }
+  if (continuing) emit();
+}
+
+std::optional<GsdParser::Stmt> GsdParser::parse_stmt(std::string_view text, std::uint32_t line) {
+  const std::string_view t = trim(text);
+  std::size_t i = 0;
+  auto kw_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '.';
+  };
+  while (i < t.size() && kw_char(t[i])) ++i;
+  if (i == 0) {
+    error(line, "expected a keyword, found '" + shorten(t) + "'");
+    return std::nullopt;
+  }
+  Stmt s;
+  s.line = line;
+  s.keyword = std::string(t.substr(0, i));
+  s.key = lower(s.keyword);
+  std::size_t j = i;
+  while (j < t.size() && is_space(t[j])) ++j;
+  if (j < t.size() && t[j] == '(') {
+    const std::size_t close = t.find(')', j);
+    if (close == std::string_view::npos) {
+      error(line, "missing ')' after '" + s.keyword + "('");
+      return std::nullopt;
+    }
+    s.has_index = true;
+    s.index = std::string(trim(t.substr(j + 1, close - j - 1)));
+    j = close + 1;
+    while (j < t.size() && is_space(t[j])) ++j;
+  }
+  if (j < t.size() && t[j] == '=') {
+    s.has_eq = true;
+    s.value = std::string(trim(t.substr(j + 1)));
+  } else {
+    s.value = std::string(trim(t.substr(j)));
+  }
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Values
+
+std::optional<std::int64_t> GsdParser::number(std::string_view tok, std::uint32_t line) {
+  tok = trim(tok);
+  std::string_view digits = tok;
+  bool negative = false;
+  if (!digits.empty() && (digits.front() == '-' || digits.front() == '+')) {
+    negative = digits.front() == '-';
+    digits.remove_prefix(1);
+  }
+  int base = 10;
+  if (digits.size() > 2 && digits[0] == '0' && (digits[1] == 'x' || digits[1] == 'X')) {
+    base = 16;
+    digits.remove_prefix(2);
+  }
+  std::uint64_t v = 0;
+  const char* end = digits.data() + digits.size();
+  auto [p, ec] = std::from_chars(digits.data(), end, v, base);
+  if (digits.empty() || p != end || ec == std::errc::invalid_argument) {
+    if (tok.empty())
+      error(line, "value missing");
+    else
+      error(line, "value '" + shorten(tok) + "' is not a number");
+    return std::nullopt;
+  }
+  if (ec == std::errc::result_out_of_range || v > (std::uint64_t{1} << 40)) {
+    error(line, "value '" + shorten(tok) + "' out of range");
+    return std::nullopt;
+  }
+  const auto sv = static_cast<std::int64_t>(v);
+  return negative ? -sv : sv;
+}
+
+bool GsdParser::need_value(const Stmt& s) {
+  if (s.has_eq) return true;
+  error(s.line, "expected '=' after '" + s.keyword + (s.has_index ? "(" + s.index + ")" : "") + "'");
+  return false;
+}
+
+std::optional<std::uint64_t> GsdParser::unsigned_value(const Stmt& s, std::string_view name,
+                                                       std::uint64_t max) {
+  if (!need_value(s)) return std::nullopt;
+  auto v = number(s.value, s.line);
+  if (!v) return std::nullopt;
+  if (*v < 0 || static_cast<std::uint64_t>(*v) > max) {
+    error(s.line, "value " + s.value + " out of range for " + std::string(name) + " (0.." +
+                      std::to_string(max) + ")");
+    return std::nullopt;
+  }
+  return static_cast<std::uint64_t>(*v);
+}
+
+std::optional<bool> GsdParser::boolean(const Stmt& s, std::string_view name) {
+  if (!need_value(s)) return std::nullopt;
+  auto v = number(s.value, s.line);
+  if (!v) return std::nullopt;
+  if (*v != 0 && *v != 1) {
+    error(s.line, "value " + s.value + " of " + std::string(name) + " is not a boolean (0 or 1)");
+    return std::nullopt;
+  }
+  return *v == 1;
+}
+
+std::optional<std::string> GsdParser::quoted(std::string_view v, std::uint32_t line, std::string* rest) {
+  v = trim(v);
+  if (v.empty() || v.front() != '"') {
+    error(line, "expected a quoted string, found '" + shorten(v) + "'");
+    return std::nullopt;
+  }
+  const std::size_t close = v.find('"', 1);
+  if (close == std::string_view::npos) {
+    error(line, "unterminated string");
+    return std::nullopt;
+  }
+  std::string s(v.substr(1, close - 1));
+  const std::string_view after = trim(v.substr(close + 1));
+  if (rest) {
+    *rest = std::string(after);
+  } else if (!after.empty()) {
+    error(line, "unexpected '" + shorten(after) + "' after the string");
+    return std::nullopt;
+  }
+  return s;
+}
+
+std::optional<std::string> GsdParser::string_value(const Stmt& s, std::string_view) {
+  if (!need_value(s)) return std::nullopt;
+  return quoted(s.value, s.line, nullptr);
+}
+
+std::optional<GsdBytes> GsdParser::byte_list(std::string_view v, std::uint32_t line, std::string_view what) {
+  GsdBytes out;
+  v = trim(v);
+  if (v.empty()) return out;
+  while (true) {
+    const std::size_t comma = v.find(',');
+    const std::string_view tok = trim(v.substr(0, comma));
+    if (tok.empty()) {
+      error(line, "empty entry in a list of " + std::string(what) + "s");
+      return std::nullopt;
+    }
+    auto n = number(tok, line);
+    if (!n) return std::nullopt;
+    if (*n < 0 || *n > 255) {
+      error(line, std::string(what) + " " + std::string(tok) + " out of range");
+      return std::nullopt;
+    }
+    out.push_back(static_cast<std::uint8_t>(*n));
+    if (comma == std::string_view::npos) break;
+    v.remove_prefix(comma + 1);
+  }
+  return out;
+}
+
+std::optional<std::uint16_t> GsdParser::index_value(const Stmt& s, std::uint64_t max) {
+  if (!s.has_index) {
+    error(s.line, "'" + s.keyword + "' needs an index: " + s.keyword + "(n)");
+    return std::nullopt;
+  }
+  auto v = number(s.index, s.line);
+  if (!v) return std::nullopt;
+  if (*v < 0 || static_cast<std::uint64_t>(*v) > max) {
+    error(s.line, "index " + s.index + " of " + s.keyword + " out of range (0.." + std::to_string(max) + ")");
+    return std::nullopt;
+  }
+  return static_cast<std::uint16_t>(*v);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statements
+
+bool GsdParser::block_start(const Stmt& s) const {
+  static const std::array<std::string_view, 8> kStarts = {
+      "module", "prmtext", "extuserprmdata", "slotdefinition", "unit_diag_area",
+      "x_unit_diag_area", "unitdiagtype", "physical_interface"};
+  return std::find(kStarts.begin(), kStarts.end(), s.key) != kStarts.end();
+}
+
+void GsdParser::unknown(const Stmt& s, std::string_view where) {
+  GsdKeyword k{s.keyword, s.index, s.value, s.line};
+  m_result_file.m_unknown.push_back(k);
+  warning(s.line, "unknown keyword '" + s.keyword + "'" + std::string(where) + " kept");
+}
+
+void GsdParser::remember(const Stmt& s) {
+  m_result_file.m_keywords.push_back({s.keyword, s.index, s.value, s.line});
+}
+
+void GsdParser::statement(const Stmt& s) {
+  switch (m_block) {
+    case Block::Top: top(s); break;
+    case Block::Module: in_module(s); break;
+    case Block::PrmText: in_prm_text(s); break;
+    case Block::ExtPrm: in_ext_prm(s); break;
+    case Block::DiagArea: in_diag_area(s); break;
+    case Block::Slots: in_slots(s); break;
+    case Block::Opaque:
+      if (s.key == m_opaque_end) m_block = m_opaque_return;
+      break;
+  }
+}
+
+bool GsdParser::scalar(const Stmt& s) {
+  const auto& t = table();
+  auto it = t.find(s.key);
+  if (it == t.end()) return false;
+  const ScalarKeyword& k = it->second;
+  switch (k.kind) {
+    case Kind::Bool:
+      if (auto v = boolean(s, k.name)) k.set_uint(m_result_file, *v ? 1 : 0);
+      break;
+    case Kind::Uint:
+      if (auto v = unsigned_value(s, k.name, k.max)) k.set_uint(m_result_file, *v);
+      break;
+    case Kind::String:
+      if (auto v = string_value(s, k.name)) k.string_field(m_result_file) = *v;
+      break;
+  }
+  return true;
+}
+
+bool GsdParser::baud_keyword(const Stmt& s) {
+  const std::string& k = s.key;
+  if (k.size() > 5 && k.compare(k.size() - 5, 5, "_supp") == 0) {
+    auto b = baud_from_gsd(std::string_view(k).substr(0, k.size() - 5));
+    if (!b) return false;
+    if (auto v = boolean(s, s.keyword)) {
+      if (*v)
+        m_supp_line[*b] = s.line;
+      else
+        m_supp_line.erase(*b);
+    }
+    return true;
+  }
+  static const std::array<std::string_view, 5> kPrefixes = {"maxtsdr_", "trdy_", "tqui_", "tset_", "tsdi_"};
+  for (std::string_view prefix : kPrefixes) {
+    if (k.size() <= prefix.size() || k.compare(0, prefix.size(), prefix) != 0) continue;
+    auto b = baud_from_gsd(std::string_view(k).substr(prefix.size()));
+    if (!b) return false;
+    auto v = unsigned_value(s, s.keyword, 0xFFFF);
+    if (!v) return true;
+    const auto val = static_cast<std::uint16_t>(*v);
+    auto& m = m_result_file.m_master;
+    if (prefix == "maxtsdr_") m_max_tsdr[*b] = val;
+    else if (prefix == "trdy_") m.trdy[*b] = val;
+    else if (prefix == "tqui_") m.tqui[*b] = val;
+    else if (prefix == "tset_") m.tset[*b] = val;
+    else m.tsdi[*b] = val;
+    return true;
+  }
+  return false;
+}
+
+void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
+  auto off = index_value(s, 236);
+  if (!off || !need_value(s)) return;
+  auto bytes = byte_list(s.value, s.line, "byte value");
+  if (!bytes) return;
+  if (bytes->empty()) {
+    error(s.line, "Ext_User_Prm_Data_Const(" + s.index + ") has no bytes");
+    return;
+  }
+  area.consts.push_back({*off, std::move(*bytes), s.line});
+}
+
+void GsdParser::prm_ref(const Stmt& s, GsdPrmArea& area) {
+  auto off = index_value(s, 236);
+  if (!off) return;
+  auto ref = unsigned_value(s, "Ext_User_Prm_Data_Ref(" + s.index + ")", 0xFFFF);
+  if (!ref) return;
+  area.refs.push_back({*off, static_cast<std::uint16_t>(*ref), s.line});
+}
+
+void GsdParser::top(const Stmt& s) {
+  remember(s);
+  // Blocks repeat; several Ext_User_Prm_Data_Ref at one offset are the normal way to place
+  // several bit parameters in one byte.
+  static const std::array<std::string_view, 18> kRepeatable = {
+      "ext_user_prm_data_ref", "ext_user_prm_data_const", "module", "endmodule", "prmtext", "endprmtext", "extuserprmdata", "endextuserprmdata",
+      "unit_diag_area", "unit_diag_area_end", "x_unit_diag_area", "x_unit_diag_area_end",
+      "slotdefinition", "endslotdefinition", "unitdiagtype", "endunitdiagtype",
+      "physical_interface", "end_physical_interface"};
+  if (std::find(kRepeatable.begin(), kRepeatable.end(), s.key) == kRepeatable.end()) {
+    const std::string id = s.key + (s.has_index ? "(" + lower(s.index) + ")" : "");
+    auto [it, fresh] = m_seen.emplace(id, s.line);
+    if (!fresh) {
+      warning(s.line, "'" + s.keyword + (s.has_index ? "(" + s.index + ")" : "") +
+                          "' given twice (first at line " + std::to_string(it->second) +
+                          "); the later value wins");
+      it->second = s.line;
+    }
+  }
+  const std::string& k = s.key;
+  auto& f = m_result_file;
+  if (k == "module") {
+    if (!need_value(s)) return;
+    std::string rest;
+    auto name = quoted(s.value, s.line, &rest);
+    if (!name) return;
+    m_module = GsdModule{};
+    m_module.name = *name;
+    m_module.line = s.line;
+    m_block = Block::Module;
+    m_block_line = s.line;
+    m_module_stmts = 0;
+    auto bytes = byte_list(rest, s.line, "config byte");
+    if (!bytes) return;
+    if (bytes->empty()) error(s.line, "Module '" + *name + "': no config bytes");
+    m_module.config = std::move(*bytes);
+  } else if (k == "endmodule") {
+    error(s.line, "EndModule without Module");
+  } else if (k == "prmtext") {
+    auto ref = unsigned_value(s, "PrmText", 0xFFFF);
+    m_prm_text = GsdPrmText{};
+    m_prm_text.ref = static_cast<std::uint16_t>(ref.value_or(0));
+    m_prm_text.line = s.line;
+    m_block = Block::PrmText;
+    m_block_line = s.line;
+  } else if (k == "endprmtext") {
+    error(s.line, "EndPrmText without PrmText");
+  } else if (k == "extuserprmdata") {
+    m_ext = GsdExtUserPrmData{};
+    m_ext.line = s.line;
+    m_ext_has_type = false;
+    m_block = Block::ExtPrm;
+    m_block_line = s.line;
+    if (!need_value(s)) return;
+    const std::string_view v = s.value;
+    const std::size_t q = v.find('"');
+    auto ref = number(v.substr(0, q), s.line);
+    if (!ref) return;
+    if (*ref < 0 || *ref > 0xFFFF) {
+      error(s.line, "ExtUserPrmData reference " + std::to_string(*ref) + " out of range (0..65535)");
+      return;
+    }
+    m_ext.ref = static_cast<std::uint16_t>(*ref);
+    if (q == std::string_view::npos) {
+      error(s.line, "ExtUserPrmData " + std::to_string(*ref) + ": name missing");
+      return;
+    }
+    if (auto name = quoted(v.substr(q), s.line, nullptr)) m_ext.name = *name;
+  } else if (k == "endextuserprmdata") {
+    error(s.line, "EndExtUserPrmData without ExtUserPrmData");
+  } else if (k == "unit_diag_area" || k == "x_unit_diag_area") {
+    m_diag_area = GsdUnitDiagArea{};
+    m_diag_area.x_variant = k[0] == 'x';
+    m_diag_area.line = s.line;
+    m_block = Block::DiagArea;
+    m_block_line = s.line;
+    if (!need_value(s)) return;
+    const std::size_t dash = s.value.find('-');
+    auto a = number(std::string_view(s.value).substr(0, dash), s.line);
+    if (!a) return;
+    auto b = dash == std::string::npos ? a : number(std::string_view(s.value).substr(dash + 1), s.line);
+    if (!b) return;
+    if (*a < 0 || *b < *a || *b > 0xFFFF) {
+      error(s.line, s.keyword + " " + s.value + ": bits out of order or out of range");
+      return;
+    }
+    m_diag_area.first_bit = static_cast<std::uint16_t>(*a);
+    m_diag_area.last_bit = static_cast<std::uint16_t>(*b);
+  } else if (k == "unit_diag_area_end" || k == "x_unit_diag_area_end") {
+    error(s.line, s.keyword + " without Unit_Diag_Area");
+  } else if (k == "slotdefinition") {
+    m_block = Block::Slots;
+    m_block_line = s.line;
+  } else if (k == "endslotdefinition") {
+    error(s.line, "EndSlotDefinition without SlotDefinition");
+  } else if (k == "unitdiagtype" || k == "physical_interface") {
+    m_block = Block::Opaque;
+    m_block_line = s.line;
+    m_opaque_end = k == "unitdiagtype" ? "endunitdiagtype" : "end_physical_interface";
+    m_opaque_return = Block::Top;
+  } else if (k == "endunitdiagtype" || k == "end_physical_interface") {
+    error(s.line, s.keyword + " without its block start");
+  } else if (k == "unit_diag_bit" || k == "channel_diag") {
+    auto idx = index_value(s, 0xFFFF);
+    if (!idx) return;
+    auto text = string_value(s, s.keyword);
+    if (!text) return;
+    (k == "unit_diag_bit" ? f.m_unit_diag_bits : f.m_channel_diag)[*idx] = *text;
+  } else if (k == "ext_user_prm_data_const") {
+    prm_const(s, f.m_global_prm);
+  } else if (k == "ext_user_prm_data_ref") {
+    prm_ref(s, f.m_global_prm);
+  } else if (k == "user_prm_data") {
+    if (!need_value(s)) return;
+    if (auto bytes = byte_list(s.value, s.line, "byte value")) f.m_global_prm.initial = std::move(*bytes);
+  } else if (k == "user_prm_data_len") {
+    if (auto v = unsigned_value(s, "User_Prm_Data_Len", 237))
+      f.m_global_prm.declared_len = static_cast<std::uint16_t>(*v);
+  } else if (k == "max_user_prm_data_len") {
+    if (auto v = unsigned_value(s, "Max_User_Prm_Data_Len", 237))
+      f.m_max_user_prm_data_len = static_cast<std::uint8_t>(*v);
+  } else if (baud_keyword(s) || scalar(s)) {
+    // handled
+  } else if (known_raw(k)) {
+    // kept in keywords() only
+  } else {
+    unknown(s, "");
+  }
+}
+
+void GsdParser::in_module(const Stmt& s) {
+  ++m_module_stmts;
+  const std::string& k = s.key;
+  const std::string where = " in Module '" + m_module.name + "'";
+  if (k == "endmodule") {
+    m_result_file.m_modules.push_back(std::move(m_module));
+    m_module = GsdModule{};
+    m_block = Block::Top;
+    return;
+  }
+  if (!s.has_eq && !s.has_index && s.value.empty() &&
+      std::isdigit(static_cast<unsigned char>(s.keyword[0])) != 0) {
+    // The module reference number line (PI 2.122: directly after the Module line).
+    if (m_module_stmts != 1) {
+      error(s.line, "unexpected number '" + s.keyword + "'" + where);
+      return;
+    }
+    auto v = number(s.keyword, s.line);
+    if (!v) return;
+    if (*v < 0 || *v > 0xFFFFFFFF) {
+      error(s.line, "module reference number " + s.keyword + " out of range");
+      return;
+    }
+    m_module.reference = static_cast<std::uint32_t>(*v);
+    return;
+  }
+  if (block_start(s)) {
+    error(s.line, "'" + s.keyword + "'" + where + " (EndModule missing?)");
+    m_block = Block::Top;  // resynchronise: the statement opens its own block
+    top(s);
+    return;
+  }
+  if (k == "ext_module_prm_data_len") {
+    if (auto v = unsigned_value(s, "Ext_Module_Prm_Data_Len", 237))
+      m_module.prm.declared_len = static_cast<std::uint16_t>(*v);
+  } else if (k == "ext_user_prm_data_const") {
+    prm_const(s, m_module.prm);
+  } else if (k == "ext_user_prm_data_ref") {
+    prm_ref(s, m_module.prm);
+  } else if (k == "info_text") {
+    if (auto v = string_value(s, "Info_Text")) m_module.info_text = *v;
+  } else if (k == "data_area_beg") {
+    m_block = Block::Opaque;
+    m_opaque_end = "data_area_end";
+    m_opaque_return = Block::Module;
+  } else {
+    m_module.other_keywords.push_back({s.keyword, s.index, s.value, s.line});
+    if (!known_module_raw(k)) {
+      warning(s.line, "unknown keyword '" + s.keyword + "'" + where + " kept");
+    }
+  }
+}
+
+void GsdParser::in_prm_text(const Stmt& s) {
+  const std::string where = " in PrmText " + std::to_string(m_prm_text.ref);
+  if (s.key == "endprmtext") {
+    auto [it, fresh] = m_prm_text_lines.emplace(m_prm_text.ref, m_prm_text.line);
+    if (!fresh)
+      error(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref) +
+                                 " defined twice (first at line " + std::to_string(it->second) + ")");
+    else
+      m_result_file.m_prm_texts[m_prm_text.ref] = std::move(m_prm_text);
+    m_block = Block::Top;
+  } else if (s.key == "text") {
+    if (!s.has_index) {
+      error(s.line, "'Text' needs an index: Text(value)");
+      return;
+    }
+    auto v = number(s.index, s.line);
+    if (!v) return;
+    auto t = string_value(s, "Text");
+    if (!t) return;
+    m_prm_text.texts.emplace_back(*v, *t);
+  } else if (block_start(s)) {
+    error(s.line, "'" + s.keyword + "'" + where + " (EndPrmText missing?)");
+    m_block = Block::Top;
+    top(s);
+  } else {
+    warning(s.line, "unknown keyword '" + s.keyword + "'" + where + " ignored");
+  }
+}
+
+void GsdParser::data_type_line(const Stmt& s) {
+  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+  if (m_ext_has_type) {
+    error(s.line, what + ": more than one data type line");
+    return;
+  }
+  const std::string& k = s.key;
+  std::int64_t lo = 0;
+  std::int64_t hi = 0;
+  if (k == "bit" || k == "bitarea") {
+    if (!s.has_index) {
+      error(s.line, what + ": " + s.keyword + " needs a bit position in parentheses");
+      return;
+    }
+    const std::size_t dash = s.index.find('-');
+    if (k == "bit" && dash != std::string::npos) {
+      error(s.line, what + ": Bit(" + s.index + ") takes one bit position");
+      return;
+    }
+    auto a = number(std::string_view(s.index).substr(0, dash), s.line);
+    if (!a) return;
+    std::optional<std::int64_t> b = a;
+    if (k == "bitarea") {
+      if (dash == std::string::npos) {
+        error(s.line, what + ": BitArea(" + s.index + ") needs first-last");
+        return;
+      }
+      b = number(std::string_view(s.index).substr(dash + 1), s.line);
+      if (!b) return;
+    }
+    if (*a < 0 || *b > 7 || *a > *b) {
+      error(s.line, what + ": bit positions " + s.index + " outside 0..7 or out of order");
+      return;
+    }
+    m_ext.type = k == "bit" ? GsdDataType::Bit : GsdDataType::BitArea;
+    m_ext.bit_first = static_cast<std::uint8_t>(*a);
+    m_ext.bit_last = static_cast<std::uint8_t>(*b);
+    hi = (std::int64_t{1} << (*b - *a + 1)) - 1;
+  } else {
+    if (s.has_index) {
+      error(s.line, what + ": " + s.keyword + " takes no index");
+      return;
+    }
+    struct T { std::string_view key; GsdDataType type; std::int64_t lo, hi; };
+    static constexpr T kTypes[] = {
+        {"unsigned8", GsdDataType::Unsigned8, 0, 0xFF},
+        {"unsigned16", GsdDataType::Unsigned16, 0, 0xFFFF},
+        {"unsigned32", GsdDataType::Unsigned32, 0, 0xFFFFFFFF},
+        {"signed8", GsdDataType::Signed8, -128, 127},
+        {"signed16", GsdDataType::Signed16, -32768, 32767},
+        {"signed32", GsdDataType::Signed32, -2147483648LL, 2147483647},
+    };
+    for (const auto& t : kTypes)
+      if (t.key == k) {
+        m_ext.type = t.type;
+        lo = t.lo;
+        hi = t.hi;
+      }
+  }
+  m_ext_has_type = true;
+  const std::string type_range = std::string(gsd_data_type_name(m_ext.type)) + " (" +
+                                 std::to_string(lo) + ".." + std::to_string(hi) + ")";
+  // "<default> <min>-<max>" or "<default> <a>,<b>,...": the allowed part may contain spaces.
+  std::string_view rest = trim(s.value);
+  std::size_t sp = 0;
+  while (sp < rest.size() && !is_space(rest[sp])) ++sp;
+  const std::string_view def_tok = rest.substr(0, sp);
+  if (def_tok.empty()) {
+    error(s.line, what + ": default value missing");
+    return;
+  }
+  auto def = number(def_tok, s.line);
+  if (!def) return;
+  std::string allowed;
+  for (char c : rest.substr(sp))
+    if (!is_space(c)) allowed += c;
+  m_ext.min_value = lo;
+  m_ext.max_value = hi;
+  auto in_type = [&](std::int64_t v) { return v >= lo && v <= hi; };
+  if (allowed.find(',') != std::string::npos) {
+    std::string_view a = allowed;
+    while (true) {
+      const std::size_t comma = a.find(',');
+      auto v = number(a.substr(0, comma), s.line);
+      if (!v) return;
+      if (!in_type(*v)) {
+        error(s.line, what + ": allowed value " + std::to_string(*v) + " outside " + type_range);
+        return;
+      }
+      m_ext.allowed.push_back(*v);
+      if (comma == std::string_view::npos) break;
+      a.remove_prefix(comma + 1);
+    }
+    m_ext.min_value = *std::min_element(m_ext.allowed.begin(), m_ext.allowed.end());
+    m_ext.max_value = *std::max_element(m_ext.allowed.begin(), m_ext.allowed.end());
+  } else if (!allowed.empty()) {
+    // A range min-max; either bound may carry a minus sign ("-100--50").
+    const std::size_t dash = allowed.find('-', allowed[0] == '-' ? 1 : 0);
+    auto a = number(std::string_view(allowed).substr(0, dash), s.line);
+    if (!a) return;
+    std::optional<std::int64_t> b = a;
+    if (dash != std::string::npos) {
+      b = number(std::string_view(allowed).substr(dash + 1), s.line);
+      if (!b) return;
+    }
+    if (*a > *b || !in_type(*a) || !in_type(*b)) {
+      error(s.line, what + ": range " + allowed + " out of order or outside " + type_range);
+      return;
+    }
+    m_ext.min_value = *a;
+    m_ext.max_value = *b;
+    if (dash == std::string::npos) m_ext.allowed.push_back(*a);
+  }
+  m_ext.default_value = *def;
+  if (!m_ext.accepts(*def)) {
+    error(s.line, what + ": default " + std::to_string(*def) + " not allowed by '" +
+                      (allowed.empty() ? type_range : allowed) + "'");
+  }
+}
+
+void GsdParser::in_ext_prm(const Stmt& s) {
+  const std::string& k = s.key;
+  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+  if (k == "endextuserprmdata") {
+    m_block = Block::Top;
+    if (!m_ext_has_type) {
+      error(m_ext.line, what + ": data type line missing");
+      return;
+    }
+    auto [it, fresh] = m_result_file.m_ext_prm.emplace(m_ext.ref, m_ext);
+    if (!fresh)
+      error(m_ext.line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " defined twice (first at line " +
+                            std::to_string(it->second.line) + ")");
+  } else if (k == "bit" || k == "bitarea" || k == "unsigned8" || k == "unsigned16" ||
+             k == "unsigned32" || k == "signed8" || k == "signed16" || k == "signed32") {
+    data_type_line(s);
+  } else if (k == "prm_text_ref") {
+    if (auto v = unsigned_value(s, "Prm_Text_Ref", 0xFFFF)) m_ext.prm_text_ref = static_cast<std::uint16_t>(*v);
+  } else if (k == "changeable") {
+    if (auto v = boolean(s, "Changeable")) m_ext.changeable = *v;
+  } else if (k == "visible") {
+    if (auto v = boolean(s, "Visible")) m_ext.visible = *v;
+  } else if (block_start(s)) {
+    error(s.line, "'" + s.keyword + "' in " + what + " (EndExtUserPrmData missing?)");
+    m_block = Block::Top;
+    top(s);
+  } else {
+    warning(s.line, "unknown keyword '" + s.keyword + "' in " + what + " ignored");
+  }
+}
+
+void GsdParser::in_diag_area(const Stmt& s) {
+  if (s.key == "unit_diag_area_end" || s.key == "x_unit_diag_area_end") {
+    m_result_file.m_unit_diag_areas.push_back(std::move(m_diag_area));
+    m_block = Block::Top;
+  } else if (s.key == "value") {
+    if (!s.has_index) {
+      error(s.line, "'Value' needs an index: Value(n)");
+      return;
+    }
+    auto v = number(s.index, s.line);
+    if (!v) return;
+    auto t = string_value(s, "Value");
+    if (!t) return;
+    m_diag_area.values.emplace_back(*v, *t);
+  } else if (block_start(s)) {
+    error(s.line, "'" + s.keyword + "' in Unit_Diag_Area (Unit_Diag_Area_End missing?)");
+    m_block = Block::Top;
+    top(s);
+  } else {
+    warning(s.line, "unknown keyword '" + s.keyword + "' in Unit_Diag_Area ignored");
+  }
+}
+
+void GsdParser::in_slots(const Stmt& s) {
+  if (s.key == "endslotdefinition") {
+    m_block = Block::Top;
+    return;
+  }
+  if (s.key != "slot") {
+    if (block_start(s)) {
+      error(s.line, "'" + s.keyword + "' in SlotDefinition (EndSlotDefinition missing?)");
+      m_block = Block::Top;
+      top(s);
+    } else {
+      warning(s.line, "unknown keyword '" + s.keyword + "' in SlotDefinition ignored");
+    }
+    return;
+  }
+  GsdSlot slot;
+  slot.line = s.line;
+  auto n = index_value(s, 255);
+  if (!n || !need_value(s)) return;
+  slot.number = *n;
+  std::string rest;
+  auto name = quoted(s.value, s.line, &rest);
+  if (!name) return;
+  slot.name = *name;
+  std::string_view r = trim(rest);
+  std::size_t sp = 0;
+  while (sp < r.size() && !is_space(r[sp])) ++sp;
+  auto def = number(r.substr(0, sp), s.line);
+  if (!def) return;
+  if (*def < 0 || *def > 0xFFFFFFFF) {
+    error(s.line, "Slot(" + s.index + "): default module reference out of range");
+    return;
+  }
+  slot.default_ref = static_cast<std::uint32_t>(*def);
+  std::string allowed;
+  for (char c : r.substr(sp))
+    if (!is_space(c)) allowed += c;
+  if (allowed.empty()) {
+    slot.allowed.emplace_back(slot.default_ref, slot.default_ref);
+  } else {
+    std::string_view a = allowed;
+    while (true) {
+      const std::size_t comma = a.find(',');
+      const std::string_view item = a.substr(0, comma);
+      const std::size_t dash = item.find('-');
+      auto lo = number(item.substr(0, dash), s.line);
+      if (!lo) return;
+      auto hi = dash == std::string_view::npos ? lo : number(item.substr(dash + 1), s.line);
+      if (!hi) return;
+      if (*lo < 0 || *hi < *lo || *hi > 0xFFFFFFFF) {
+        error(s.line, "Slot(" + s.index + "): module references '" + std::string(item) + "' out of order");
+        return;
+      }
+      slot.allowed.emplace_back(static_cast<std::uint32_t>(*lo), static_cast<std::uint32_t>(*hi));
+      if (comma == std::string_view::npos) break;
+      a.remove_prefix(comma + 1);
+    }
+  }
+  m_result_file.m_slots.push_back(std::move(slot));
+}
+
+void GsdParser::close_block_at_end() {
+  switch (m_block) {
+    case Block::Top: return;
+    case Block::Module: error(m_block_line, "Module '" + m_module.name + "' without EndModule"); break;
+    case Block::PrmText:
+      error(m_block_line, "PrmText " + std::to_string(m_prm_text.ref) + " without EndPrmText");
+      break;
+    case Block::ExtPrm:
+      error(m_block_line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " without EndExtUserPrmData");
+      break;
+    case Block::DiagArea: error(m_block_line, "Unit_Diag_Area without Unit_Diag_Area_End"); break;
+    case Block::Slots: error(m_block_line, "SlotDefinition without EndSlotDefinition"); break;
+    case Block::Opaque:
+      error(m_block_line, "block without its end keyword '" + m_opaque_end + "'");
+      break;
+  }
+  m_block = Block::Top;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Whole-file checks
+
+void GsdParser::finish() {
+  auto& f = m_result_file;
+  auto seen = [&](std::string_view key) -> std::optional<std::uint32_t> {
+    auto it = m_seen.find(std::string(key));
+    if (it == m_seen.end()) return std::nullopt;
+    return it->second;
+  };
+
+  if (!seen("ident_number")) error(m_section_line, "Ident_Number missing");
+  if (!seen("station_type")) warning(m_section_line, "Station_Type missing; DP slave (0) assumed");
+
+  for (const auto& [baud, line] : m_supp_line) {
+    const auto it = m_max_tsdr.find(baud);
+    const std::string rate = gsd_baud_spelling(baud);
+    if (it == m_max_tsdr.end()) {
+      error(line, "MaxTsdr_" + rate + " missing although " + rate + "_supp = 1");
+      continue;
+    }
+    f.m_baud_rates.push_back({baud, it->second});
+  }
+  if (m_supp_line.empty()) error(m_section_line, "no baud rate supported (no *_supp = 1)");
+
+  const bool slave = !f.is_master();
+  if (slave) {
+    if (f.m_modules.empty()) error(m_section_line, "no Module defined");
+    if (!seen("min_slave_intervall")) warning(m_section_line, "Min_Slave_Intervall missing");
+    if (auto l = seen("max_diag_data_len")) {
+      if (f.m_slave.max_diag_data_len < 6)
+        error(*l, "Max_Diag_Data_Len " + std::to_string(f.m_slave.max_diag_data_len) + " below 6");
+    } else {
+      warning(m_section_line, "Max_Diag_Data_Len missing; 6 assumed");
+    }
+  }
+  if (f.m_slave.modular_station && !seen("max_module"))
+    error(*seen("modular_station"), "Max_Module missing although Modular_Station = 1");
+  if (!f.m_slave.modular_station && !seen("max_module")) f.m_slave.max_module = 1;
+  if (!seen("max_data_len"))
+    f.m_slave.max_data_len = static_cast<std::uint16_t>(f.m_slave.max_input_len + f.m_slave.max_output_len);
+
+  if (auto l = seen("c2_max_data_len"); l && f.m_dpv1.c2_max_data_len > 0 && f.m_dpv1.c2_max_data_len < 48)
+    error(*l, "C2_Max_Data_Len " + std::to_string(f.m_dpv1.c2_max_data_len) + " not allowed (0 or 48..240)");
+  if (auto l = seen("max_initiate_pdu_length");
+      l && f.m_dpv1.max_initiate_pdu_length > 0 && f.m_dpv1.max_initiate_pdu_length < 52)
+    error(*l, "Max_Initiate_PDU_Length " + std::to_string(f.m_dpv1.max_initiate_pdu_length) +
+                  " not allowed (0 or 52..244)");
+
+  // References between blocks.
+  auto check_refs = [&](const GsdPrmArea& area) {
+    for (const auto& r : area.refs)
+      if (!f.m_ext_prm.count(r.ref))
+        error(r.line, "Ext_User_Prm_Data_Ref(" + std::to_string(r.offset) +
+                          ") refers to undefined ExtUserPrmData " + std::to_string(r.ref));
+  };
+  check_refs(f.m_global_prm);
+  for (const auto& m : f.m_modules) check_refs(m.prm);
+  for (const auto& [ref, e] : f.m_ext_prm)
+    if (e.prm_text_ref && !f.m_prm_texts.count(*e.prm_text_ref))
+      error(e.line, "ExtUserPrmData " + std::to_string(ref) + " '" + e.name +
+                        "': Prm_Text_Ref refers to undefined PrmText " + std::to_string(*e.prm_text_ref));
+
+  // Modules: identifiers well formed; lengths derived from them.
+  std::map<std::uint32_t, std::uint32_t> refs_seen;
+  for (auto& m : f.m_modules) {
+    std::string why;
+    if (!m.config.empty()) {
+      if (auto len = gsd_cfg_lengths(m.config, &why)) {
+        m.input_len = len->input_len;
+        m.output_len = len->output_len;
+        m.consistent = len->consistent;
+      } else {
+        error(m.line, "Module '" + m.name + "': " + why);
+      }
+    }
+    if (m.reference) {
+      auto [it, fresh] = refs_seen.emplace(*m.reference, m.line);
+      if (!fresh)
+        warning(m.line, "Module '" + m.name + "': reference number " + std::to_string(*m.reference) +
+                            " already used at line " + std::to_string(it->second));
+    }
+    const std::size_t len = m.prm.length(f.m_ext_prm);
+    if (m.prm.declared_len && len > *m.prm.declared_len)
+      warning(m.line, "Module '" + m.name + "': parameters reach byte " + std::to_string(len) +
+                          ", beyond Ext_Module_Prm_Data_Len " + std::to_string(*m.prm.declared_len) +
+                          "; area extended");
+  }
+
+  // Global parameter area.
+  const auto& g = f.m_global_prm;
+  if (g.declared_len) {
+    const std::uint32_t l = seen("user_prm_data_len").value_or(m_section_line);
+    if (g.initial.size() > *g.declared_len)
+      warning(l, "User_Prm_Data has " + std::to_string(g.initial.size()) +
+                     " bytes, more than User_Prm_Data_Len " + std::to_string(*g.declared_len) +
+                     "; truncated");
+    std::size_t ext = 0;
+    for (const auto& c : g.consts) ext = std::max(ext, c.offset + c.data.size());
+    for (const auto& r : g.refs) {
+      auto it = f.m_ext_prm.find(r.ref);
+      ext = std::max(ext, r.offset + (it != f.m_ext_prm.end() ? it->second.size() : 1));
+    }
+    if (ext > *g.declared_len)
+      warning(l, "Ext_User_Prm_Data_Const/Ref reach byte " + std::to_string(ext) +
+                     ", beyond User_Prm_Data_Len " + std::to_string(*g.declared_len) + "; area extended");
+  }
+  if (f.m_dpv1.dpv1_slave && g.length(f.m_ext_prm) < 3)
+    warning(seen("dpv1_slave").value_or(m_section_line),
+            "DPV1_Slave = 1 but User_Prm_Data has fewer than 3 bytes (DPV1_Status_1..3); "
+            "missing status bytes assembled as 80 00 00");
+
+  for (const auto& slot : f.m_slots)
+    if (!f.find_module_by_reference(slot.default_ref))
+      warning(slot.line, "Slot(" + std::to_string(slot.number) + "): default module reference " +
+                             std::to_string(slot.default_ref) + " matches no Module");
+}
+
+GsdParseResult GsdParser::run() {
+  const std::string text = decode();
+  split_logical(text);
+  for (const auto& [line_text, line] : m_logical) {
+    if (too_many_errors()) break;
+    if (auto s = parse_stmt(line_text, line)) statement(*s);
+  }
+  if (m_section_line != 0 && !too_many_errors()) close_block_at_end();
+  if (m_errors.empty()) finish();
+
+  GsdParseResult r;
+  r.errors = std::move(m_errors);
+  r.warnings = std::move(m_warnings);
+  if (r.errors.empty()) r.file = std::move(m_result_file);
+  return r;
+}
+
+GsdParseResult parse_gsd(std::string_view bytes, std::string_view file_name) {
+  try {
+    return GsdParser(bytes, file_name).run();
+  } catch (const std::exception& e) {
+    // Only allocation failure can get here; report it instead of letting it escape.
+    GsdParseResult r;
+    r.errors.push_back({std::string(file_name), 0, std::string("internal error: ") + e.what()});
+    return r;
+  }
+}
+
+GsdParseResult load_gsd(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream buf;
+  if (in) buf << in.rdbuf();
+  if (!in) {
+    GsdParseResult r;
+    r.errors.push_back({path.string(), 0, "cannot read the file"});
+    return r;
+  }
+  return parse_gsd(buf.str(), path.string());
+}
+
+}  // namespace pbvbus::devices

@@ -1,0 +1,149 @@
+// `pbvbus gsd`: called through the tools library (no process), asserting output lines and exit
+// codes; the --json output is checked to be valid JSON with python3 -m json.tool.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "pbvbus/tools/commands.hpp"
+
+using pbvbus::tools::cmd_gsd;
+
+namespace {
+
+struct GsdRun {
+  int rc;
+  std::string out;
+  std::string err;
+};
+
+GsdRun run(const pbvbus::tools::Args& args) {
+  std::ostringstream out;
+  std::ostringstream err;
+  const int rc = cmd_gsd(args, out, err);
+  return {rc, out.str(), err.str()};
+}
+
+std::string src(const std::string& rel) { return std::string(PBVBUS_SOURCE_DIR) + "/" + rel; }
+
+bool has_line(const std::string& text, const std::string& line) {
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (l == line) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST(CmdGsd, Help) {
+  GsdRun r = run({"--help"});
+  EXPECT_EQ(r.rc, 0);
+  EXPECT_TRUE(has_line(r.out, "usage: pbvbus gsd FILE [--json]"));
+  EXPECT_TRUE(r.err.empty());
+}
+
+TEST(CmdGsd, BadUsage) {
+  EXPECT_EQ(run({}).rc, 2);
+  GsdRun r = run({"--frobnicate", "x.gsd"});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_TRUE(has_line(r.err, "pbvbus gsd: unknown option '--frobnicate'"));
+  EXPECT_EQ(run({"a.gsd", "b.gsd"}).rc, 2);
+}
+
+TEST(CmdGsd, CompactStationText) {
+  const std::string f = src("examples/gsd/PBVB0A01.gsd");
+  GsdRun r = run({f});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(has_line(r.out, "Ident_Number:       0x0A01"));
+  EXPECT_TRUE(has_line(r.out, "Station_Type:       0 (DP slave)"));
+  EXPECT_TRUE(has_line(r.out, "Vendor_Name:        pbvbus"));
+  EXPECT_TRUE(has_line(r.out, "Model_Name:         pbvbus CS16 16DI/16DO"));
+  EXPECT_TRUE(has_line(r.out, "  9.6k    MaxTsdr 60"));
+  EXPECT_TRUE(has_line(r.out, "  45.45k  MaxTsdr 250"));
+  EXPECT_TRUE(has_line(r.out, "  12M     MaxTsdr 800"));
+  EXPECT_TRUE(has_line(r.out, "  [0] \"16DI/16DO DC24V\" ref 1: cfg 0x11,0x21, in 2, out 2"));
+  EXPECT_TRUE(has_line(r.out, "  station defaults: 12"));
+  EXPECT_TRUE(has_line(r.out, "  ExtUserPrmData 2 \"Input delay\": BitArea(4-5), default 1, allowed 0-3"));
+  EXPECT_TRUE(has_line(r.out, "      2 = 15 ms"));
+  EXPECT_TRUE(has_line(r.out, "DP-V1:              no"));
+}
+
+TEST(CmdGsd, ModularAndDpv1Text) {
+  GsdRun r = run({src("examples/gsd/PBVB0A02.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(has_line(r.out, "  [4] \"4AI U/I 16 bit\" ref 5: cfg 0xD3, in 8, out 0, consistent, prm 02 02 02 02 00 64"));
+  EXPECT_TRUE(has_line(r.out, "  ExtUserPrmData 30 \"Output range\": Unsigned8, default 2, allowed 1,2,3,4"));
+  r = run({src("examples/gsd/PBVB0A03.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(has_line(r.out, "DP-V1:              yes"));
+  EXPECT_TRUE(has_line(r.out, "  C1_Read_Write_supp 1, C1_Max_Data_Len 240, C1_Response_Timeout 100"));
+  EXPECT_TRUE(has_line(r.out, "  station defaults: 80 E0 00 01"));
+  EXPECT_TRUE(has_line(r.out, "  alarms: Diagnostic 1, Process 1, Pull_Plug 1, Status 0, Update 0, "
+                              "Manufacturer_Specific 0; Alarm_Sequence_Mode_Count 8"));
+}
+
+TEST(CmdGsd, VendorFileWarningsGoToStderr) {
+  const std::string f = src("tests/data/gsd/VNDR4711.gsd");
+  GsdRun r = run({f});
+  ASSERT_EQ(r.rc, 0);
+  EXPECT_TRUE(has_line(r.err, f + ":51: warning: unknown keyword 'Vendor_Specific_Feature' kept"));
+  EXPECT_TRUE(has_line(r.out, "Vendor_Name:        M\xC3\xBCller & S\xC3\xB6hne"));
+  EXPECT_TRUE(has_line(r.out, "  31.25k  MaxTsdr 100"));
+  EXPECT_TRUE(has_line(r.out, "Redundancy:         Redundancy 1, PrmCmd_supp 1, Slave_Redundancy_supp 8, "
+                              "Slave_Max_Switch_Over_Time 100"));
+}
+
+TEST(CmdGsd, BrokenFileExits2WithFileLineReason) {
+  const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_broken.gsd";
+  {
+    std::ofstream o(path, std::ios::binary);
+    o << "#Profibus_DP\nIdent_Number = 0x1234\nModule = \"x\" 0x10,0x1FF\nEndModule\n";
+  }
+  GsdRun r = run({path});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_TRUE(has_line(r.err, path + ":3: config byte 0x1FF out of range")) << r.err;
+  std::remove(path.c_str());
+
+  r = run({src("tests/data/gsd/no-such-file.gsd")});
+  EXPECT_EQ(r.rc, 2);
+  EXPECT_TRUE(has_line(r.err, src("tests/data/gsd/no-such-file.gsd") + ": cannot read the file"));
+}
+
+TEST(CmdGsd, JsonIsValid) {
+  for (const char* rel : {"examples/gsd/PBVB0A01.gsd", "examples/gsd/PBVB0A02.gsd", "examples/gsd/PBVB0A03.gsd",
+                          "tests/data/gsd/VNDR4711.gsd"}) {
+    GsdRun r = run({src(rel), "--json"});
+    ASSERT_EQ(r.rc, 0) << rel;
+    const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_test.json";
+    {
+      std::ofstream o(path, std::ios::binary);
+      o << r.out;
+    }
+    // json.tool rejects anything that is not one valid JSON document.
+    const std::string cmd =
+        "python3 -c \"import json,sys; d=json.load(open(sys.argv[1])); "
+        "print(d['ident_number'], len(d['modules']), d['modules'][0]['config'][0], d['baud_rates'][-1]['max_tsdr'])\" " +
+        path;
+    FILE* p = popen(cmd.c_str(), "r");
+    ASSERT_NE(p, nullptr);
+    char buf[256] = {};
+    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+    const int status = pclose(p);
+    ASSERT_EQ(status, 0) << rel << "\n" << r.out;
+    const std::string line(buf, n);
+    const std::string name(rel);
+    if (name == "examples/gsd/PBVB0A01.gsd") {
+      EXPECT_EQ(line, "2561 1 17 800\n");
+    } else if (name == "examples/gsd/PBVB0A02.gsd") {
+      EXPECT_EQ(line, "2562 6 16 800\n");
+    } else if (name == "tests/data/gsd/VNDR4711.gsd") {
+      EXPECT_EQ(line, "18193 4 32 800\n");
+    }
+    std::remove(path.c_str());
+  }
+}

@@ -103,11 +103,20 @@ std::uint8_t ActiveStation::next_addr(std::uint8_t a) const {
 }
 
 std::uint8_t ActiveStation::compute_ns() const {
+  // Called at every step: cache the walk for the current LAS (comparing 128 bits is cheap).
+  if (m_ns_cache_valid && m_ns_cache_las == m_las) return m_ns_cache;
+  std::uint8_t ns = m_ts;
   for (int i = 1; i < 128; ++i) {
     const auto a = static_cast<std::size_t>((m_ts + i) % 128);
-    if (a != 127 && m_las.test(a)) return static_cast<std::uint8_t>(a);
+    if (a != 127 && m_las.test(a)) {
+      ns = static_cast<std::uint8_t>(a);
+      break;
+    }
   }
-  return m_ts;
+  m_ns_cache_las = m_las;
+  m_ns_cache = ns;
+  m_ns_cache_valid = true;
+  return ns;
 }
 
 std::uint8_t ActiveStation::compute_ps() const {

@@ -217,6 +217,9 @@ class ActiveStation final : public bus::Device {
   bool m_las_valid = false;
   bool m_in_ring = false;
   std::uint8_t m_ns = 0;
+  mutable std::bitset<128> m_ns_cache_las;
+  mutable std::uint8_t m_ns_cache = 0;
+  mutable bool m_ns_cache_valid = false;
   std::uint8_t m_token_candidate = kNobody;
   int m_pass_failures = 0;
   // Listen_Token discovery: two complete identical rotations.

@@ -309,3 +309,110 @@ TEST_F(ThreeMasters, CutLineSplitsIntoTwoRingsAndMergesAfterRepair) {
 
 }  // namespace
 }  // namespace pbvbus::fdl
+
+namespace pbvbus::fdl {
+namespace {
+
+// Noise and random power cycles of masters and slaves; once the faults stop, the ring 1-2-3
+// must form again and the slaves must be polled without errors. Several seeds.
+class RingRecovery : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(RingRecovery, RingFormsAgainAfterNoiseAndPowerCycles) {
+  const std::uint64_t seed = GetParam();
+  bus::Scheduler sched;
+  bus::Line line{sched, "dp", kBaud, seed};
+  FrameRecorder rec;
+  line.add_tap(rec);
+  const BusParams p = ring_params(12, 3, 5000);
+  QueueMasterUser u[3];
+  for (auto& x : u) {
+    x.high_per_visit = 1;
+    x.high.da = 10;
+    x.high.data = {1, 2, 3};
+    x.low_per_visit = 2;
+    x.low.da = 11;
+    x.low.fn = RequestFn::SrdLow;
+    x.low.data = {4};
+  }
+  ActiveStation m1(1, p, u[0]), m2(2, p, u[1]), m3(3, p, u[2]);
+  DataSlaveUser s10({1}), s11({2, 3});
+  PassiveStation p10(10, p, s10), p11(11, p, s11);
+  line.attach(m1);
+  line.attach(p10);
+  line.attach(m2);
+  line.attach(p11);
+  line.attach(m3);
+  line.start();
+  sched.run_until(100 * bus::kTicksPerMs);
+  line.set_noise(200'000);  // 2e-4 bit errors per bit
+  std::uint64_t r = seed * 7919;
+  for (int k = 0; k < 40; ++k) {
+    r = r * 6364136223846793005ULL + 1442695040888963407ULL;
+    const int att = static_cast<int>((r >> 33) % 5);
+    line.set_power(att, !line.powered(att));
+    sched.run_until(sched.now() + static_cast<bus::Ticks>((r >> 40) % 20 + 1) * bus::kTicksPerMs);
+  }
+  line.set_noise(0);
+  for (int i = 0; i < 5; ++i) line.set_power(i, true);
+  sched.run_until(sched.now() + 300 * bus::kTicksPerMs);
+  EXPECT_TRUE(ring_is(rec, {"DC 02 01", "DC 03 02", "DC 01 03"}, 30));
+  for (const ActiveStation* m : {&m1, &m2, &m3}) {
+    EXPECT_EQ(m->las(), (std::vector<std::uint8_t>{1, 2, 3}));
+    EXPECT_TRUE(m->in_ring());
+  }
+  for (auto& x : u) {
+    ASSERT_GT(x.confirmations.size(), 10u);
+    for (std::size_t i = x.confirmations.size() - 10; i < x.confirmations.size(); ++i)
+      EXPECT_EQ(x.confirmations[i].result, Confirmation::Result::Ok);
+  }
+  EXPECT_EQ(m1.live(10), StationType::Slave);
+  EXPECT_EQ(m1.live(11), StationType::Slave);
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, RingRecovery, ::testing::Values(1, 2, 3, 4, 5, 6, 7, 8));
+
+}  // namespace
+}  // namespace pbvbus::fdl
+
+namespace pbvbus::fdl {
+namespace {
+
+// protocol-facts.md §H.2 (MPI trace, S4): a lone PLC at address 2 passes the token to itself
+// (DC 02 02) and polls one free address per visit (10 05 02 49 50 16); a PG at address 0 that
+// answers "ready" gets the token (DC 00 02) and passes it back (DC 02 00).
+TEST(TokenRingMpi, LonePlcPollsAndAdmitsPg) {
+  constexpr bus::Baud kMpi = bus::Baud::k187_5;
+  bus::Scheduler sched;
+  bus::Line line{sched, "mpi", kMpi};
+  FrameRecorder rec;
+  line.add_tap(rec);
+  BusParams p = BusParams::defaults(kMpi);
+  p.hsa = 15;
+  p.gap_factor = 1;
+  p.ttr = 20'000;
+  QueueMasterUser plc_user, pg_user;
+  ActiveStation plc(2, p, plc_user);
+  ActiveStation pg(0, p, pg_user);
+  line.attach(plc, "PLC");
+  const int pg_att = line.attach(pg, "PG");
+  line.set_power(0, true);
+  sched.run_until(200 * bus::kTicksPerMs);
+  EXPECT_LT(find_frame(rec, "10 05 02 49 50 16"), rec.size());
+  EXPECT_TRUE(ring_is(rec, {"DC 02 02"}, 5));
+  // The PG joins; its TTO (6*TSL = 600 bits) would be the shortest, but the bus is busy.
+  const std::size_t before = rec.size();
+  line.set_power(pg_att, true);
+  sched.run_until(sched.now() + 400 * bus::kTicksPerMs);
+  EXPECT_EQ(pg.stats().token_losses, 0u);
+  // Poll of address 0: 00+02+49 = 4B; PG ready: 02+00+20 = 22.
+  const std::size_t ready = find_frame(rec, "10 02 00 20 22 16", before);
+  ASSERT_LT(ready, rec.size());
+  EXPECT_EQ(rec.hex(ready - 1), "10 00 02 49 4B 16");
+  EXPECT_EQ(rec.hex(ready + 1), "DC 00 02");
+  EXPECT_TRUE(ring_is(rec, {"DC 00 02", "DC 02 00"}, 20));
+  EXPECT_EQ(plc.las(), (std::vector<std::uint8_t>{0, 2}));
+  EXPECT_EQ(pg.las(), (std::vector<std::uint8_t>{0, 2}));
+}
+
+}  // namespace
+}  // namespace pbvbus::fdl

@@ -1,0 +1,255 @@
+#include "pbvbus/bus/pty_station.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <cerrno>
+#include <cstdlib>
+#include <stdexcept>
+#include <system_error>
+
+#include "pbvbus/bus/paced_runner.hpp"
+
+namespace pbvbus::bus {
+
+namespace {
+
+/// TSYN: idle before a request or token (protocol-facts.md §A).
+constexpr std::int64_t kTsynBits = 33;
+
+[[noreturn]] void throw_errno(const char* what) {
+  throw std::system_error(errno, std::generic_category(), what);
+}
+
+/// Destination address of a telegram as a station's filter would see it, or -1.
+int telegram_da(std::span<const std::uint8_t> b) {
+  if (b.empty()) return -1;
+  switch (b[0]) {
+    case 0x10:
+    case 0xA2:
+    case 0xDC: return b.size() > 1 ? b[1] & 0x7F : -1;
+    case 0x68: return b.size() > 4 ? b[4] & 0x7F : -1;
+    default: return -1;
+  }
+}
+
+}  // namespace
+
+std::int64_t default_slot_time_bits(Baud baud) {
+  switch (baud) {
+    case Baud::k500: return 200;
+    case Baud::k1_5M: return 300;
+    case Baud::k3M: return 400;
+    case Baud::k6M: return 600;
+    case Baud::k12M: return 1000;
+    default: return 100;  // 9.6k .. 187.5k, 45.45k [U in §C.1], 31.25k
+  }
+}
+
+struct PtyStation::Io {
+  Io(PacedRunner& r, int fd) : runner(r), sd(r.io_context(), fd) {}
+  ~Io() {
+    boost::system::error_code ec;
+    sd.cancel(ec);
+    sd.close(ec);  // closes our dup of the master side only
+  }
+  PacedRunner& runner;
+  boost::asio::posix::stream_descriptor sd;
+  std::shared_ptr<bool> alive = std::make_shared<bool>(true);
+  bool write_armed = false;
+};
+
+PtyStation::PtyStation(Options options) : m_opt(options) {
+  if (m_opt.mode == Mode::Station && (m_opt.address < 0 || m_opt.address > 126))
+    throw std::invalid_argument("pty station: an FDL address 0..126 is needed in station mode");
+  m_master = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
+  if (m_master < 0) throw_errno("posix_openpt");
+  try {
+    if (::grantpt(m_master) != 0) throw_errno("grantpt");
+    if (::unlockpt(m_master) != 0) throw_errno("unlockpt");
+    char name[128];
+    if (::ptsname_r(m_master, name, sizeof name) != 0) throw_errno("ptsname_r");
+    m_path = name;
+    m_slave = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
+    if (m_slave < 0) throw_errno("open pty slave");
+    termios tio{};
+    if (::tcgetattr(m_slave, &tio) != 0) throw_errno("tcgetattr");
+    ::cfmakeraw(&tio);  // 8 bits, no echo, no line editing, no CR/LF mapping
+    tio.c_cc[VMIN] = 1;
+    tio.c_cc[VTIME] = 0;
+    if (::tcsetattr(m_slave, TCSANOW, &tio) != 0) throw_errno("tcsetattr");
+    const int fl = ::fcntl(m_master, F_GETFL);
+    if (fl < 0 || ::fcntl(m_master, F_SETFL, fl | O_NONBLOCK) != 0) throw_errno("fcntl O_NONBLOCK");
+  } catch (...) {
+    if (m_slave >= 0) ::close(m_slave);
+    ::close(m_master);
+    throw;
+  }
+  m_out.reserve(4096);
+}
+
+PtyStation::~PtyStation() {
+  m_io.reset();
+  if (m_slave >= 0) ::close(m_slave);
+  if (m_master >= 0) ::close(m_master);
+}
+
+PtyStation::Stats PtyStation::stats() const {
+  Stats s = m_stats;
+  s.garbage_bytes += m_splitter.garbage();
+  return s;
+}
+
+void PtyStation::on_power_on(Ticks now) {
+  m_powered = true;
+  m_tx_free_at = now;
+  m_reply_after = m_reply_until = -1;
+}
+
+void PtyStation::on_power_off(Ticks) {
+  m_powered = false;
+  m_reply_after = m_reply_until = -1;
+}
+
+void PtyStation::on_timer(Ticks) {}
+
+void PtyStation::on_frame(const RxFrame& f) {
+  bool out = m_opt.mode == Mode::Monitor;
+  if (!out) {
+    const int da = telegram_da(f.bytes);
+    out = da == m_opt.address || da == 127;
+    if (m_reply_until >= 0 && f.start >= m_reply_after) {
+      // The first frame after our telegram: the reply if it started in time, else none came.
+      if (f.start <= m_reply_until) out = true;
+      m_reply_after = m_reply_until = -1;
+    }
+  }
+  if (out) emit(f.bytes);
+}
+
+void PtyStation::emit(std::span<const std::uint8_t> frame) {
+  if (m_out.size() + frame.size() > m_opt.max_backlog) {
+    flush_output();
+    if (m_out.size() + frame.size() > m_opt.max_backlog) {
+      ++m_stats.frames_dropped;
+      return;
+    }
+  }
+  ++m_stats.frames_out;
+  m_stats.bytes_out += frame.size();
+  m_out.insert(m_out.end(), frame.begin(), frame.end());
+  flush_output();
+}
+
+void PtyStation::flush_output() {
+  std::size_t done = 0;
+  while (done < m_out.size()) {
+    const ssize_t n = ::write(m_master, m_out.data() + done, m_out.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    break;  // EAGAIN: the program is not reading; anything else: try again later
+  }
+  m_out.erase(m_out.begin(), m_out.begin() + static_cast<std::ptrdiff_t>(done));
+  if (!m_out.empty() && m_io && !m_io->write_armed) {
+    m_io->write_armed = true;
+    std::weak_ptr<bool> alive = m_io->alive;
+    m_io->sd.async_wait(boost::asio::posix::stream_descriptor::wait_write,
+                        [this, alive](const boost::system::error_code& ec) {
+                          if (ec || alive.expired()) return;
+                          m_io->write_armed = false;
+                          flush_output();
+                        });
+  }
+}
+
+std::size_t PtyStation::read_available(std::vector<std::uint8_t>& into) {
+  std::size_t total = 0;
+  std::uint8_t buf[4096];
+  for (;;) {
+    const ssize_t n = ::read(m_master, buf, sizeof buf);
+    if (n > 0) {
+      into.insert(into.end(), buf, buf + n);
+      total += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    break;  // EAGAIN (nothing more), 0 or EIO (cannot happen while we hold the slave open)
+  }
+  return total;
+}
+
+std::size_t PtyStation::poll_input(std::chrono::milliseconds wait) {
+  pollfd p{m_master, POLLIN, 0};
+  const int r = ::poll(&p, 1, static_cast<int>(wait.count()));
+  if (r <= 0) return 0;
+  std::vector<std::uint8_t> bytes;
+  const std::size_t n = read_available(bytes);
+  if (n > 0) feed(bytes);
+  flush_output();
+  return n;
+}
+
+void PtyStation::attach_io(PacedRunner& runner) {
+  if (m_io) throw std::logic_error("pty station: attach_io() called twice");
+  const int fd = ::fcntl(m_master, F_DUPFD_CLOEXEC, 0);
+  if (fd < 0) throw_errno("dup pty master");
+  m_io = std::make_unique<Io>(runner, fd);
+  // The read loop: wait for readability, read everything, hand it to the runner so that it
+  // enters at the virtual time matching now, wait again.
+  struct Reader {
+    PtyStation* self;
+    std::weak_ptr<bool> alive;
+    void operator()(const boost::system::error_code& ec) const {
+      if (ec || alive.expired()) return;
+      std::vector<std::uint8_t> bytes;
+      self->read_available(bytes);
+      if (!bytes.empty()) {
+        self->m_io->runner.post([s = self, a = alive, b = std::move(bytes)](Ticks) {
+          if (!a.expired()) s->feed(b);
+        });
+      }
+      self->m_io->sd.async_wait(boost::asio::posix::stream_descriptor::wait_read, *this);
+    }
+  };
+  m_io->sd.async_wait(boost::asio::posix::stream_descriptor::wait_read, Reader{this, m_io->alive});
+}
+
+void PtyStation::feed(std::span<const std::uint8_t> bytes) {
+  m_stats.bytes_in += bytes.size();
+  if (!bound() || !m_powered) {
+    m_stats.garbage_bytes += bytes.size();  // an unpowered station's UART hears nothing
+    return;
+  }
+  const Ticks now = port().now();
+  if (m_splitter.pending() > 0 && now - m_first_pending_at > m_opt.resync_after) {
+    m_splitter.discard_pending();
+    ++m_stats.abandoned;
+  }
+  const bool was_idle = m_splitter.pending() == 0;
+  const Ticks bit = ticks_per_bit(port().baud());
+  const std::size_t n = m_splitter.feed(bytes, [&](std::span<const std::uint8_t> f) {
+    const Ticks start = std::max(now, m_tx_free_at);
+    port().transmit(start, f);
+    ++m_stats.frames_in;
+    const Ticks end = start + chars_to_ticks(static_cast<std::int64_t>(f.size()), port().baud());
+    m_tx_free_at = end + kTsynBits * bit;
+    if (m_opt.mode == Mode::Station) {
+      const std::int64_t window =
+          m_opt.reply_window_bits > 0 ? m_opt.reply_window_bits : default_slot_time_bits(port().baud());
+      m_reply_after = end;
+      m_reply_until = end + window * bit;
+    }
+  });
+  if (m_splitter.pending() > 0 && (was_idle || n > 0)) m_first_pending_at = now;
+  flush_output();
+}
+
+}  // namespace pbvbus::bus

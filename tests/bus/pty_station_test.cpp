@@ -1,0 +1,302 @@
+// Serial PROFIBUS over a real pseudo-terminal (design.md "Serial PROFIBUS"): a test plays the
+// program on the slave side of the pty; probes on the line check bytes and bit timing.
+
+#include "pbvbus/bus/pty_station.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "frame_recorder.hpp"
+#include "hex.hpp"
+#include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/paced_runner.hpp"
+#include "probe.hpp"
+
+namespace pbvbus::bus {
+namespace {
+
+using namespace std::chrono_literals;
+using test::bytes_from_hex;
+using test::Probe;
+using test::to_hex;
+
+constexpr Ticks kBit = 2424;  // 1.5 Mbit/s
+constexpr Ticks B(std::int64_t bits) { return bits * kBit; }
+constexpr const char* kFdlStatusTo3 = "10 03 01 49 4D 16";  // Request FDL Status, 1 -> 3
+
+/// The program's end of the pty.
+class Program {
+ public:
+  explicit Program(const std::string& path) { open(path); }
+  ~Program() { close(); }
+  void open(const std::string& path) {
+    m_fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+    ASSERT_GE(m_fd, 0) << "cannot open " << path;
+  }
+  void close() {
+    if (m_fd >= 0) ::close(m_fd);
+    m_fd = -1;
+  }
+  void write_hex(const char* hex) {
+    const auto b = bytes_from_hex(hex);
+    ASSERT_EQ(::write(m_fd, b.data(), b.size()), static_cast<ssize_t>(b.size()));
+  }
+  /// Reads exactly n octets or whatever arrived before the timeout.
+  std::string read_hex(std::size_t n, std::chrono::milliseconds timeout = 2000ms) {
+    return to_hex(read_bytes(n, timeout));
+  }
+  std::vector<std::uint8_t> read_bytes(std::size_t n, std::chrono::milliseconds timeout = 2000ms) {
+    std::vector<std::uint8_t> got;
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (got.size() < n && std::chrono::steady_clock::now() < until) {
+      pollfd p{m_fd, POLLIN, 0};
+      if (::poll(&p, 1, 20) <= 0) continue;
+      std::uint8_t buf[512];
+      const ssize_t r = ::read(m_fd, buf, std::min(sizeof buf, n - got.size()));
+      if (r > 0) got.insert(got.end(), buf, buf + r);
+    }
+    return got;
+  }
+  /// Whether anything is readable within `wait`.
+  bool readable(std::chrono::milliseconds wait = 50ms) {
+    pollfd p{m_fd, POLLIN, 0};
+    return ::poll(&p, 1, static_cast<int>(wait.count())) > 0;
+  }
+
+ private:
+  int m_fd = -1;
+};
+
+/// Reads until `want` octets came through or 2 s passed (the pty delivers asynchronously).
+std::size_t poll_until(PtyStation& pty, std::size_t want) {
+  std::size_t got = 0;
+  const auto until = std::chrono::steady_clock::now() + 2s;
+  while (got < want && std::chrono::steady_clock::now() < until) got += pty.poll_input(20ms);
+  return got;
+}
+
+class PtyTest : public ::testing::Test {
+ protected:
+  void make(PtyStation::Options o) {
+    pty = std::make_unique<PtyStation>(o);
+    line.attach(*pty, "pty");
+    line.attach(master, "master");
+    line.attach(slave, "slave");
+    line.add_tap(rec);
+    line.start();
+  }
+  Scheduler sched;
+  Line line{sched, "A", Baud::k1_5M};
+  std::unique_ptr<PtyStation> pty;
+  Probe master, slave;
+  test::FrameRecorder rec;
+};
+
+TEST_F(PtyTest, OpensARawPseudoTerminal) {
+  make({});
+  EXPECT_EQ(pty->path().rfind("/dev/pts/", 0), 0u) << pty->path();
+  EXPECT_EQ(::access(pty->path().c_str(), R_OK | W_OK), 0);
+  EXPECT_STREQ(pty->kind(), "pty");
+  EXPECT_THROW(PtyStation({PtyStation::Mode::Station, 127}), std::invalid_argument);
+  EXPECT_THROW(PtyStation({PtyStation::Mode::Station, -1}), std::invalid_argument);
+}
+
+TEST_F(PtyTest, ProgramTelegramGoesOnTheLineAtTheCurrentTime) {
+  make({});
+  Program prog(pty->path());
+  sched.run_until(B(1000));
+  prog.write_hex(kFdlStatusTo3);
+  ASSERT_EQ(poll_until(*pty, 6), 6u);
+  sched.run_until(B(2000));
+  for (Probe* p : {&master, &slave}) {
+    ASSERT_EQ(p->rx.size(), 1u);
+    EXPECT_EQ(p->rx[0].hex(), kFdlStatusTo3);
+    EXPECT_EQ(p->rx[0].start, B(1000));
+    EXPECT_EQ(p->rx[0].end, B(1000 + 66));
+    EXPECT_EQ(p->rx[0].flags, 0);
+  }
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_EQ(rec.frame(0).sender, 0);
+  EXPECT_EQ(pty->stats().frames_in, 1u);
+  EXPECT_EQ(pty->stats().bytes_in, 6u);
+  EXPECT_EQ(pty->stats().garbage_bytes, 0u);
+}
+
+TEST_F(PtyTest, TelegramsWrittenAtOnceKeepTsynBetweenThem) {
+  make({});
+  Program prog(pty->path());
+  prog.write_hex("10 03 01 49 4D 16 DC 05 01 E5");
+  ASSERT_EQ(poll_until(*pty, 10), 10u);
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 3u);
+  EXPECT_EQ(rec.hex_all(), (std::vector<std::string>{kFdlStatusTo3, "DC 05 01", "E5"}));
+  EXPECT_EQ(rec.gap_bits(1), 33);
+  EXPECT_EQ(rec.gap_bits(2), 33);
+}
+
+TEST_F(PtyTest, GarbageBeforeATelegramIsSkippedAndCounted) {
+  make({});
+  Program prog(pty->path());
+  prog.write_hex("FF 00 16 68 03 03 68 10 03 01 49 4D 16");
+  ASSERT_EQ(poll_until(*pty, 13), 13u);
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_EQ(rec.hex(0), kFdlStatusTo3);
+  EXPECT_EQ(pty->stats().garbage_bytes, 7u);
+}
+
+TEST_F(PtyTest, AbandonsAnIncompleteTelegramAfterAPause) {
+  PtyStation::Options o;
+  o.resync_after = 100 * kTicksPerMs;
+  make(o);
+  Program prog(pty->path());
+  prog.write_hex("10 03 01");  // the rest never comes
+  ASSERT_EQ(poll_until(*pty, 3), 3u);
+  sched.run_until(200 * kTicksPerMs);
+  prog.write_hex(kFdlStatusTo3);
+  ASSERT_EQ(poll_until(*pty, 6), 6u);
+  sched.run_until(300 * kTicksPerMs);
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_EQ(rec.hex(0), kFdlStatusTo3);
+  EXPECT_EQ(pty->stats().abandoned, 1u);
+  EXPECT_EQ(pty->stats().garbage_bytes, 3u);
+}
+
+TEST_F(PtyTest, MonitorPassesEveryFrameRaw) {
+  make({});
+  Program prog(pty->path());
+  master.send(B(10), "10 05 01 49 4F 16");
+  slave.send(B(100), "E5");
+  master.send(B(200), "68 05 05 68 8A 81 6D 3C 3E F2 16");
+  sched.run_until(B(1000));
+  EXPECT_EQ(prog.read_hex(18), "10 05 01 49 4F 16 E5 68 05 05 68 8A 81 6D 3C 3E F2 16");
+  EXPECT_EQ(pty->stats().frames_out, 3u);
+}
+
+TEST_F(PtyTest, StationGetsItsOwnTrafficAndTheReplyToItsRequest) {
+  make({PtyStation::Mode::Station, 3});
+  Program prog(pty->path());
+  master.send(B(10), kFdlStatusTo3);          // to 3: out
+  master.send(B(100), "10 04 01 49 4E 16");   // to 4: not out
+  master.send(B(200), "10 7F 01 44 C4 16");   // broadcast: out
+  master.send(B(300), "DC 03 01");            // token to 3: out
+  master.send(B(400), "E5");                  // SC, not after a request of ours: not out
+  sched.run_until(B(1000));
+  EXPECT_EQ(prog.read_hex(15), "10 03 01 49 4D 16 10 7F 01 44 C4 16 DC 03 01");
+  EXPECT_FALSE(prog.readable());
+
+  // The program sends a request to 4; station 4 answers with SC after 11 bits: the reply comes
+  // out. A later SC (outside the reply window of 300 bit times at 1.5M) does not.
+  slave.on_rx = [&](const RxFrame& f) {
+    if (to_hex(f.bytes) == "10 04 03 49 50 16") slave.send(f.end + B(11), "E5");
+  };
+  prog.write_hex("10 04 03 49 50 16");
+  ASSERT_EQ(poll_until(*pty, 6), 6u);
+  const Ticks sent = sched.now();
+  sched.run_until(sent + B(500));
+  master.send(sent + B(600), "E5");
+  sched.run_until(sent + B(1000));
+  EXPECT_EQ(prog.read_hex(1), "E5");
+  EXPECT_FALSE(prog.readable());
+}
+
+TEST_F(PtyTest, ReplyWindowIsTheSlotTime) {
+  PtyStation::Options o{PtyStation::Mode::Station, 3};
+  o.reply_window_bits = 50;
+  make(o);
+  Program prog(pty->path());
+  prog.write_hex("10 04 03 49 50 16");
+  ASSERT_EQ(poll_until(*pty, 6), 6u);
+  const Ticks end = sched.now() + B(66);
+  master.send(end + B(51), "E5");  // too late
+  sched.run_until(end + B(500));
+  EXPECT_FALSE(prog.readable());
+  EXPECT_EQ(default_slot_time_bits(Baud::k1_5M), 300);
+  EXPECT_EQ(default_slot_time_bits(Baud::k12M), 1000);
+  EXPECT_EQ(default_slot_time_bits(Baud::k187_5), 100);
+}
+
+TEST_F(PtyTest, ProgramMayCloseAndReopenThePath) {
+  make({});
+  {
+    Program prog(pty->path());
+    prog.write_hex(kFdlStatusTo3);
+    ASSERT_EQ(poll_until(*pty, 6), 6u);
+  }  // closed: the station keeps the pty alive
+  master.send(B(500), "E5");  // written while nobody has it open
+  sched.run_until(B(1000));
+  EXPECT_EQ(pty->poll_input(20ms), 0u) << "no EIO/hangup on the master side";
+  Program again(pty->path());
+  EXPECT_EQ(again.read_hex(1), "E5") << "queued while closed, like a serial port";
+  again.write_hex("DC 05 01");
+  ASSERT_EQ(poll_until(*pty, 3), 3u);
+  master.send(B(2000), "10 05 01 49 4F 16");
+  sched.run_until(B(3000));
+  EXPECT_EQ(again.read_hex(6), "10 05 01 49 4F 16");
+  ASSERT_EQ(slave.rx.size(), 4u);  // pty SD1, master SC, pty token, master SD1
+  EXPECT_EQ(slave.rx[2].hex(), "DC 05 01");
+}
+
+TEST_F(PtyTest, ProgramThatDoesNotReadNeverStallsTheBus) {
+  PtyStation::Options o;
+  o.max_backlog = 1024;
+  make(o);
+  Program prog(pty->path());  // opened, never read
+  // 1000 of the longest telegrams (255 octets, LE 249): far more than any tty buffer holds.
+  std::vector<std::uint8_t> longest(255, 0x00);
+  longest[0] = longest[3] = 0x68;
+  longest[1] = longest[2] = 249;
+  longest[4] = 3;
+  longest[254] = 0x16;
+  constexpr int kFrames = 1000;
+  for (int i = 0; i < kFrames; ++i) master.send(B((255 * 11 + 100) * i), longest);
+  sched.run_until(B((255 * 11 + 100) * kFrames));
+  EXPECT_EQ(slave.rx.size(), static_cast<std::size_t>(kFrames));
+  const auto s = pty->stats();
+  EXPECT_GT(s.frames_dropped, 0u);
+  EXPECT_EQ(s.frames_out + s.frames_dropped, static_cast<std::uint64_t>(kFrames));
+  EXPECT_LE(pty->backlog(), 1024u);
+  // What did get through is whole telegrams, in order: drain the tty and the backlog.
+  std::vector<std::uint8_t> all;
+  for (int i = 0; i < 500 && (prog.readable(20ms) || pty->backlog() > 0); ++i) {
+    const auto chunk = prog.read_bytes(1 << 16, 20ms);
+    all.insert(all.end(), chunk.begin(), chunk.end());
+    pty->flush_output();
+  }
+  EXPECT_EQ(pty->backlog(), 0u);
+  ASSERT_EQ(all.size(), s.frames_out * 255);
+  for (std::size_t i = 0; i < all.size(); i += 255) {
+    ASSERT_EQ(to_hex(std::span(all).subspan(i, 5)), "68 F9 F9 68 03") << "telegram at octet " << i;
+  }
+}
+
+TEST_F(PtyTest, PacedRunnerReadsThePtyAndWritesToIt) {
+  make({});
+  PacedRunner runner(sched);
+  pty->attach_io(runner);
+  Program prog(pty->path());
+  Ticks got_at = -1;
+  master.on_rx = [&](const RxFrame& f) {
+    got_at = f.start;
+    master.send(f.end + B(11), "E5");
+  };
+  std::thread program([&] {
+    while (!runner.running()) std::this_thread::sleep_for(1ms);
+    std::this_thread::sleep_for(30ms);
+    prog.write_hex(kFdlStatusTo3);
+  });
+  runner.run_for(150 * kTicksPerMs);
+  program.join();
+  ASSERT_EQ(master.rx.size(), 1u);
+  EXPECT_EQ(master.rx[0].hex(), kFdlStatusTo3);
+  EXPECT_GE(got_at, 25 * kTicksPerMs) << "entered at the virtual time of its wall time";
+  EXPECT_EQ(prog.read_hex(1), "E5");
+}
+
+}  // namespace
+}  // namespace pbvbus::bus

@@ -796,11 +796,12 @@ local function fcs_of(tvb, off, len)
 end
 
 -- Address extension chain (§B.2): octets while bit 7 is set; bit 6 = segment, else SAP.
-local function ext_chain(tvb, pos, stop, tree, f_raw, f_sap, f_seg)
+local function ext_chain(tvb, pos, stop, tree, f_raw, f_sap, f_seg, truncated)
   local sap, seg
   while true do
     if pos >= stop then
-      tree:add_proto_expert_info(E.ext, "extension chain runs past the data")
+      -- In a frame cut short the chain simply is not there: the truncation is the error.
+      if not truncated then tree:add_proto_expert_info(E.ext, "extension chain runs past the data") end
       return pos, sap, seg, false
     end
     local o = tvb(pos, 1):uint()
@@ -931,12 +932,12 @@ function fdl.dissector(tvb, pinfo, tree)
   local ok_ext = true
   if bit.band(da_o, 0x80) ~= 0 then
     local ok
-    pos, fr.dsap, fr.da_seg, ok = ext_chain(tvb, pos, stop, t, F.dae, F.dsap, F.da_segment)
+    pos, fr.dsap, fr.da_seg, ok = ext_chain(tvb, pos, stop, t, F.dae, F.dsap, F.da_segment, truncated)
     ok_ext = ok_ext and ok
   end
   if bit.band(sa_o, 0x80) ~= 0 then
     local ok
-    pos, fr.ssap, fr.sa_seg, ok = ext_chain(tvb, pos, stop, t, F.sae, F.ssap, F.sa_segment)
+    pos, fr.ssap, fr.sa_seg, ok = ext_chain(tvb, pos, stop, t, F.sae, F.ssap, F.sa_segment, truncated)
     ok_ext = ok_ext and ok
   end
   local du_off, du_len = pos, stop - pos

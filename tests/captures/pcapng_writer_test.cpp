@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <unistd.h>
+
 #include "capture_fixture.hpp"
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
@@ -271,6 +273,35 @@ TEST(PcapngWriter, StreamingFlushesEveryBlock) {
   w.on_frame(test::tap_frame(a, test::kSc, 0));
   // SHB, IDB and EPB each written as soon as they are complete.
   EXPECT_EQ(writes, (std::vector<std::size_t>{44, 80, 36}));
+}
+
+TEST(PcapngWriter, DashStreamsToStdoutBlockByBlock) {
+  const auto path = std::filesystem::temp_directory_path() / "pbvbus_writer_stdout.pcapng";
+  std::fflush(stdout);
+  const int saved = dup(fileno(stdout));
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  ASSERT_TRUE(f);
+  dup2(fileno(f), fileno(stdout));
+  std::uintmax_t size_while_open = 0;
+  {
+    auto w = PcapngWriter::open("-", {});
+    bus::Scheduler sched;
+    bus::Line a(sched, "dp0", bus::Baud::k12M);
+    w->on_frame(test::tap_frame(a, test::kSc, 0));
+    // Streaming: everything is on its way before the writer is closed.
+    size_while_open = std::filesystem::file_size(path);
+  }
+  std::fflush(stdout);
+  dup2(saved, fileno(stdout));
+  close(saved);
+  std::fclose(f);
+  EXPECT_EQ(size_while_open, 44u + 80u + 36u);
+  PcapngError err;
+  auto cap = read_pcapng_file(path.string(), err);
+  ASSERT_TRUE(cap) << err.to_string();
+  ASSERT_EQ(cap->records.size(), 1u);
+  EXPECT_EQ(cap->records[0].bytes, test::kSc);
+  std::filesystem::remove(path);
 }
 
 TEST(PcapngWriter, FileSinkAndWriteErrors) {

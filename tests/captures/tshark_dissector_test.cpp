@@ -251,6 +251,43 @@ TEST_F(TsharkDissector, EventRecords) {
                         "dp0: cable cut between 'master 3' and 'slave 10'"}));
 }
 
+// Segment octets in the extension chain, a partial frame, SRD low, an FDL status reply from a
+// master and a DP-V1 poll with no data (E.4).
+TEST(TsharkDissectorMore, SegmentsPartialFramesAndPolls) {
+  if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  const auto path = (std::filesystem::temp_directory_path() / "pbvbus_tshark_more.pcapng").string();
+  {
+    bus::Scheduler sched;
+    bus::Line line(sched, "dp1", bus::Baud::k187_5);
+    auto w = PcapngWriter::open(path, {});
+    ASSERT_TRUE(w);
+    // Slave_Diag request as SRD low with a destination segment octet (0xC5: EXT | segment | 5)
+    // before DSAP 60.
+    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x81, 0x4C, 0xC5, 0x3C, 0x3E}), 1000));
+    // Set_Prm cut after 7 of 18 octets.
+    const Bytes part(test::kSetPrm.begin(), test::kSetPrm.begin() + 7);
+    w->on_frame(test::tap_frame(line, part, 2000, bus::kRxPartial, 18));
+    // FDL Status reply from master 5 in the ring (Appendix 1).
+    w->on_frame(test::tap_frame(line, Bytes{0x10, 0x01, 0x05, 0x30, 0x36, 0x16}, 3000));
+    // DP-V1 poll: SRD to SAP 51 without data, and the slave's empty DL answer.
+    w->on_frame(test::tap_frame(line, sd2({0x8A, 0xB3, 0x5D, 0x33, 0x33}), 4000));
+    w->on_frame(test::tap_frame(line, sd2({0xB3, 0x8A, 0x08, 0x33, 0x33}), 5000));
+  }
+  using R = std::vector<std::string>;
+  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbfdl.da_segment", "pbfdl.dsap", "pbfdl.ssap",
+                                             "pbfdl.fc.station_type", "_ws.expert.message"});
+  std::filesystem::remove(path);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0], (R{"SRD_low 1→10 Slave_Diag.req FCB=0 FCV=0", "5", "60", "62", "", ""}));
+  // The DSAP octet was never sent: no DP service, and no complaint about the extension chain.
+  EXPECT_EQ(rows[1][0], "SRD_high 1→10 FCB=0 FCV=1 [truncated]");
+  // Wireshark shows the pcapng comment as an expert item too, then the dissector's own.
+  EXPECT_EQ(rows[1][5], "partial: 7 of 18 octets,7 of 18 octets");
+  EXPECT_EQ(rows[2], (R{"5→1 OK (master in the ring)", "", "", "", "3", ""}));
+  EXPECT_EQ(rows[3][0], "SRD_high 51→10 MSAC_C1 poll FCB=0 FCV=1");
+  EXPECT_EQ(rows[4][0], "10→51 DL MSAC_C1 not ready");
+}
+
 // Mutated and random frames must never make the dissector raise a Lua error.
 TEST(TsharkDissectorRobustness, GarbageFramesDecodeWithoutLuaErrors) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;

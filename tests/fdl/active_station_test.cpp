@@ -414,6 +414,7 @@ class HandDriven : public ::testing::Test {
 
 TEST_F(HandDriven, ListenTokenAnswersNotReadyThenReady) {
   EXPECT_EQ(station->state(), MacState::Listen_Token);
+  EXPECT_EQ(to_string(station->state()), "Listen_Token");
   feed("10 02 01 49 4C 16", 500);
   ASSERT_EQ(port.transmit_count(), 1u);
   EXPECT_EQ(to_hex(port.last().bytes), "10 01 02 10 13 16");  // master not ready

@@ -1,12 +1,251 @@
-#include <ostream>
+// `pbvbus run [SCENARIO] [options]` (design.md "Configuration and command line").
+//
+// Decisions:
+//  - Without a scenario file the built-in default runs (scenario.hpp default_scenario_text()).
+//  - The fast driver is the default unless something outside the process is attached (a pty):
+//    then virtual time must follow the wall clock and --paced is the default. --fast with a pty
+//    is allowed (the external side then sees a very fast bus) but warned about.
+//  - `--capture -` streams pcapng to stdout; the report then goes to stderr, and --json (which
+//    would also need stdout) is refused.
+//  - --quiet prints nothing but errors and the --json report.
+//  - Progress (virtual time, speed) goes to stderr only when stderr is a terminal and the run
+//    has taken more than a second of wall time; it is erased before the report.
+//  - Exit codes: 0 done, 1 the run failed (capture could not be written), 2 bad usage or a bad
+//    scenario.
 
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/tools/commands.hpp"
+#include "pbvbus/tools/report.hpp"
+#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/tools/simulation.hpp"
 
 namespace pbvbus::tools {
 
-int cmd_run(const Args&, std::ostream&, std::ostream& err) {
-  err << "pbvbus run: scenario runner not built yet\n";
-  return 2;
+namespace {
+
+constexpr const char* kUsage =
+    "usage: pbvbus run [SCENARIO] [options]\n"
+    "\n"
+    "Runs a scenario (Protocol Buffers text format, see tools/proto/scenario.proto); without\n"
+    "SCENARIO, a built-in default scenario.\n"
+    "\n"
+    "options:\n"
+    "  --fast            run as fast as possible (default without serial attachments)\n"
+    "  --paced           virtual time follows the wall clock (default with serial attachments)\n"
+    "  --duration T      how long to run, e.g. 500ms, 5s, 2min (overrides the scenario)\n"
+    "  --seed N          seed of the random choices (overrides the scenario)\n"
+    "  --capture FILE    write a pcapng capture; '-' streams it to stdout\n"
+    "  --json            print the report as JSON (schema pbvbus.run.report/1)\n"
+    "  --quiet           print nothing but errors (and the --json report)\n"
+    "  -h, --help        this text\n";
+
+struct RunArgs {
+  std::optional<std::string> scenario;
+  bool fast = false;
+  bool paced = false;
+  std::optional<bus::Ticks> duration;
+  std::optional<std::uint64_t> seed;
+  std::optional<std::string> capture;
+  bool json = false;
+  bool quiet = false;
+  bool help = false;
+};
+
+/// Parses the arguments; on error returns the message (without the "pbvbus run: " prefix).
+std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* opt) -> std::optional<std::string> {
+      if (i + 1 >= args.size()) return std::nullopt;
+      (void)opt;
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      out.help = true;
+    } else if (a == "--fast") {
+      out.fast = true;
+    } else if (a == "--paced") {
+      out.paced = true;
+    } else if (a == "--json") {
+      out.json = true;
+    } else if (a == "--quiet" || a == "-q") {
+      out.quiet = true;
+    } else if (a == "--duration") {
+      auto v = value("--duration");
+      if (!v) return "--duration needs a value, e.g. --duration 5s";
+      auto t = bus::parse_duration(*v);
+      if (!t || *t == 0)
+        return "bad duration '" + *v + "' (expected a number and a unit: ns, us, ms, s, min, h)";
+      out.duration = *t;
+    } else if (a == "--seed") {
+      auto v = value("--seed");
+      if (!v) return "--seed needs a value";
+      std::uint64_t s = 0;
+      std::size_t used = 0;
+      try {
+        if (v->empty() || (*v)[0] == '-') throw std::invalid_argument("negative");
+        s = std::stoull(*v, &used, 0);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != v->size()) return "bad seed '" + *v + "' (expected an unsigned integer)";
+      out.seed = s;
+    } else if (a == "--capture") {
+      auto v = value("--capture");
+      if (!v || v->empty()) return "--capture needs a file name or '-'";
+      out.capture = *v;
+    } else if (a.size() > 1 && a[0] == '-') {
+      return "unknown option '" + a + "'";
+    } else if (!out.scenario) {
+      out.scenario = a;
+    } else {
+      return "more than one scenario given ('" + *out.scenario + "' and '" + a + "')";
+    }
+  }
+  if (out.fast && out.paced) return "--fast and --paced exclude each other";
+  if (out.json && out.capture && *out.capture == "-")
+    return "--json and --capture - both need stdout; write the capture to a file";
+  return std::nullopt;
+}
+
+class Progress {
+ public:
+  Progress(std::ostream& err, bool enabled, bus::Ticks total)
+      : m_err(err), m_enabled(enabled), m_total(total), m_t0(std::chrono::steady_clock::now()) {}
+
+  void update(bus::Ticks now) {
+    if (!m_enabled) return;
+    const auto wall = std::chrono::steady_clock::now() - m_t0;
+    if (wall < std::chrono::seconds(1) || wall - m_last < std::chrono::milliseconds(200)) return;
+    m_last = wall;
+    const double w = std::chrono::duration<double>(wall).count();
+    const double v = static_cast<double>(now) / bus::kTicksPerSecond;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "\r%s / %s virtual, %.1fx real time   ",
+                  bus::format_duration(now).c_str(), bus::format_duration(m_total).c_str(), v / w);
+    m_err << buf << std::flush;
+    m_shown = true;
+  }
+  void clear() {
+    if (m_shown) m_err << "\r" << std::string(70, ' ') << "\r" << std::flush;
+  }
+  double elapsed() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_t0).count();
+  }
+
+ private:
+  std::ostream& m_err;
+  bool m_enabled;
+  bus::Ticks m_total;
+  std::chrono::steady_clock::time_point m_t0;
+  std::chrono::steady_clock::duration m_last{};
+  bool m_shown = false;
+};
+
+}  // namespace
+
+int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
+  RunArgs ra;
+  if (auto e = parse_args(args, ra)) {
+    err << "pbvbus run: " << *e << "\n" << "Try 'pbvbus run --help'.\n";
+    return 2;
+  }
+  if (ra.help) {
+    out << kUsage;
+    return 0;
+  }
+
+  const LoadResult loaded = ra.scenario ? load_scenario_file(*ra.scenario)
+                                        : parse_scenario(default_scenario_text(), "<built-in default>");
+  if (!loaded.ok()) {
+    for (const auto& d : loaded.errors) err << d.str() << "\n";
+    return 2;
+  }
+
+  // With the capture on stdout, everything else goes to stderr.
+  const bool capture_stdout = ra.capture && *ra.capture == "-";
+  std::ostream& report_os = capture_stdout ? err : out;
+
+  std::unique_ptr<captures::PcapngWriter> capture;
+  if (ra.capture) {
+    std::string why;
+    capture = captures::PcapngWriter::open(*ra.capture, {}, &why);
+    if (!capture) {
+      err << "pbvbus run: cannot write the capture " << *ra.capture << ": " << why << "\n";
+      return 2;
+    }
+  }
+
+  SimulationOptions so;
+  so.duration = ra.duration;
+  so.seed = ra.seed;
+  so.capture = capture.get();
+  std::unique_ptr<Simulation> sim;
+  try {
+    sim = std::make_unique<Simulation>(*loaded.plan, so);
+  } catch (const std::exception& e) {
+    err << "pbvbus run: " << e.what() << "\n";
+    return 1;
+  }
+  if (!sim->duration()) {
+    err << "pbvbus run: " << loaded.plan->file
+        << ": the scenario has no duration; add duration: \"5s\" or use --duration\n";
+    return 2;
+  }
+  const bus::Ticks end = *sim->duration();
+  const bool paced = ra.paced || (!ra.fast && sim->has_external_attachments());
+
+  if (!ra.quiet) {
+    for (const auto& s : sim->serial_ports())
+      err << "serial " << s.mode << " on line " << s.line << ": " << s.path << "\n";
+    if (ra.fast && sim->has_external_attachments())
+      err << "pbvbus run: warning: --fast with serial attachments: the bus runs faster than real "
+             "time\n";
+  }
+
+  const bool show_progress = !ra.quiet && &err == &std::cerr && ::isatty(STDERR_FILENO) == 1;
+  Progress progress(err, show_progress, end);
+  if (paced) {
+    err << "pbvbus run: --paced needs bus::PacedRunner, not yet in this build\n";
+    return 1;
+  }
+  sim->start();
+  // Run in slices so that progress can be shown; the slices do not change the result.
+  const bus::Ticks slice = 10 * bus::kTicksPerMs;
+  for (bus::Ticks t = 0; t < end;) {
+    t = std::min(end, t + slice);
+    sim->run_until(t);
+    progress.update(t);
+  }
+  progress.clear();
+  const double wall = progress.elapsed();
+
+  int rc = 0;
+  if (capture) {
+    capture->flush();
+    if (!capture->ok()) {
+      err << "pbvbus run: writing the capture failed: " << capture->error() << "\n";
+      rc = 1;
+    }
+  }
+  const Report report = sim->report(wall);
+  if (ra.json) {
+    write_json(report, out);
+  } else if (!ra.quiet) {
+    write_text(report, report_os);
+  }
+  return rc;
 }
 
 }  // namespace pbvbus::tools

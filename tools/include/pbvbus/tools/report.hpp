@@ -1,0 +1,120 @@
+#pragma once
+// The report at the end of `pbvbus run`: per line the live list, per master the token rotation
+// times and ring counters, traffic by frame type and request function, errors and the faults
+// applied. Written as text for people or as JSON for programs (--json).
+//
+// JSON schema "pbvbus.run.report/1" (stable: fields are only ever added; a change of meaning
+// gets a new version). All times are integers: nanoseconds (`_ns`) of virtual time, or bit
+// times (`_bits`) of the line's baud rate; wall-clock figures are the only floats.
+//
+//   { "schema": "pbvbus.run.report/1",
+//     "scenario": { "name": str, "file": str, "seed": int },
+//     "duration_ns": int,            // virtual time simulated
+//     "wall_time_s": float, "speed": float,   // speed = virtual s / wall s
+//     "events": int,                 // scheduler events run
+//     "serial": [ { "line": str, "mode": "monitor"|"station", "path": str } ],
+//     "faults_not_reached": [ str ], // scheduled after the end of the run
+//     "lines": [ {
+//       "name": str, "baud": int,
+//       "bus_params": { "tsl","min_tsdr","max_tsdr","tqui","tset","ttr","gap_factor","hsa",
+//                       "max_retry": int },
+//       "live_list": [ { "address": int, "type": "master_in_ring"|"master_ready"|
+//                        "master_not_ready"|"slave" } ],          // ascending address
+//       "frames": { "total","octets","SD1","SD2","SD3","SD4","SC","garbage","responses": int },
+//       "requests": { "<function>": int },   // intact requests, e.g. "SRD_low", "FDL_Status"
+//       "errors": { "error_frames","collisions","parity","bad_fcs","malformed","partial",
+//                   "babble","no_response","retries": int },
+//       "faults": [ { "time_ns": int, "text": str } ],   // faults and repairs as applied
+//       "masters": [ { "address": int, "state": str, "tokens_received","tokens_passed",
+//                      "token_losses","claims": int,
+//                      "rotation": { "count": int, "min_ns","median_ns","max_ns": int,
+//                                    "min_bits","median_bits","max_bits": int },
+//                      "polls": { "requests","ok","no_response","sent","retries",
+//                                 "data_octets": int } } ],
+//       "stations": [ { "address": int, "requests","replies","fdl_status","cycles": int } ]
+//     } ] }
+//
+// Rotation statistics leave out the first token a master receives after power-on or after
+// (re)entering the ring: its "rotation" includes the time the master spent outside the ring.
+
+#include <cstdint>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+#include "pbvbus/devices/fdl_poller.hpp"
+#include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/tools/line_stats.hpp"
+
+namespace pbvbus::tools {
+
+struct RotationStats {
+  std::uint64_t count = 0;
+  bus::Ticks min = 0;
+  bus::Ticks median = 0;
+  bus::Ticks max = 0;
+};
+/// min/median/max of `samples` (the median of an even count is the lower middle value).
+RotationStats rotation_stats(std::vector<bus::Ticks> samples);
+
+struct MasterReport {
+  std::uint8_t address = 0;
+  std::string state;  ///< MAC state at the end, e.g. "Active_Idle"
+  std::uint64_t tokens_received = 0;
+  std::uint64_t tokens_passed = 0;
+  std::uint64_t token_losses = 0;
+  std::uint64_t claims = 0;
+  RotationStats rotation;
+  devices::PollStats polls;
+};
+
+struct StationReport {
+  std::uint8_t address = 0;
+  std::uint64_t requests = 0;
+  std::uint64_t replies = 0;
+  std::uint64_t fdl_status = 0;
+  std::uint64_t cycles = 0;  ///< SRD answered with fresh data
+};
+
+struct LiveEntry {
+  std::uint8_t address = 0;
+  fdl::StationType type = fdl::StationType::Slave;
+};
+
+struct LineReport {
+  std::string name;
+  bus::Baud baud = bus::Baud::k1_5M;
+  fdl::BusParams params;
+  std::vector<LiveEntry> live;
+  LineStats traffic;  ///< a copy of the line's statistics tap
+  std::vector<MasterReport> masters;
+  std::vector<StationReport> stations;
+};
+
+struct SerialReport {
+  std::string line;
+  std::string mode;
+  std::string path;
+};
+
+struct Report {
+  std::string name;
+  std::string file;
+  std::uint64_t seed = 0;
+  bus::Ticks duration = 0;
+  double wall_seconds = 0;
+  std::uint64_t events = 0;
+  std::vector<SerialReport> serial;
+  std::vector<std::string> faults_not_reached;
+  std::vector<LineReport> lines;
+};
+
+/// "master_in_ring", "master_ready", "master_not_ready", "slave".
+std::string_view live_type_key(fdl::StationType t);
+
+void write_text(const Report& r, std::ostream& os);
+void write_json(const Report& r, std::ostream& os);
+
+}  // namespace pbvbus::tools

@@ -1,0 +1,96 @@
+#pragma once
+// A running scenario (design.md "Time", "The line", "Captures"): the scheduler, one bus::Line
+// per scenario line, the FDL stations with their users, pty attachments, the faults scheduled
+// at their times, and the taps (statistics, optional pcapng capture).
+//
+// Decisions:
+//  - Line i is seeded with a value derived from the scenario seed and i (splitmix64), so two
+//    lines never share a noise pattern and adding a line does not change the others'.
+//  - Stations are attached in cable order (ScenarioPlan), labelled "master N", "slave N",
+//    "serial monitor" or "serial station N" (the labels appear in fault descriptions).
+//  - Everything is powered at time 0; faults and repairs run as scheduler events at their
+//    time, before any station event of the same tick that was scheduled later.
+//  - Faults scheduled after the end of the run (possible with a shorter --duration) are not
+//    applied and are listed in the report.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/tools/report.hpp"
+#include "pbvbus/tools/scenario.hpp"
+
+namespace pbvbus::captures {
+class PcapngWriter;
+}
+namespace pbvbus::devices {
+class FdlPoller;
+class FdlResponder;
+}  // namespace pbvbus::devices
+
+namespace pbvbus::tools {
+
+struct SimulationOptions {
+  std::optional<bus::Ticks> duration;  ///< overrides the scenario's
+  std::optional<std::uint64_t> seed;   ///< overrides the scenario's
+  /// Tap for every line (not owned; must outlive the Simulation's runs).
+  captures::PcapngWriter* capture = nullptr;
+};
+
+class Simulation {
+ public:
+  /// Builds everything; throws std::runtime_error if a resource cannot be had (a pty).
+  Simulation(const ScenarioPlan& plan, const SimulationOptions& opts = {});
+  ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  bus::Scheduler& scheduler() { return m_sched; }
+  /// The run's length: the option, else the scenario's; nullopt if neither gives one.
+  std::optional<bus::Ticks> duration() const { return m_duration; }
+  std::uint64_t seed() const { return m_seed; }
+  const ScenarioPlan& plan() const { return m_plan; }
+
+  std::size_t line_count() const { return m_lines.size(); }
+  bus::Line& line(std::size_t i) { return *m_lines.at(i)->line; }
+  const LineStats& stats(std::size_t i) const { return m_lines.at(i)->stats; }
+  /// The traffic user of master `addr` on line `li`, or nullptr.
+  const devices::FdlPoller* poller(std::size_t li, std::uint8_t addr) const;
+  /// The user of passive station `addr` on line `li`, or nullptr.
+  const devices::FdlResponder* responder(std::size_t li, std::uint8_t addr) const;
+
+  /// Whether something outside the process is attached (a pty): then the run must be paced.
+  bool has_external_attachments() const { return !m_serial.empty(); }
+  const std::vector<SerialReport>& serial_ports() const { return m_serial; }
+
+  /// Powers every station and schedules the faults (done once; run_until calls it).
+  void start();
+  /// Fast driver: runs every event up to `t` as fast as the CPU allows.
+  void run_until(bus::Ticks t);
+
+  /// The report as of now. `wall_seconds` is how long the run took (for the speed figure).
+  Report report(double wall_seconds) const;
+
+ private:
+  struct Station;
+  struct LineState;
+  void build_line(std::size_t li);
+  void schedule_faults();
+  void apply_fault(const PlanFault& f, bool on);
+
+  ScenarioPlan m_plan;
+  SimulationOptions m_opts;
+  std::optional<bus::Ticks> m_duration;
+  std::uint64_t m_seed = 0;
+  bus::Scheduler m_sched;
+  std::vector<std::unique_ptr<LineState>> m_lines;
+  std::vector<SerialReport> m_serial;
+  std::vector<std::string> m_not_reached;
+  bool m_started = false;
+};
+
+}  // namespace pbvbus::tools

@@ -1,0 +1,223 @@
+#include "pbvbus/tools/report.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <ostream>
+
+namespace pbvbus::tools {
+
+RotationStats rotation_stats(std::vector<bus::Ticks> samples) {
+  RotationStats r;
+  r.count = samples.size();
+  if (samples.empty()) return r;
+  const auto mid = samples.begin() + static_cast<std::ptrdiff_t>((samples.size() - 1) / 2);
+  std::nth_element(samples.begin(), mid, samples.end());
+  r.median = *mid;
+  const auto [lo, hi] = std::minmax_element(samples.begin(), samples.end());
+  r.min = *lo;
+  r.max = *hi;
+  return r;
+}
+
+std::string_view live_type_key(fdl::StationType t) {
+  switch (t) {
+    case fdl::StationType::Slave: return "slave";
+    case fdl::StationType::MasterNotReady: return "master_not_ready";
+    case fdl::StationType::MasterReady: return "master_ready";
+    case fdl::StationType::MasterInRing: return "master_in_ring";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr const char* kTypeNames[LineStats::kTypes] = {"SD1", "SD2", "SD3", "SD4", "SC"};
+
+/// Microseconds with three decimals, from ticks, without floating point.
+std::string us(bus::Ticks t) {
+  const std::int64_t ns = bus::ticks_to_ns(t);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%lld.%03lld", static_cast<long long>(ns / 1000),
+                static_cast<long long>(ns % 1000));
+  return buf;
+}
+
+std::string json_string(std::string_view s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\r': o += "\\r"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
+          o += buf;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::uint64_t no_response(const LineReport& l) {
+  std::uint64_t n = 0;
+  for (const auto& m : l.masters) n += m.polls.no_response;
+  return n;
+}
+std::uint64_t retries(const LineReport& l) {
+  std::uint64_t n = 0;
+  for (const auto& m : l.masters) n += m.polls.retries;
+  return n;
+}
+
+}  // namespace
+
+void write_text(const Report& r, std::ostream& os) {
+  os << "scenario " << (r.name.empty() ? "(unnamed)" : r.name) << " (" << r.file << "), seed "
+     << r.seed << "\n";
+  os << "simulated " << bus::format_duration(r.duration) << " in " << fixed(r.wall_seconds, 3)
+     << " s wall time";
+  if (r.wall_seconds > 0)
+    os << " (" << fixed(static_cast<double>(r.duration) / bus::kTicksPerSecond / r.wall_seconds, 1)
+       << "x real time)";
+  os << ", " << r.events << " events\n";
+  for (const auto& s : r.serial) os << "serial " << s.mode << " on line " << s.line << ": " << s.path << "\n";
+  for (const auto& l : r.lines) {
+    const auto bit = bus::ticks_per_bit(l.baud);
+    os << "\nline " << l.name << " (" << bus::baud_name(l.baud) << "bit/s, TSL " << l.params.tsl
+       << ", TTR " << l.params.ttr << " bit times)\n";
+    os << "  live list:";
+    if (l.live.empty()) os << " (empty)";
+    os << "\n";
+    for (const auto& e : l.live)
+      os << "    " << static_cast<int>(e.address) << "\t" << fdl::to_string(e.type) << "\n";
+    for (const auto& m : l.masters) {
+      os << "  master " << static_cast<int>(m.address);
+      if (!m.state.empty()) os << " (" << m.state << ")";
+      os << ": tokens received " << m.tokens_received << ", passed " << m.tokens_passed
+         << ", losses " << m.token_losses << ", claims " << m.claims << "\n";
+      if (m.rotation.count > 0) {
+        os << "    token rotation (" << m.rotation.count << "): min " << us(m.rotation.min)
+           << " / median " << us(m.rotation.median) << " / max " << us(m.rotation.max)
+           << " us = " << m.rotation.min / bit << " / " << m.rotation.median / bit << " / "
+           << m.rotation.max / bit << " bit times\n";
+      }
+      const auto& p = m.polls;
+      os << "    polls: " << p.requests << " requests, " << p.ok << " ok, " << p.no_response
+         << " no response, " << p.sent << " sent (SDN), " << p.retries << " retries\n";
+    }
+    for (const auto& s : l.stations) {
+      os << "  station " << static_cast<int>(s.address) << ": " << s.requests << " requests, "
+         << s.replies << " replies, " << s.fdl_status << " FDL status, " << s.cycles
+         << " data cycles\n";
+    }
+    const auto& t = l.traffic;
+    os << "  frames: " << t.frames << " (" << t.octets << " octets):";
+    for (std::size_t i = 0; i < LineStats::kTypes; ++i) os << " " << kTypeNames[i] << " " << t.by_type[i];
+    if (t.garbage) os << " garbage " << t.garbage;
+    os << "\n  requests:";
+    bool any = false;
+    for (std::size_t fn = 0; fn < t.requests_by_fn.size(); ++fn) {
+      if (t.requests_by_fn[fn] == 0) continue;
+      os << " " << fdl::to_string(static_cast<fdl::RequestFn>(fn)) << " " << t.requests_by_fn[fn];
+      any = true;
+    }
+    if (!any) os << " none";
+    os << "; responses " << t.responses << "\n";
+    os << "  errors: " << t.error_frames() << " frames (collisions " << t.collisions
+       << ", parity " << t.parity << ", bad FCS " << t.bad_fcs << ", malformed " << t.malformed
+       << ", partial " << t.partial << ", babble " << t.babble << "); no response "
+       << no_response(l) << ", retries " << retries(l) << "\n";
+    for (const auto& f : t.faults) os << "  fault at " << bus::format_duration(f.time) << ": " << f.text << "\n";
+  }
+  for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
+}
+
+void write_json(const Report& r, std::ostream& os) {
+  os << "{\"schema\":\"pbvbus.run.report/1\",\n";
+  os << "\"scenario\":{\"name\":" << json_string(r.name) << ",\"file\":" << json_string(r.file)
+     << ",\"seed\":" << r.seed << "},\n";
+  os << "\"duration_ns\":" << bus::ticks_to_ns(r.duration) << ",\"wall_time_s\":"
+     << fixed(r.wall_seconds, 6) << ",\"speed\":"
+     << fixed(r.wall_seconds > 0 ? static_cast<double>(r.duration) / bus::kTicksPerSecond / r.wall_seconds : 0.0, 3)
+     << ",\"events\":" << r.events << ",\n";
+  os << "\"serial\":[";
+  for (std::size_t i = 0; i < r.serial.size(); ++i) {
+    const auto& s = r.serial[i];
+    os << (i ? "," : "") << "{\"line\":" << json_string(s.line) << ",\"mode\":" << json_string(s.mode)
+       << ",\"path\":" << json_string(s.path) << "}";
+  }
+  os << "],\n\"faults_not_reached\":[";
+  for (std::size_t i = 0; i < r.faults_not_reached.size(); ++i)
+    os << (i ? "," : "") << json_string(r.faults_not_reached[i]);
+  os << "],\n\"lines\":[";
+  for (std::size_t li = 0; li < r.lines.size(); ++li) {
+    const auto& l = r.lines[li];
+    const auto bit = bus::ticks_per_bit(l.baud);
+    const auto& p = l.params;
+    os << (li ? ",\n" : "\n") << "{\"name\":" << json_string(l.name)
+       << ",\"baud\":" << static_cast<std::uint32_t>(l.baud) << ",\n \"bus_params\":{\"tsl\":"
+       << p.tsl << ",\"min_tsdr\":" << p.min_tsdr << ",\"max_tsdr\":" << p.max_tsdr
+       << ",\"tqui\":" << p.tqui << ",\"tset\":" << p.tset << ",\"ttr\":" << p.ttr
+       << ",\"gap_factor\":" << p.gap_factor << ",\"hsa\":" << static_cast<int>(p.hsa)
+       << ",\"max_retry\":" << static_cast<int>(p.max_retry) << "},\n \"live_list\":[";
+    for (std::size_t i = 0; i < l.live.size(); ++i)
+      os << (i ? "," : "") << "{\"address\":" << static_cast<int>(l.live[i].address)
+         << ",\"type\":\"" << live_type_key(l.live[i].type) << "\"}";
+    const auto& t = l.traffic;
+    os << "],\n \"frames\":{\"total\":" << t.frames << ",\"octets\":" << t.octets;
+    for (std::size_t i = 0; i < LineStats::kTypes; ++i) os << ",\"" << kTypeNames[i] << "\":" << t.by_type[i];
+    os << ",\"garbage\":" << t.garbage << ",\"responses\":" << t.responses << "},\n \"requests\":{";
+    bool first = true;
+    for (std::size_t fn = 0; fn < t.requests_by_fn.size(); ++fn) {
+      if (t.requests_by_fn[fn] == 0) continue;
+      os << (first ? "" : ",") << json_string(fdl::to_string(static_cast<fdl::RequestFn>(fn)))
+         << ":" << t.requests_by_fn[fn];
+      first = false;
+    }
+    os << "},\n \"errors\":{\"error_frames\":" << t.error_frames() << ",\"collisions\":" << t.collisions
+       << ",\"parity\":" << t.parity << ",\"bad_fcs\":" << t.bad_fcs << ",\"malformed\":"
+       << t.malformed << ",\"partial\":" << t.partial << ",\"babble\":" << t.babble
+       << ",\"no_response\":" << no_response(l) << ",\"retries\":" << retries(l) << "},\n \"faults\":[";
+    for (std::size_t i = 0; i < t.faults.size(); ++i)
+      os << (i ? "," : "") << "{\"time_ns\":" << bus::ticks_to_ns(t.faults[i].time)
+         << ",\"text\":" << json_string(t.faults[i].text) << "}";
+    os << "],\n \"masters\":[";
+    for (std::size_t i = 0; i < l.masters.size(); ++i) {
+      const auto& m = l.masters[i];
+      const auto& ro = m.rotation;
+      os << (i ? ",\n  " : "\n  ") << "{\"address\":" << static_cast<int>(m.address)
+         << ",\"state\":" << json_string(m.state) << ",\"tokens_received\":" << m.tokens_received
+         << ",\"tokens_passed\":" << m.tokens_passed << ",\"token_losses\":" << m.token_losses
+         << ",\"claims\":" << m.claims << ",\"rotation\":{\"count\":" << ro.count
+         << ",\"min_ns\":" << bus::ticks_to_ns(ro.min) << ",\"median_ns\":" << bus::ticks_to_ns(ro.median)
+         << ",\"max_ns\":" << bus::ticks_to_ns(ro.max) << ",\"min_bits\":" << ro.min / bit
+         << ",\"median_bits\":" << ro.median / bit << ",\"max_bits\":" << ro.max / bit
+         << "},\"polls\":{\"requests\":" << m.polls.requests << ",\"ok\":" << m.polls.ok
+         << ",\"no_response\":" << m.polls.no_response << ",\"sent\":" << m.polls.sent
+         << ",\"retries\":" << m.polls.retries << ",\"data_octets\":" << m.polls.data_octets << "}}";
+    }
+    os << "],\n \"stations\":[";
+    for (std::size_t i = 0; i < l.stations.size(); ++i) {
+      const auto& s = l.stations[i];
+      os << (i ? "," : "") << "{\"address\":" << static_cast<int>(s.address)
+         << ",\"requests\":" << s.requests << ",\"replies\":" << s.replies
+         << ",\"fdl_status\":" << s.fdl_status << ",\"cycles\":" << s.cycles << "}";
+    }
+    os << "]}";
+  }
+  os << "]}\n";
+}
+
+}  // namespace pbvbus::tools

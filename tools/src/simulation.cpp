@@ -1,0 +1,205 @@
+#include "pbvbus/tools/simulation.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "pbvbus/captures/pcapng_writer.hpp"
+#include "pbvbus/devices/fdl_poller.hpp"
+#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl/passive_station.hpp"
+
+namespace pbvbus::tools {
+
+using bus::Ticks;
+
+namespace {
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31);
+}
+
+fdl::RequestFn request_fn(scenario::Service s, scenario::Priority p) {
+  const bool high = p == scenario::HIGH;
+  switch (s) {
+    case scenario::SDA: return high ? fdl::RequestFn::SdaHigh : fdl::RequestFn::SdaLow;
+    case scenario::SDN: return high ? fdl::RequestFn::SdnHigh : fdl::RequestFn::SdnLow;
+    default: return high ? fdl::RequestFn::SrdHigh : fdl::RequestFn::SrdLow;
+  }
+}
+
+}  // namespace
+
+struct Simulation::Station {
+  StationKind kind = StationKind::Passive;
+  std::uint8_t address = 0;
+  std::unique_ptr<devices::FdlPoller> poller;
+  std::unique_ptr<devices::FdlResponder> responder;
+  std::unique_ptr<fdl::PassiveStation> passive;
+  std::unique_ptr<bus::Device> device;  // masters and attachments without a typed handle
+};
+
+struct Simulation::LineState {
+  std::unique_ptr<bus::Line> line;
+  LineStats stats;
+  std::vector<Station> stations;  // cable order
+};
+
+Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
+    : m_plan(plan), m_opts(opts) {
+  m_duration = opts.duration ? opts.duration : plan.duration;
+  m_seed = opts.seed ? *opts.seed : plan.seed;
+  for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
+}
+
+Simulation::~Simulation() = default;
+
+void Simulation::build_line(std::size_t li) {
+  const PlanLine& pl = m_plan.lines[li];
+  auto ls = std::make_unique<LineState>();
+  ls->line = std::make_unique<bus::Line>(m_sched, pl.name, pl.baud,
+                                         splitmix64(m_seed ^ splitmix64(li + 1)));
+  ls->line->set_index(static_cast<int>(li));
+  ls->stations.reserve(pl.stations.size());
+  for (const PlanStation& ps : pl.stations) {
+    Station st;
+    st.kind = ps.kind;
+    st.address = ps.address.value_or(0);
+    std::string label;
+    switch (ps.kind) {
+      case StationKind::Master: {
+        const auto& m = m_plan.proto.master(ps.source);
+        std::vector<devices::PollItem> items;
+        for (const auto& poll : m.poll())
+          for (std::uint32_t a : poll.address)
+            items.push_back({static_cast<std::uint8_t>(a), request_fn(poll.service(), poll.priority()),
+                             static_cast<std::uint16_t>(poll.length())});
+        st.poller = std::make_unique<devices::FdlPoller>(std::move(items));
+        label = "master " + std::to_string(st.address);
+        throw std::runtime_error("FDL masters need fdl::ActiveStation, not yet in this build");
+      }
+      case StationKind::Passive: {
+        const auto& p = m_plan.proto.passive_station(ps.source);
+        st.responder =
+            std::make_unique<devices::FdlResponder>(static_cast<std::uint16_t>(p.response_length()));
+        st.passive = std::make_unique<fdl::PassiveStation>(
+            st.address, ps.params, *st.responder, p.has_response_delay() ? p.response_delay() : 0);
+        label = "slave " + std::to_string(st.address);
+        ls->line->attach(*st.passive, label);
+        break;
+      }
+      case StationKind::SerialMonitor:
+      case StationKind::SerialStation:
+        throw std::runtime_error("serial attachments need bus::PtyStation, not yet in this build");
+    }
+    ls->stations.push_back(std::move(st));
+  }
+  ls->line->add_tap(ls->stats);
+  if (m_opts.capture != nullptr) {
+    m_opts.capture->add_line(*ls->line);
+    ls->line->add_tap(*m_opts.capture);
+  }
+  m_lines.push_back(std::move(ls));
+}
+
+const devices::FdlPoller* Simulation::poller(std::size_t li, std::uint8_t addr) const {
+  for (const auto& s : m_lines.at(li)->stations)
+    if (s.kind == StationKind::Master && s.address == addr) return s.poller.get();
+  return nullptr;
+}
+
+const devices::FdlResponder* Simulation::responder(std::size_t li, std::uint8_t addr) const {
+  for (const auto& s : m_lines.at(li)->stations)
+    if (s.kind == StationKind::Passive && s.address == addr) return s.responder.get();
+  return nullptr;
+}
+
+void Simulation::start() {
+  if (m_started) return;
+  m_started = true;
+  for (auto& ls : m_lines) ls->line->start();
+  schedule_faults();
+}
+
+void Simulation::schedule_faults() {
+  for (const PlanFault& f : m_plan.faults) {
+    if (m_duration && f.at > *m_duration) {
+      m_not_reached.push_back(f.description + " at " + bus::format_duration(f.at));
+      continue;
+    }
+    m_sched.schedule(f.at, [this, &f] { apply_fault(f, true); });
+    if (f.repair_at) {
+      if (m_duration && *f.repair_at > *m_duration) {
+        m_not_reached.push_back("repair of " + f.description + " at " +
+                                bus::format_duration(*f.repair_at));
+      } else {
+        m_sched.schedule(*f.repair_at, [this, &f] { apply_fault(f, false); });
+      }
+    }
+  }
+}
+
+void Simulation::apply_fault(const PlanFault& f, bool on) {
+  bus::Line& l = *m_lines.at(static_cast<std::size_t>(f.line))->line;
+  using K = PlanFault::Kind;
+  switch (f.kind) {
+    case K::CableCut: l.set_cut_between(f.a, f.b, on); break;
+    case K::ShortCircuit: l.set_short_circuit(on); break;
+    case K::Noise: l.set_noise(on ? f.noise_ppb : 0); break;
+    case K::PowerLoss: l.set_power(f.a, !on); break;
+    case K::TransceiverFailure: l.set_transceiver_ok(f.a, !on); break;
+    case K::Babble: l.set_babbling(f.a, on); break;
+  }
+}
+
+void Simulation::run_until(Ticks t) {
+  start();
+  m_sched.run_until(t);
+}
+
+Report Simulation::report(double wall_seconds) const {
+  Report r;
+  r.name = m_plan.name;
+  r.file = m_plan.file;
+  r.seed = m_seed;
+  r.duration = m_sched.now();
+  r.wall_seconds = wall_seconds;
+  r.events = m_sched.events_run();
+  r.serial = m_serial;
+  r.faults_not_reached = m_not_reached;
+  for (std::size_t li = 0; li < m_lines.size(); ++li) {
+    const LineState& ls = *m_lines[li];
+    const PlanLine& pl = m_plan.lines[li];
+    LineReport lr;
+    lr.name = pl.name;
+    lr.baud = pl.baud;
+    lr.params = pl.params;
+    lr.traffic = ls.stats;
+    for (const Station& s : ls.stations) {
+      if (s.kind == StationKind::Master) {
+        MasterReport m;
+        m.address = s.address;
+        m.tokens_received = s.poller->tokens();
+        m.tokens_passed = ls.stats.tokens_by_sa[s.address];
+        m.rotation = rotation_stats(s.poller->rotation_times());
+        m.polls = s.poller->total();
+        lr.masters.push_back(std::move(m));
+      } else if (s.kind == StationKind::Passive) {
+        StationReport sr;
+        sr.address = s.address;
+        const auto& ps = s.passive->stats();
+        sr.requests = ps.requests;
+        sr.replies = ps.replies;
+        sr.fdl_status = ps.fdl_status;
+        sr.cycles = s.responder->cycle();
+        lr.stations.push_back(sr);
+      }
+    }
+    r.lines.push_back(std::move(lr));
+  }
+  return r;
+}
+
+}  // namespace pbvbus::tools

@@ -142,9 +142,12 @@ TEST(ScenarioParser, BaudMustBeAProfibusRate) {
 
 TEST(ScenarioParser, BusParameterViolations) {
   // max TSDR + 15 <= TSL (protocol-facts.md §C.1).
-  const auto errs = errors_of("line { name: \"A\"\n  bus_params { tsl: 100 } }\n");
-  ASSERT_EQ(errs.size(), 1u);
-  EXPECT_EQ(errs[0].rfind("s.textproto:2:3: bus parameters of line \"A\": ", 0), 0u) << errs[0];
+  EXPECT_EQ(errors_of("line { name: \"A\"\n  bus_params { tsl: 100 } }\n"),
+            Errs{"s.textproto:2:3: bus parameters of line \"A\": TSL 100 must be at least max "
+                 "TSDR + 15 = 165"});
+  // A master's overrides are checked on top of its line's parameters.
+  EXPECT_EQ(errors_of(kLine + "master { address: 1 line: \"A\" bus_params { ttr: 100 } }\n"),
+            Errs{"s.textproto:2:31: bus parameters of master 1: TTR 100 must be at least 256"});
   EXPECT_EQ(errors_of("line { name: \"A\" bus_params { hsa: 127 } }\n"),
             Errs{"s.textproto:1:31: hsa 127 is out of range 1..126"});
   EXPECT_EQ(errors_of("line { name: \"A\" bus_params { max_retry: 16 } }\n"),

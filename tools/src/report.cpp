@@ -105,8 +105,12 @@ void write_text(const Report& r, std::ostream& os) {
     for (const auto& m : l.masters) {
       os << "  master " << static_cast<int>(m.address);
       if (!m.state.empty()) os << " (" << m.state << ")";
-      os << ": tokens received " << m.tokens_received << ", passed " << m.tokens_passed
-         << ", losses " << m.token_losses << ", claims " << m.claims << "\n";
+      os << ": " << (m.in_ring ? "in the ring" : "not in the ring") << ", LAS {";
+      for (std::size_t i = 0; i < m.las.size(); ++i) os << (i ? " " : "") << static_cast<int>(m.las[i]);
+      os << "}\n    tokens received " << m.tokens_received << ", passed " << m.tokens_passed
+         << " (" << m.token_pass_retries << " repeated), token losses/claims " << m.token_losses
+         << ", stations dropped " << m.stations_dropped << ", admitted " << m.admissions
+         << ", duplicate tokens " << m.duplicate_tokens << ", GAP polls " << m.gap_polls << "\n";
       if (m.rotation.count > 0) {
         os << "    token rotation (" << m.rotation.count << "): min " << us(m.rotation.min)
            << " / median " << us(m.rotation.median) << " / max " << us(m.rotation.max)
@@ -198,9 +202,14 @@ void write_json(const Report& r, std::ostream& os) {
       const auto& m = l.masters[i];
       const auto& ro = m.rotation;
       os << (i ? ",\n  " : "\n  ") << "{\"address\":" << static_cast<int>(m.address)
-         << ",\"state\":" << json_string(m.state) << ",\"tokens_received\":" << m.tokens_received
-         << ",\"tokens_passed\":" << m.tokens_passed << ",\"token_losses\":" << m.token_losses
-         << ",\"claims\":" << m.claims << ",\"rotation\":{\"count\":" << ro.count
+         << ",\"state\":" << json_string(m.state) << ",\"in_ring\":" << (m.in_ring ? "true" : "false")
+         << ",\"las\":[";
+      for (std::size_t k = 0; k < m.las.size(); ++k) os << (k ? "," : "") << static_cast<int>(m.las[k]);
+      os << "],\"tokens_received\":" << m.tokens_received << ",\"tokens_passed\":" << m.tokens_passed
+         << ",\"token_pass_retries\":" << m.token_pass_retries << ",\"stations_dropped\":"
+         << m.stations_dropped << ",\"token_losses\":" << m.token_losses << ",\"admissions\":"
+         << m.admissions << ",\"duplicate_tokens\":" << m.duplicate_tokens << ",\"gap_polls\":"
+         << m.gap_polls << ",\"rotation\":{\"count\":" << ro.count
          << ",\"min_ns\":" << bus::ticks_to_ns(ro.min) << ",\"median_ns\":" << bus::ticks_to_ns(ro.median)
          << ",\"max_ns\":" << bus::ticks_to_ns(ro.max) << ",\"min_bits\":" << ro.min / bit
          << ",\"median_bits\":" << ro.median / bit << ",\"max_bits\":" << ro.max / bit

@@ -1,11 +1,13 @@
 #include "pbvbus/tools/simulation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/devices/fdl_poller.hpp"
 #include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl/active_station.hpp"
 #include "pbvbus/fdl/passive_station.hpp"
 
 namespace pbvbus::tools {
@@ -38,6 +40,8 @@ struct Simulation::Station {
   std::unique_ptr<devices::FdlPoller> poller;
   std::unique_ptr<devices::FdlResponder> responder;
   std::unique_ptr<fdl::PassiveStation> passive;
+  std::unique_ptr<fdl::ActiveStation> active;
+  bus::AttachmentId position = -1;
   std::unique_ptr<bus::Device> device;  // masters and attachments without a typed handle
 };
 
@@ -73,12 +77,14 @@ void Simulation::build_line(std::size_t li) {
         const auto& m = m_plan.proto.master(ps.source);
         std::vector<devices::PollItem> items;
         for (const auto& poll : m.poll())
-          for (std::uint32_t a : poll.address)
+          for (std::uint32_t a : poll.address())
             items.push_back({static_cast<std::uint8_t>(a), request_fn(poll.service(), poll.priority()),
                              static_cast<std::uint16_t>(poll.length())});
         st.poller = std::make_unique<devices::FdlPoller>(std::move(items));
+        st.active = std::make_unique<fdl::ActiveStation>(st.address, ps.params, *st.poller);
         label = "master " + std::to_string(st.address);
-        throw std::runtime_error("FDL masters need fdl::ActiveStation, not yet in this build");
+        st.position = ls->line->attach(*st.active, label);
+        break;
       }
       case StationKind::Passive: {
         const auto& p = m_plan.proto.passive_station(ps.source);
@@ -87,7 +93,7 @@ void Simulation::build_line(std::size_t li) {
         st.passive = std::make_unique<fdl::PassiveStation>(
             st.address, ps.params, *st.responder, p.has_response_delay() ? p.response_delay() : 0);
         label = "slave " + std::to_string(st.address);
-        ls->line->attach(*st.passive, label);
+        st.position = ls->line->attach(*st.passive, label);
         break;
       }
       case StationKind::SerialMonitor:
@@ -103,6 +109,9 @@ void Simulation::build_line(std::size_t li) {
   }
   m_lines.push_back(std::move(ls));
 }
+
+bus::Line& Simulation::line(std::size_t i) { return *m_lines.at(i)->line; }
+const LineStats& Simulation::stats(std::size_t i) const { return m_lines.at(i)->stats; }
 
 const devices::FdlPoller* Simulation::poller(std::size_t li, std::uint8_t addr) const {
   for (const auto& s : m_lines.at(li)->stations)
@@ -177,15 +186,35 @@ Report Simulation::report(double wall_seconds) const {
     lr.baud = pl.baud;
     lr.params = pl.params;
     lr.traffic = ls.stats;
+    std::array<int, 128> live;
+    live.fill(-1);
     for (const Station& s : ls.stations) {
       if (s.kind == StationKind::Master) {
+        const fdl::ActiveStats& as = s.active->stats();
         MasterReport m;
         m.address = s.address;
-        m.tokens_received = s.poller->tokens();
-        m.tokens_passed = ls.stats.tokens_by_sa[s.address];
+        m.state = std::string(fdl::to_string(s.active->state()));
+        m.in_ring = s.active->in_ring();
+        m.las = s.active->las();
+        m.tokens_received = as.tokens_received;
+        m.tokens_passed = as.tokens_passed;
+        m.token_pass_retries = as.token_pass_retries;
+        m.stations_dropped = as.stations_dropped;
+        m.token_losses = as.token_losses;
+        m.admissions = as.admissions;
+        m.duplicate_tokens = as.duplicate_token;
+        m.gap_polls = as.gap_polls;
         m.rotation = rotation_stats(s.poller->rotation_times());
         m.polls = s.poller->total();
         lr.masters.push_back(std::move(m));
+        // Live list: what the masters know from their GAP polls and LAS, merged; the master
+        // itself by its own state. Knowledge of a powered-off master is left out (stale).
+        if (!ls.line->powered(s.position)) continue;
+        live[s.address] = std::max(live[s.address], s.active->in_ring()
+                                                        ? int(fdl::StationType::MasterInRing)
+                                                        : int(fdl::StationType::MasterNotReady));
+        for (const auto& [addr, type] : s.active->live_list())
+          if (addr < 128) live[addr] = std::max(live[addr], int(type));
       } else if (s.kind == StationKind::Passive) {
         StationReport sr;
         sr.address = s.address;
@@ -197,6 +226,9 @@ Report Simulation::report(double wall_seconds) const {
         lr.stations.push_back(sr);
       }
     }
+    for (int a = 0; a < 128; ++a)
+      if (live[a] >= 0)
+        lr.live.push_back({static_cast<std::uint8_t>(a), static_cast<fdl::StationType>(live[a])});
     r.lines.push_back(std::move(lr));
   }
   return r;

@@ -25,8 +25,10 @@
 //       "errors": { "error_frames","collisions","parity","bad_fcs","malformed","partial",
 //                   "babble","no_response","retries": int },
 //       "faults": [ { "time_ns": int, "text": str } ],   // faults and repairs as applied
-//       "masters": [ { "address": int, "state": str, "tokens_received","tokens_passed",
-//                      "token_losses","claims": int,
+//       "masters": [ { "address": int, "state": str, "in_ring": bool, "las": [int],
+//                      "tokens_received","tokens_passed","token_pass_retries",
+//                      "stations_dropped","token_losses","admissions","duplicate_tokens",
+//                      "gap_polls": int,
 //                      "rotation": { "count": int, "min_ns","median_ns","max_ns": int,
 //                                    "min_bits","median_bits","max_bits": int },
 //                      "polls": { "requests","ok","no_response","sent","retries",
@@ -34,8 +36,10 @@
 //       "stations": [ { "address": int, "requests","replies","fdl_status","cycles": int } ]
 //     } ] }
 //
-// Rotation statistics leave out the first token a master receives after power-on or after
-// (re)entering the ring: its "rotation" includes the time the master spent outside the ring.
+// Token rotation times are the real rotation times (TRR) the master measured at each token
+// receipt over the whole run, so the maximum includes rotations disturbed by faults (a ring
+// re-forming after a cut); the median is the figure for the undisturbed ring. A token loss is
+// a TTO expiry, after which the master claims the token: "token_losses" counts both.
 
 #include <cstdint>
 #include <iosfwd>
@@ -62,10 +66,16 @@ RotationStats rotation_stats(std::vector<bus::Ticks> samples);
 struct MasterReport {
   std::uint8_t address = 0;
   std::string state;  ///< MAC state at the end, e.g. "Active_Idle"
+  bool in_ring = false;
+  std::vector<std::uint8_t> las;  ///< its list of active stations at the end
   std::uint64_t tokens_received = 0;
-  std::uint64_t tokens_passed = 0;
-  std::uint64_t token_losses = 0;
-  std::uint64_t claims = 0;
+  std::uint64_t tokens_passed = 0;       ///< token frames sent, incl. repeats and claims
+  std::uint64_t token_pass_retries = 0;  ///< token passes repeated (no activity from NS)
+  std::uint64_t stations_dropped = 0;    ///< NS removed from the LAS after failed passes
+  std::uint64_t token_losses = 0;        ///< token lost (TTO expired) and claimed
+  std::uint64_t admissions = 0;          ///< masters admitted to the ring by this one
+  std::uint64_t duplicate_tokens = 0;    ///< token dropped on hearing a second token holder
+  std::uint64_t gap_polls = 0;
   RotationStats rotation;
   devices::PollStats polls;
 };

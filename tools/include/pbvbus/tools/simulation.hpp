@@ -56,8 +56,8 @@ class Simulation {
   const ScenarioPlan& plan() const { return m_plan; }
 
   std::size_t line_count() const { return m_lines.size(); }
-  bus::Line& line(std::size_t i) { return *m_lines.at(i)->line; }
-  const LineStats& stats(std::size_t i) const { return m_lines.at(i)->stats; }
+  bus::Line& line(std::size_t i);
+  const LineStats& stats(std::size_t i) const;
   /// The traffic user of master `addr` on line `li`, or nullptr.
   const devices::FdlPoller* poller(std::size_t li, std::uint8_t addr) const;
   /// The user of passive station `addr` on line `li`, or nullptr.

@@ -68,7 +68,9 @@ void FdlPoller::on_confirmation(const fdl::Confirmation& con) {
 void FdlPoller::on_token(bus::Ticks, bus::Ticks trr) {
   ++m_tokens;
   ++m_visit;
-  m_trr.push_back(trr);
+  // The station reports 0 for the first token after power-on or after (re)entering the ring:
+  // there is no previous receipt to measure a rotation from.
+  if (trr > 0) m_trr.push_back(trr);
 }
 
 }  // namespace pbvbus::devices

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <sys/stat.h>
+#include <sys/wait.h>
 
 #include "pbvbus/tools/commands.hpp"
 
@@ -30,7 +32,7 @@ std::string write_temp(const std::string& name, const std::string& text) {
 }
 
 /// Runs a shell command, returns its exit status and stdout.
-[[maybe_unused]] std::pair<int, std::string> shell(const std::string& cmd) {
+std::pair<int, std::string> shell(const std::string& cmd) {
   std::string out;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (p == nullptr) return {-1, ""};
@@ -113,6 +115,70 @@ TEST(CmdRun, CaptureThatCannotBeWrittenIsAUsageError) {
   EXPECT_EQ(r.rc, 2);
   EXPECT_EQ(r.err.rfind("pbvbus run: cannot write the capture /nonexistent/dir/x.pcapng: ", 0), 0u)
       << r.err;
+}
+
+TEST(CmdRun, DefaultScenarioRunsAndReports) {
+  const auto r = run({});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_EQ(r.out.rfind("scenario default (<built-in default>), seed 1\nsimulated 2.000 s in ", 0), 0u)
+      << r.out;
+  // Two masters in one ring, four slaves; station 12's power loss and return are reported.
+  EXPECT_NE(r.out.find("  live list:\n    1\tmaster in ring\n    2\tmaster in ring\n"
+                       "    10\tslave\n    11\tslave\n    12\tslave\n    13\tslave\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("  fault at 1.000 s: A: power off: 'slave 12'\n"
+                       "  fault at 1.500 s: A: power on: 'slave 12'\n"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST(CmdRun, QuietPrintsNothing) {
+  const auto r = run({"--quiet", "--duration", "50ms"});
+  EXPECT_EQ(r.rc, 0);
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(CmdRun, JsonReportIsValidJsonWithTheDocumentedSchema) {
+  const auto r = run({PBVBUS_SOURCE_DIR "/examples/multimaster.textproto", "--json", "--seed", "9"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const std::string path = write_temp("cmd_run_report.json", r.out);
+  const auto [rc, out] = shell(
+      "python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); l=d[\"lines\"][0]; "
+      "print(d[\"schema\"], d[\"scenario\"][\"seed\"], d[\"duration_ns\"], l[\"name\"], l[\"baud\"], "
+      "[m[\"address\"] for m in l[\"masters\"]], [s[\"address\"] for s in l[\"stations\"]], "
+      "[(e[\"address\"], e[\"type\"]) for e in l[\"live_list\"]][:4], len(l[\"faults\"]), "
+      "l[\"frames\"][\"total\"] == sum(l[\"frames\"][k] for k in (\"SD1\",\"SD2\",\"SD3\",\"SD4\",\"SC\",\"garbage\")), "
+      "l[\"masters\"][0][\"rotation\"][\"median_bits\"] > 0)' " +
+      path);
+  ASSERT_EQ(rc, 0) << r.out;
+  EXPECT_EQ(out,
+            "pbvbus.run.report/1 9 5000000000 A 1500000 [1, 2, 3] [10, 11, 12, 13, 14] "
+            "[(1, 'master_in_ring'), (2, 'master_in_ring'), (3, 'master_in_ring'), (10, "
+            "'slave')] 2 True True\n");
+  EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+TEST(CmdRun, CaptureToStdoutSendsTheReportToStderr) {
+  const std::string exe = PBVBUS_BINARY_DIR "/bin/pbvbus";
+  struct stat st;
+  if (::stat(exe.c_str(), &st) != 0) GTEST_SKIP() << exe << " not built";
+  const std::string pcap = PBVBUS_BINARY_DIR "/cmd_run_stdout.pcapng";
+  const std::string errf = PBVBUS_BINARY_DIR "/cmd_run_stdout.err";
+  const auto [rc, out] =
+      shell(exe + " run --duration 100ms --capture - > " + pcap + " 2> " + errf + "; echo $?");
+  EXPECT_EQ(out, "0\n");
+  std::ifstream p(pcap, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(p)), std::istreambuf_iterator<char>());
+  // A pcapng Section Header Block (0x0A0D0D0A), little-endian byte-order magic 0x1A2B3C4D.
+  ASSERT_GE(bytes.size(), 12u);
+  EXPECT_EQ(bytes.substr(0, 4), std::string("\x0A\x0D\x0D\x0A", 4));
+  EXPECT_EQ(bytes.substr(8, 4), std::string("\x4D\x3C\x2B\x1A", 4));
+  std::ifstream e(errf);
+  std::string err((std::istreambuf_iterator<char>(e)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(err.rfind("scenario default (<built-in default>), seed 1\n", 0), 0u) << err;
 }
 
 }  // namespace

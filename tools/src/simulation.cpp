@@ -128,7 +128,12 @@ const devices::FdlResponder* Simulation::responder(std::size_t li, std::uint8_t 
 void Simulation::start() {
   if (m_started) return;
   m_started = true;
-  for (auto& ls : m_lines) ls->line->start();
+  for (auto& ls : m_lines) {
+    ls->line->start();
+    // Powering up is not a fault: only what happens from now on goes into the report (the
+    // capture keeps the power-on events).
+    ls->stats.faults.clear();
+  }
   schedule_faults();
 }
 

@@ -47,7 +47,9 @@ class FdlPoller final : public fdl::InitiatorUser {
   PollStats total() const;
 
   std::uint64_t tokens() const { return m_tokens; }
-  /// Real rotation times reported with each token received, in ticks, in arrival order.
+  /// Real rotation times reported with each token received, in ticks, in arrival order; the
+  /// first token after power-on or ring entry (reported as 0: nothing to measure from) is left
+  /// out.
   const std::vector<bus::Ticks>& rotation_times() const { return m_trr; }
 
   // fdl::InitiatorUser

@@ -1,3 +1,4 @@
+// FDL telegram codec (protocol-facts.md §B; decisions documented in telegram.hpp).
 #include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::fdl {

@@ -247,6 +247,33 @@ TEST(SlaveDpv1, ModuleStatusBlock) {
             (Bytes{0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x42, 0x02, 0x05, 0x82, 0x00, 0x00, 0x08}));
 }
 
+TEST(SlaveDpv1, CheckCfgModeLetsTheUserDecide) {
+  auto c = dpv1_config();
+  c.features.check_cfg_mode = true;
+  std::vector<Bytes> asked;
+  // This device also accepts its output byte declared consistent (A0): same layout.
+  c.check_cfg_user = [&](std::span<const std::uint8_t> cfg) {
+    asked.emplace_back(cfg.begin(), cfg.end());
+    return cfg.size() == 2 && cfg[0] == 0x10 && (cfg[1] == 0x20 || cfg[1] == 0xA0);
+  };
+  SlaveEngine e(c);
+  Harness h(e);
+  // Without Check_Cfg_Mode the strict check applies and the callback is not asked.
+  h.req(kM1, kS, kSapSetPrm, prm(0x80, 0x00, 0x00));
+  h.req(kM1, kS, kSapChkCfg, {0x10, 0xA0});
+  EXPECT_EQ(e.state(), SlaveState::WaitPrm);
+  EXPECT_TRUE(asked.empty());
+  // With Check_Cfg_Mode (DPV1_Status_2 bit 0) the callback decides.
+  h.req(kM1, kS, kSapSetPrm, prm(0x80, 0x01, 0x00));
+  h.req(kM1, kS, kSapChkCfg, {0x10, 0x50});
+  EXPECT_EQ(e.state(), SlaveState::WaitPrm);
+  EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}), (Bytes{0x06, 0x05, 0x00, 0xFF, 0x12, 0x34}));
+  h.req(kM1, kS, kSapSetPrm, prm(0x80, 0x01, 0x00));
+  h.req(kM1, kS, kSapChkCfg, {0x10, 0xA0});
+  EXPECT_EQ(e.state(), SlaveState::DataExch);
+  EXPECT_EQ(asked, (std::vector<Bytes>{{0x10, 0x50}, {0x10, 0xA0}}));
+}
+
 // --- MSAC_C2 ------------------------------------------------------------------------------------
 
 SlaveConfig c2_config() {
@@ -309,6 +336,23 @@ TEST(SlaveDpv1, C2TimesOutAfterTwiceSendTimeout) {
   EXPECT_EQ(h.last.status, ResponseStatus::RS);
   // Malformed Initiate to the resource manager.
   EXPECT_EQ(h.du(kM2, kS, kSapC2ResourceManager, {0x57, 0x00}), (Bytes{0xD7, 0x80, 0xB8, 0x00}));
+}
+
+TEST(SlaveDpv1, C2Write) {
+  SlaveEngine e(c2_config());
+  Bytes written;
+  e.application().on_write(2, 7, [&](const RecordCall& call, std::span<const std::uint8_t> d) {
+    EXPECT_TRUE(call.c2);
+    written.assign(d.begin(), d.end());
+    return RecordResult::ok();
+  });
+  Harness h(e);
+  h.du(kM2, kS, kSapC2ResourceManager, kInitiate);
+  h.du(kM2, kS, 48, kInitiate);
+  EXPECT_EQ(h.du(kM2, kS, 48, {0x5F, 0x02, 0x07, 0x03, 0x01, 0x02, 0x03}),
+            (Bytes{0x5F, 0x02, 0x07, 0x03}));
+  EXPECT_EQ(written, (Bytes{0x01, 0x02, 0x03}));
+  EXPECT_EQ(h.du(kM2, kS, 48, {0x5F, 0x02, 0x08, 0x01, 0x01}), (Bytes{0xDF, 0x80, 0xB0, 0x00}));
 }
 
 }  // namespace

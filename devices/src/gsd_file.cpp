@@ -51,15 +51,20 @@ void write_value(GsdBytes& buf, std::size_t offset, const GsdExtUserPrmData& def
   }
 }
 
+// Builds one area; `settings` are those addressed to this area (already validated).
 GsdBytes build_area(const GsdPrmArea& area, const std::map<std::uint16_t, GsdExtUserPrmData>& defs,
-                    std::size_t length) {
+                    std::size_t length, const std::vector<const GsdPrmSetting*>& settings = {}) {
   GsdBytes buf(length, 0);
   std::copy_n(area.initial.begin(), std::min(area.initial.size(), length), buf.begin());
   for (const auto& c : area.consts)
     for (std::size_t i = 0; i < c.data.size() && c.offset + i < length; ++i) buf[c.offset + i] = c.data[i];
   for (const auto& r : area.refs) {
     auto it = defs.find(r.ref);
-    if (it != defs.end()) write_value(buf, r.offset, it->second, it->second.default_value);
+    if (it == defs.end()) continue;
+    std::int64_t value = it->second.default_value;
+    for (const GsdPrmSetting* s : settings)
+      if (s->ref == r.ref && (!s->offset || *s->offset == r.offset)) value = s->value;
+    write_value(buf, r.offset, it->second, value);
   }
   return buf;
 }
@@ -143,6 +148,11 @@ const GsdKeyword* GsdFile::keyword(std::string_view name) const {
 }
 
 GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modules) const {
+  return user_prm_data(modules, {});
+}
+
+GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modules,
+                                            const std::vector<GsdPrmSetting>& settings) const {
   GsdOutcome<GsdBytes> out;
   for (std::size_t idx : modules)
     if (idx >= m_modules.size())
@@ -150,15 +160,51 @@ GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modu
                            std::to_string(m_modules.size()) + " modules)");
   if (!out.errors.empty()) return out;
 
-  GsdBytes data = build_area(m_global_prm, m_ext_prm, m_global_prm.length(m_ext_prm));
+  // Settings per area: index 0 = station area, 1 + n = the n-th selected module.
+  std::vector<std::vector<const GsdPrmSetting*>> per_area(modules.size() + 1);
+  for (const auto& s : settings) {
+    const std::string where = s.slot ? "slot " + std::to_string(*s.slot) : std::string("the station parameters");
+    if (s.slot && *s.slot >= modules.size()) {
+      out.errors.push_back("setting for " + where + ": only " + std::to_string(modules.size()) +
+                           " modules selected");
+      continue;
+    }
+    auto def = m_ext_prm.find(s.ref);
+    if (def == m_ext_prm.end()) {
+      out.errors.push_back("setting for " + where + ": no ExtUserPrmData " + std::to_string(s.ref));
+      continue;
+    }
+    const std::string what = "ExtUserPrmData " + std::to_string(s.ref) + " '" + def->second.name + "'";
+    const GsdPrmArea& area = s.slot ? m_modules[modules[*s.slot]].prm : m_global_prm;
+    const bool used = std::any_of(area.refs.begin(), area.refs.end(), [&](const GsdPrmRef& r) {
+      return r.ref == s.ref && (!s.offset || *s.offset == r.offset);
+    });
+    if (!used) {
+      out.errors.push_back(what + " is not used in " + where +
+                           (s.offset ? " at offset " + std::to_string(*s.offset) : std::string()));
+      continue;
+    }
+    if (!def->second.changeable && s.value != def->second.default_value) {
+      out.errors.push_back(what + " is not changeable");
+      continue;
+    }
+    if (!def->second.accepts(s.value)) {
+      out.errors.push_back(what + ": value " + std::to_string(s.value) + " not allowed");
+      continue;
+    }
+    per_area[s.slot ? *s.slot + 1 : 0].push_back(&s);
+  }
+  if (!out.errors.empty()) return out;
+
+  GsdBytes data = build_area(m_global_prm, m_ext_prm, m_global_prm.length(m_ext_prm), per_area[0]);
   if (m_dpv1.dpv1_slave && data.size() < 3) {
     static constexpr std::uint8_t kMinimalDpv1Status[3] = {0x80, 0x00, 0x00};
     for (std::size_t i = data.size(); i < 3; ++i) data.push_back(kMinimalDpv1Status[i]);
     out.notes.push_back("DPV1_Status_1..3 not all given by the file; filled with 80 00 00");
   }
-  for (std::size_t idx : modules) {
-    const auto& area = m_modules[idx].prm;
-    GsdBytes part = build_area(area, m_ext_prm, area.length(m_ext_prm));
+  for (std::size_t n = 0; n < modules.size(); ++n) {
+    const auto& area = m_modules[modules[n]].prm;
+    GsdBytes part = build_area(area, m_ext_prm, area.length(m_ext_prm), per_area[n + 1]);
     data.insert(data.end(), part.begin(), part.end());
   }
   if (data.size() > m_max_user_prm_data_len) {
@@ -197,6 +243,9 @@ GsdOutcome<std::pair<std::size_t, std::size_t>> GsdFile::check_modules(
   if (modules.empty()) out.errors.push_back("no module selected");
   std::size_t in = 0;
   std::size_t outp = 0;
+  std::size_t cfg_len = 0;
+  std::size_t prm_len = m_global_prm.length(m_ext_prm);
+  if (m_dpv1.dpv1_slave) prm_len = std::max<std::size_t>(prm_len, 3);
   for (std::size_t idx : modules) {
     if (idx >= m_modules.size()) {
       out.errors.push_back("module index " + std::to_string(idx) + " out of range (" +
@@ -205,6 +254,8 @@ GsdOutcome<std::pair<std::size_t, std::size_t>> GsdFile::check_modules(
     }
     in += m_modules[idx].input_len;
     outp += m_modules[idx].output_len;
+    cfg_len += m_modules[idx].config.size();
+    prm_len += m_modules[idx].prm.length(m_ext_prm);
   }
   if (!m_slave.modular_station && modules.size() > 1)
     out.errors.push_back("a compact station (Modular_Station = 0) takes exactly one module, " +
@@ -221,6 +272,12 @@ GsdOutcome<std::pair<std::size_t, std::size_t>> GsdFile::check_modules(
   if (in + outp > m_slave.max_data_len)
     out.errors.push_back("inputs + outputs of " + std::to_string(in + outp) +
                          " bytes exceed Max_Data_Len " + std::to_string(m_slave.max_data_len));
+  // Chk_Cfg carries at most 244 octets of identifiers (§D.3).
+  if (cfg_len > 244)
+    out.errors.push_back("config data of " + std::to_string(cfg_len) + " bytes exceeds 244");
+  if (prm_len > m_max_user_prm_data_len)
+    out.errors.push_back("User_Prm_Data of " + std::to_string(prm_len) +
+                         " bytes exceeds Max_User_Prm_Data_Len " + std::to_string(m_max_user_prm_data_len));
   if (out.errors.empty()) out.value = std::make_pair(in, outp);
   return out;
 }

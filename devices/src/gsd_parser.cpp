@@ -355,7 +355,7 @@ namespace {
 // Keywords of PI 2.122 that the model does not interpret; kept raw, no warning.
 bool known_raw(std::string_view key) {
   static const std::array<std::string_view, 42> kKnown = {
-      "slave_family",         "bitmap_device",        "bitmap_diag",
+      "bitmap_device",        "bitmap_device",        "bitmap_diag",
       "bitmap_sf",            "unit_diag_not_bit",    "x_unit_diag_bit",
       "x_unit_diag_not_bit",  "unit_diag_bit_help",   "x_unit_diag_bit_help",
       "unit_diag_not_bit_help", "channel_diag_help",  "diag_update_delay",
@@ -882,6 +882,12 @@ void GsdParser::top(const Stmt& s) {
   } else if (k == "max_user_prm_data_len") {
     if (auto v = unsigned_value(s, "Max_User_Prm_Data_Len", 237))
       f.m_max_user_prm_data_len = static_cast<std::uint8_t>(*v);
+  } else if (k == "slave_family") {
+    // "main@sub@...", unquoted in most files; quotes tolerated.
+    if (!need_value(s)) return;
+    std::string v = s.value;
+    if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
+    f.m_info.slave_family = v;
   } else if (baud_keyword(s) || scalar(s)) {
     // handled
   } else if (known_raw(k)) {

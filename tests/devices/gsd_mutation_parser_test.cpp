@@ -150,7 +150,7 @@ TEST(GsdMutation, NeverCrashesAndAlwaysLocatesErrors) {
       for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
       auto p = f.user_prm_data(all);
       ASSERT_TRUE(p.ok());
-      EXPECT_LE(p.value->size(), f.max_user_prm_data_len() < 3 && f.dpv1().dpv1_slave ? 3u : f.max_user_prm_data_len());
+      EXPECT_LE(p.value->size(), f.max_user_prm_data_len());
       auto c = f.cfg_data(all);
       ASSERT_TRUE(c.ok());
       (void)f.check_modules(all);

@@ -90,6 +90,8 @@ TEST(Gsd, CompactStation) {
   EXPECT_EQ(f.info().revision, "V1.0");
   EXPECT_EQ(f.info().gsd_revision, 5);
   EXPECT_EQ(f.info().revision_number, 1);
+  EXPECT_EQ(f.info().slave_family, "3@Digital@24V");
+  EXPECT_EQ(f.info().implementation_type, "VPC3+S");
   // The Info_Text string is continued with a trailing backslash inside the quotes.
   EXPECT_EQ(f.info().info_text,
             "Compact station, 16 digital inputs DC 24 V, 16 digital outputs DC 24 V / 0.5 A");
@@ -360,6 +362,45 @@ TEST(Gsd, UserPrmDataTruncatedToMaxLen) {
   EXPECT_EQ(*o.value, (GsdBytes{0x11, 0x22, 0x33}));
   ASSERT_EQ(o.notes.size(), 1u);
   EXPECT_EQ(o.notes[0], "User_Prm_Data of 4 bytes truncated to Max_User_Prm_Data_Len 3");
+  auto chk = r.file->check_modules({0});
+  ASSERT_EQ(chk.errors.size(), 1u);
+  EXPECT_EQ(chk.errors[0], "User_Prm_Data of 4 bytes exceeds Max_User_Prm_Data_Len 3");
+}
+
+TEST(Gsd, ParameterSettings) {
+  const GsdFile f = load_ok("examples/gsd/PBVB0A02.gsd");
+  const std::vector<std::size_t> sel = {0, 3, 4, 5};  // 8DI, 16DO, 4AI, 2AO
+  // Station Bit(0) off; 4AI channel 1 (offset 1) 4..20 mA (3), smoothing 500 ms = 0x01F4;
+  // 2AO both channels 0..20 mA (4).
+  auto o = f.user_prm_data(sel, {{std::nullopt, 1, 0, std::nullopt},
+                                 {2, 20, 3, std::uint16_t{1}},
+                                 {2, 21, 500, std::nullopt},
+                                 {3, 30, 4, std::nullopt}});
+  ASSERT_TRUE(o.ok()) << o.errors[0];
+  EXPECT_EQ(*o.value, (GsdBytes{0x00, 0x01, 0x00, 0x02, 0x03, 0x02, 0x02, 0x01, 0xF4, 0x04, 0x04}));
+
+  auto bad = f.user_prm_data(sel, {{3, 30, 0, std::nullopt},
+                                   {0, 20, 1, std::nullopt},
+                                   {9, 20, 1, std::nullopt},
+                                   {std::nullopt, 99, 1, std::nullopt},
+                                   {2, 20, 1, std::uint16_t{4}}});
+  ASSERT_EQ(bad.errors.size(), 5u);
+  EXPECT_EQ(bad.errors[0], "ExtUserPrmData 30 'Output range': value 0 not allowed");
+  EXPECT_EQ(bad.errors[1], "ExtUserPrmData 20 'Measuring range' is not used in slot 0");
+  EXPECT_EQ(bad.errors[2], "setting for slot 9: only 4 modules selected");
+  EXPECT_EQ(bad.errors[3], "setting for the station parameters: no ExtUserPrmData 99");
+  EXPECT_EQ(bad.errors[4], "ExtUserPrmData 20 'Measuring range' is not used in slot 2 at offset 4");
+  EXPECT_FALSE(bad.value);
+
+  GsdParseResult v = load_gsd(src("tests/data/gsd/VNDR4711.gsd"));
+  ASSERT_TRUE(v.ok());
+  auto fixed = v.file->user_prm_data({0}, {{0, 4, 2000, std::nullopt}});
+  ASSERT_EQ(fixed.errors.size(), 1u);
+  EXPECT_EQ(fixed.errors[0], "ExtUserPrmData 4 'Pulsdauer [ms]' is not changeable");
+  // Setting the default of a fixed parameter is fine; Signed16 -1000 = 0xFC18.
+  auto ok = v.file->user_prm_data({0, 2}, {{0, 4, 100000, std::nullopt}, {1, 5, -1000, std::nullopt}});
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(*ok.value, (GsdBytes{0x34, 0x00, 0x00, 0x00, 0xA5, 0x00, 0x01, 0x86, 0xA0, 0xFC, 0x18}));
 }
 
 TEST(Gsd, Dpv1StatusFilledWhenTheFileGivesNone) {

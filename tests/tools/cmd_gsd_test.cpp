@@ -97,6 +97,16 @@ TEST(CmdGsd, VendorFileWarningsGoToStderr) {
                               "Slave_Max_Switch_Over_Time 100"));
 }
 
+TEST(CmdGsd, MasterFile) {
+  GsdRun r = run({src("tests/data/gsd/PBVB0AFF.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(has_line(r.out, "Station_Type:       1 (DP master)"));
+  EXPECT_TRUE(has_line(r.out, "  Max_Slaves_supp 124"));
+  EXPECT_TRUE(has_line(r.out, "  Tsdi_12M 76"));
+  EXPECT_TRUE(has_line(r.out, "Modules (0):"));
+}
+
 TEST(CmdGsd, BrokenFileExits2WithFileLineReason) {
   const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_broken.gsd";
   {
@@ -116,7 +126,7 @@ TEST(CmdGsd, BrokenFileExits2WithFileLineReason) {
 
 TEST(CmdGsd, JsonIsValid) {
   for (const char* rel : {"examples/gsd/PBVB0A01.gsd", "examples/gsd/PBVB0A02.gsd", "examples/gsd/PBVB0A03.gsd",
-                          "tests/data/gsd/VNDR4711.gsd"}) {
+                          "tests/data/gsd/VNDR4711.gsd", "tests/data/gsd/PBVB0AFF.gsd"}) {
     GsdRun r = run({src(rel), "--json"});
     ASSERT_EQ(r.rc, 0) << rel;
     const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_test.json";
@@ -127,7 +137,8 @@ TEST(CmdGsd, JsonIsValid) {
     // json.tool rejects anything that is not one valid JSON document.
     const std::string cmd =
         "python3 -c \"import json,sys; d=json.load(open(sys.argv[1])); "
-        "print(d['ident_number'], len(d['modules']), d['modules'][0]['config'][0], d['baud_rates'][-1]['max_tsdr'])\" " +
+        "m=d['modules']; print(d['ident_number'], len(m), m[0]['config'][0] if m else '-', "
+        "d['baud_rates'][-1]['max_tsdr'], d['master']['tsdi'].get('12M', '-'))\" " +
         path;
     FILE* p = popen(cmd.c_str(), "r");
     ASSERT_NE(p, nullptr);
@@ -138,11 +149,13 @@ TEST(CmdGsd, JsonIsValid) {
     const std::string line(buf, n);
     const std::string name(rel);
     if (name == "examples/gsd/PBVB0A01.gsd") {
-      EXPECT_EQ(line, "2561 1 17 800\n");
+      EXPECT_EQ(line, "2561 1 17 800 -\n");
     } else if (name == "examples/gsd/PBVB0A02.gsd") {
-      EXPECT_EQ(line, "2562 6 16 800\n");
+      EXPECT_EQ(line, "2562 6 16 800 -\n");
     } else if (name == "tests/data/gsd/VNDR4711.gsd") {
-      EXPECT_EQ(line, "18193 4 32 800\n");
+      EXPECT_EQ(line, "18193 4 32 800 -\n");
+    } else if (name == "tests/data/gsd/PBVB0AFF.gsd") {
+      EXPECT_EQ(line, "2815 0 - 800 76\n");
     }
     std::remove(path.c_str());
   }

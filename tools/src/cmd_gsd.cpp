@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -165,6 +166,16 @@ void print_text(const GsdFile& f, std::ostream& out) {
     out << "  WD_Base_1ms_supp " << yn(d.wd_base_1ms_supp) << ", Check_Cfg_Mode "
         << yn(d.check_cfg_mode) << ", Ident_Maintenance_supp " << yn(d.ident_maintenance_supp) << "\n";
   }
+  if (f.is_master()) {
+    const auto& m = f.master();
+    out << "\nMaster:\n";
+    if (m.max_slaves_supp) out << "  Max_Slaves_supp " << int(*m.max_slaves_supp) << "\n";
+    if (m.min_poll_timeout) out << "  Min_Poll_Timeout " << *m.min_poll_timeout << "\n";
+    out << "  DPV1_Master " << yn(m.dpv1_master) << ", C1_Master_Read_Write_supp "
+        << yn(m.c1_master_read_write_supp) << "\n";
+    for (const auto& [baud, trdy] : m.trdy) out << "  Trdy_" << bus::baud_name(baud) << " " << trdy << "\n";
+    for (const auto& [baud, tsdi] : m.tsdi) out << "  Tsdi_" << bus::baud_name(baud) << " " << tsdi << "\n";
+  }
   const auto& r = f.redundancy();
   out << "\nRedundancy:         Redundancy " << yn(r.redundancy) << ", PrmCmd_supp " << yn(r.prm_cmd_supp)
       << ", Slave_Redundancy_supp " << int(r.slave_redundancy_supp)
@@ -221,6 +232,7 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   out << "  \"hardware_release\": " << js(i.hardware_release) << ",\n";
   out << "  \"software_release\": " << js(i.software_release) << ",\n";
   out << "  \"order_number\": " << js(i.order_number) << ",\n";
+  out << "  \"slave_family\": " << js(i.slave_family) << ",\n";
   out << "  \"info_text\": " << js(i.info_text) << ",\n";
   out << "  \"baud_rates\": [";
   for (std::size_t n = 0; n < f.baud_rates().size(); ++n) {
@@ -296,6 +308,24 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   out << "  \"redundancy\": {\"redundancy\": " << jb(r.redundancy) << ", \"prm_cmd_supp\": " << jb(r.prm_cmd_supp)
       << ", \"slave_redundancy_supp\": " << int(r.slave_redundancy_supp)
       << ", \"slave_max_switch_over_time\": " << r.slave_max_switch_over_time << "},\n";
+  const auto& m = f.master();
+  auto opt = [](const auto& o) { return o ? std::to_string(*o) : std::string("null"); };
+  auto per_baud = [](const std::map<bus::Baud, std::uint16_t>& mp) {
+    std::string o = "{";
+    for (const auto& [b, v] : mp) o += (o.size() > 1 ? ", " : "") + js(bus::baud_name(b)) + ": " + std::to_string(v);
+    return o + "}";
+  };
+  out << "  \"master\": {\"is_master\": " << jb(f.is_master()) << ", \"max_slaves_supp\": " << opt(m.max_slaves_supp)
+      << ", \"min_poll_timeout\": " << opt(m.min_poll_timeout) << ", \"dpv1_master\": " << jb(m.dpv1_master)
+      << ", \"c1_master_read_write_supp\": " << jb(m.c1_master_read_write_supp) << ", \"trdy\": " << per_baud(m.trdy)
+      << ", \"tqui\": " << per_baud(m.tqui) << ", \"tset\": " << per_baud(m.tset) << ", \"tsdi\": " << per_baud(m.tsdi)
+      << "},\n";
+  out << "  \"unknown_keywords\": [";
+  for (std::size_t n = 0; n < f.unknown_keywords().size(); ++n) {
+    const auto& k = f.unknown_keywords()[n];
+    out << (n ? ", " : "") << "{\"name\": " << js(k.name) << ", \"value\": " << js(k.value) << ", \"line\": " << k.line << "}";
+  }
+  out << "],\n";
   out << "  \"warnings\": [";
   for (std::size_t n = 0; n < warnings.size(); ++n) out << (n ? ", " : "") << js(warnings[n].to_string());
   out << "]\n}\n";

@@ -270,6 +270,16 @@ struct GsdMasterFeatures {
   bool act_param_supp = false;
 };
 
+/// A parameter value other than the default, for user_prm_data(). `slot` is nullopt for the
+/// station (global) area, otherwise the position in the module list passed alongside. The value
+/// goes to every Ext_User_Prm_Data_Ref(o) = ref of that area, or only to the one at `offset`.
+struct GsdPrmSetting {
+  std::optional<std::size_t> slot;
+  std::uint16_t ref = 0;
+  std::int64_t value = 0;
+  std::optional<std::uint16_t> offset;
+};
+
 /// Result of an assembly or a check on a module selection.
 template <class T>
 struct GsdOutcome {
@@ -325,12 +335,18 @@ class GsdFile {
   /// User_Prm_Data for Set_Prm (octets 8..) with every parameter at its default, for the modules
   /// at these indices (into modules()), in this order (§I.1). Errors: an index out of range.
   GsdOutcome<GsdBytes> user_prm_data(const std::vector<std::size_t>& modules) const;
+  /// The same with some parameters set to other values. Errors: a value the ExtUserPrmData does
+  /// not allow, a parameter that is not Changeable, a setting that matches no reference in its
+  /// area, a slot beyond the module list.
+  GsdOutcome<GsdBytes> user_prm_data(const std::vector<std::size_t>& modules,
+                                     const std::vector<GsdPrmSetting>& settings) const;
   /// The bytes one parameter area (global_prm() or a module's prm) contributes, all defaults.
   GsdBytes prm_area_defaults(const GsdPrmArea& area) const;
   /// Chk_Cfg data: the concatenated config bytes of these modules. Errors: index out of range.
   GsdOutcome<GsdBytes> cfg_data(const std::vector<std::size_t>& modules) const;
-  /// Checks a module selection against Max_Module, Max_Input_Len, Max_Output_Len, Max_Data_Len
-  /// (and, for a non-modular station, that exactly one module is chosen). value = {in, out}.
+  /// Checks a module selection against Max_Module, Max_Input_Len, Max_Output_Len, Max_Data_Len,
+  /// Max_User_Prm_Data_Len and the 244-byte Chk_Cfg limit (and, for a non-modular station, that
+  /// exactly one module is chosen). value = {input bytes, output bytes}.
   GsdOutcome<std::pair<std::size_t, std::size_t>> check_modules(
       const std::vector<std::size_t>& modules) const;
 

@@ -189,6 +189,52 @@ TEST(TelegramFc, RoundTripEveryFrameType) {
   EXPECT_EQ(encode_as(FrameType::SC, cases[0].spec, f), EncodeError::WrongFrameType);
 }
 
+TEST(TelegramFc, EveryValidFcInEveryFrameTypeWithAnFc) {
+  // Each valid request and response FC octet through SD1, SD2 (1 and 8 data octets) and SD3:
+  // encode_as() gives the hand-built frame, decode() returns the same FC and data.
+  const Bytes d8{1, 2, 3, 4, 5, 6, 7, 8};
+  std::size_t checked = 0;
+  for (unsigned v = 0; v < 256; ++v) {
+    const auto fc = static_cast<std::uint8_t>(v);
+    const bool valid = fc_is_request(fc) ? (request_fn_valid(fc) && (!(fc & 0x80) || fc == 0xC0))
+                                         : (!(fc & 0x80) && response_status_valid(fc));
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{8}}) {
+      for (const FrameType type : {FrameType::SD1, FrameType::SD2, FrameType::SD3}) {
+        if ((type == FrameType::SD1) != (n == 0) || (type == FrameType::SD3 && n != 8)) continue;
+        Bytes want;
+        Bytes body{10, 1, fc};
+        body.insert(body.end(), d8.begin(), d8.begin() + static_cast<std::ptrdiff_t>(n));
+        if (type == FrameType::SD2) {
+          want = sd2(body);
+        } else {
+          want = {type == FrameType::SD1 ? std::uint8_t{0x10} : std::uint8_t{0xA2}};
+          want.insert(want.end(), body.begin(), body.end());
+          want.push_back(sum8(body));
+          want.push_back(0x16);
+        }
+        Frame f;
+        const FrameSpec s{.da = 10, .sa = 1, .fc = fc, .data = std::span(d8).first(n)};
+        if (!valid) {
+          EXPECT_EQ(encode_as(type, s, f), EncodeError::BadFunction) << int(fc);
+          EXPECT_NE(dec(want), DecodeError::None) << to_hex(want);
+          continue;
+        }
+        ASSERT_EQ(encode_as(type, s, f), EncodeError::None) << int(fc);
+        EXPECT_EQ(to_hex(f.bytes()), to_hex(want));
+        Telegram t;
+        ASSERT_EQ(decode(want, t), DecodeError::None) << to_hex(want);
+        EXPECT_EQ(t.type, type);
+        EXPECT_EQ(t.fc, fc);
+        EXPECT_EQ(t.data.size(), n);
+        ++checked;
+      }
+    }
+  }
+  // 11 request functions x 4 FCB/FCV + clock value, 4 station types x 9 statuses; 4 shapes each
+  // (SD1; SD2 with 1 octet; SD2 and SD3 with 8 octets).
+  EXPECT_EQ(checked, (11u * 4 + 1 + 4 * 9) * 4);
+}
+
 // --- addresses and broadcast ------------------------------------------------------------------
 
 TEST(TelegramAddress, BroadcastOnlyWithSdnOrTimeEvent) {

@@ -94,6 +94,18 @@ local channel_types = {
   [6] = "2 words", [7] = "reserved",
 }
 local channel_dirs = { [0] = "reserved", [1] = "input", [2] = "output", [3] = "input/output" }
+local prm_block_types = {
+  [0x02] = "PrmCmd", [0x03] = "DXB link table", [0x04] = "Isochronous mode",
+  [0x07] = "DXB subscriber table", [0x08] = "Time AR", [0x81] = "User prm data",
+}
+local red_state_bits = {
+  { 0x01, "Backup" }, { 0x02, "Primary" }, { 0x04, "Hardware_defective" }, { 0x08, "Data_Exchange" },
+  { 0x10, "Master_State_Clear" }, { 0x20, "Baudrate_found" }, { 0x40, "Output_Hold_Time_started" },
+}
+local red_function_bits = {
+  { 0x02, "Primary_Request" }, { 0x04, "Stop_MSAC1S" }, { 0x08, "Start_MSAC1S" },
+  { 0x10, "Check_Properties" }, { 0x40, "Master_State_Clear" },
+}
 local abort_subnets = { [0] = "none", [1] = "local", [2] = "remote" }
 local abort_instances = { [0] = "FDL", [1] = "MSAC_C2", [2] = "user" }
 local abort_reasons = {
@@ -206,6 +218,25 @@ local D = {
   prm_structure = ProtoField.bool("pbdp.prm.prm_structure", "Prm_Structure", 8, nil, 0x08),
   alarm_mode = ProtoField.uint8("pbdp.prm.alarm_mode", "Alarm_Mode", base.DEC, nil, 0x07),
   user_prm_data = ProtoField.bytes("pbdp.prm.user_prm_data", "User_Prm_Data"),
+  blk_len = ProtoField.uint8("pbdp.prm.block_length", "Structure_Length", base.DEC),
+  blk_type = ProtoField.uint8("pbdp.prm.block_type", "Structure_Type", base.HEX, prm_block_types),
+  blk_slot = ProtoField.uint8("pbdp.prm.block_slot", "Slot_Number", base.DEC),
+  blk_spec = ProtoField.uint8("pbdp.prm.block_specifier", "Index/Specifier", base.HEX),
+  blk_data = ProtoField.bytes("pbdp.prm.block_data", "Structure data"),
+  -- Slave redundancy (PI 2.212, protocol-facts.md §G.2/G.3)
+  red_seq = ProtoField.uint8("pbdp.red.seq_nr", "Seq_Nr", base.DEC, nil, 0xF8),
+  red_function = ProtoField.uint8("pbdp.red.function", "Function", base.HEX),
+  red_primary_req = ProtoField.bool("pbdp.red.primary_request", "Primary_Request", 8, nil, 0x02),
+  red_stop_msac1s = ProtoField.bool("pbdp.red.stop_msac1s", "Stop_MSAC1S", 8, nil, 0x04),
+  red_start_msac1s = ProtoField.bool("pbdp.red.start_msac1s", "Start_MSAC1S", 8, nil, 0x08),
+  red_check_props = ProtoField.bool("pbdp.red.check_properties", "Check_Properties", 8, nil, 0x10),
+  red_msc = ProtoField.bool("pbdp.red.master_state_clear", "Master_State_Clear", 8, nil, 0x40),
+  red_properties = ProtoField.uint8("pbdp.red.properties", "Properties", base.HEX),
+  red_hold = ProtoField.uint16("pbdp.red.output_hold_time", "Output_Hold_Time (10 ms)", base.DEC),
+  red_state_1 = ProtoField.uint8("pbdp.red.state_1", "Red_State_1 (this interface)", base.HEX),
+  red_state_2 = ProtoField.uint8("pbdp.red.state_2", "Red_State_2 (partner)", base.HEX),
+  red_state_3 = ProtoField.uint8("pbdp.red.state_3", "Red_State_3", base.HEX),
+  red_state_text = ProtoField.string("pbdp.red.state", "Redundancy state"),
   -- Chk_Cfg / Get_Cfg
   cfg_id = ProtoField.uint8("pbdp.cfg.id", "Identifier", base.HEX),
   cfg_format = ProtoField.string("pbdp.cfg.format", "Format"),
@@ -383,8 +414,42 @@ local function dp_set_prm(tvb, off, len, tree)
     for _, f in ipairs({ D.prm_cmd, D.isom_req, D.prm_structure, D.alarm_mode }) do s3:add(f, tvb(off + 9, 1)) end
     user = off + 10
   end
-  if off + len > user then tree:add(D.user_prm_data, tvb(user, off + len - user)) end
-  return string.format("ident 0x%04X WD %d ms", tvb(off + 4, 2):uint(), wd)
+  local extra = ""
+  if len >= 10 and bit.band(tvb(off + 9, 1):uint(), 0x08) ~= 0 then
+    -- Prm_Structure: the rest is a sequence of structured blocks (§D.2, §G.2).
+    local pos, stop = user, off + len
+    while pos < stop do
+      local blen = tvb(pos, 1):uint()
+      if blen < 4 or pos + blen > stop then
+        tree:add_proto_expert_info(E.dp, string.format("structured block of length %d at octet %d does not fit", blen, pos - off + 1))
+        tree:add(D.user_prm_data, tvb(pos, stop - pos))
+        break
+      end
+      local btype = tvb(pos + 1, 1):uint()
+      local b = tree:add(D.blk_type, tvb(pos + 1, 1))
+      b:set_text(string.format("Structured block: %s, %d octets", prm_block_types[btype] or string.format("type 0x%02X", btype), blen))
+      b:add(D.blk_len, tvb(pos, 1))
+      b:add(D.blk_slot, tvb(pos + 2, 1))
+      b:add(D.blk_spec, tvb(pos + 3, 1))
+      if btype == 0x02 and blen >= 8 then
+        b:add(D.red_seq, tvb(pos + 3, 1))
+        local fi = b:add(D.red_function, tvb(pos + 4, 1))
+        for _, f in ipairs({ D.red_primary_req, D.red_stop_msac1s, D.red_start_msac1s, D.red_check_props, D.red_msc }) do
+          fi:add(f, tvb(pos + 4, 1))
+        end
+        b:add(D.red_properties, tvb(pos + 5, 1))
+        b:add(D.red_hold, tvb(pos + 6, 2))
+        local fn = bits_set(tvb(pos + 4, 1):uint(), red_function_bits)
+        extra = extra .. " PrmCmd" .. (fn ~= "" and (" " .. fn) or "")
+      elseif blen > 4 then
+        b:add(D.blk_data, tvb(pos + 4, blen - 4))
+      end
+      pos = pos + blen
+    end
+  elseif off + len > user then
+    tree:add(D.user_prm_data, tvb(user, off + len - user))
+  end
+  return string.format("ident 0x%04X WD %d ms", tvb(off + 4, 2):uint(), wd) .. extra
 end
 
 local function cfg_describe(dir, n, words, consistent)
@@ -493,6 +558,22 @@ local function dpv1_diag_block(tvb, off, blen, tree)
     sub:add(V.status_type, tvb(off + 1, 1))
     sub:add(V.slot, tvb(off + 2, 1))
     sub:add(V.status_spec, tvb(off + 3, 1))
+    if (t == 0x9E or t == 0x9F) and blen >= 7 then
+      -- Slave redundancy status (§G.3): function echo, own and partner Red_State.
+      sub:add(D.red_seq, tvb(off + 3, 1))
+      local fi = sub:add(D.red_function, tvb(off + 4, 1))
+      for _, f in ipairs({ D.red_primary_req, D.red_stop_msac1s, D.red_start_msac1s, D.red_check_props, D.red_msc }) do
+        fi:add(f, tvb(off + 4, 1))
+      end
+      sub:add(D.red_state_1, tvb(off + 5, 1))
+      sub:add(D.red_state_2, tvb(off + 6, 1))
+      if blen >= 8 then sub:add(D.red_state_3, tvb(off + 7, 1)) end
+      local own = bits_set(tvb(off + 5, 1):uint(), red_state_bits)
+      local partner = bits_set(tvb(off + 6, 1):uint(), red_state_bits)
+      local text = string.format("own %s; partner %s", own ~= "" and own or "-", partner ~= "" and partner or "-")
+      sub:add(D.red_state_text, tvb(off + 5, 2), text)
+      return status_types[t] .. " (" .. text .. ")"
+    end
     if blen > 4 then sub:add(V.diag_data, tvb(off + 4, blen - 4)) end
     return "status " .. (status_types[t] or string.format("0x%02X", t))
   end

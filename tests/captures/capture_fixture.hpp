@@ -2,8 +2,12 @@
 // Shared by the captures tests: golden frames from protocol-facts.md Appendix 1 (written by
 // hand, never produced by the code under test), a do-nothing device and a memory sink.
 
+#include <unistd.h>
+
 #include <cstdint>
+#include <filesystem>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "pbvbus/bus/device.hpp"
@@ -40,6 +44,14 @@ inline const Bytes kDpv1ReadNeg = {0x68, 0x09, 0x09, 0x68, 0x81, 0x8A, 0x08, 0x3
 inline const Bytes kSetSlaveAdd = {0x68, 0x09, 0x09, 0x68, 0xFE, 0x81, 0x6D, 0x37,
                                    0x3E, 0x05, 0x12, 0x34, 0x00, 0xAC, 0x16};
 inline const Bytes kSc = {0xE5};
+
+/// A file name in the temp directory unique to this process: test binaries of several
+/// worktrees and ctest -j run at the same time.
+inline std::string temp_capture_path(const std::string& stem) {
+  return (std::filesystem::temp_directory_path() /
+          (stem + "_" + std::to_string(::getpid()) + ".pcapng"))
+      .string();
+}
 
 /// A station that does nothing: gives the line attachments with labels.
 class IdleDevice final : public bus::Device {

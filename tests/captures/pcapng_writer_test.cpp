@@ -276,7 +276,7 @@ TEST(PcapngWriter, StreamingFlushesEveryBlock) {
 }
 
 TEST(PcapngWriter, DashStreamsToStdoutBlockByBlock) {
-  const auto path = std::filesystem::temp_directory_path() / "pbvbus_writer_stdout.pcapng";
+  const auto path = std::filesystem::path(test::temp_capture_path("pbvbus_writer_stdout"));
   std::fflush(stdout);
   const int saved = dup(fileno(stdout));
   std::FILE* f = std::fopen(path.c_str(), "wb");
@@ -305,7 +305,7 @@ TEST(PcapngWriter, DashStreamsToStdoutBlockByBlock) {
 }
 
 TEST(PcapngWriter, FileSinkAndWriteErrors) {
-  const auto path = std::filesystem::temp_directory_path() / "pbvbus_writer_test.pcapng";
+  const auto path = std::filesystem::path(test::temp_capture_path("pbvbus_writer_test"));
   std::string why;
   {
     auto w = PcapngWriter::open(path.string(), {}, &why);

@@ -49,10 +49,16 @@ const Bytes kAlarmAck = sd2({0x8A, 0x81, 0x7D, 0x32, 0x33, 0x5C, 0x02, 0x01, 0x2
 // instance MSAC_C2, reason 3 (connection timeout).
 const Bytes kC2Abort = sd2({0x8A, 0x82, 0x6D, 0x30, 0x32, 0x58, 0x01, 0x13, 0x00});
 
+// Slave redundancy frames (§G.2/G.3), see SlaveRedundancyBlocks.
+const Bytes kPrmCmd = sd2({0x8A, 0x81, 0x5D, 0x3D, 0x3E, 0x88, 0x0A, 0x0A, 0x0B, 0x12, 0x34, 0x00, 0x80,
+                           0x00, 0x88, 0x08, 0x02, 0x00, 0x08, 0x02, 0x00, 0x00, 0x0A});
+const Bytes kRedState = sd2({0x81, 0x8A, 0x08, 0x3E, 0x3C, 0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x08, 0x9F,
+                             0x00, 0x08, 0x02, 0x0A, 0x01, 0x00});
+
 class TsharkDissector : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    s_path = (std::filesystem::temp_directory_path() / "pbvbus_tshark_test.pcapng").string();
+    s_path = test::temp_capture_path("pbvbus_tshark_test");
     bus::Scheduler sched;
     bus::Line line(sched, "dp0", bus::Baud::k1_5M);
     test::IdleDevice m, s;
@@ -255,7 +261,7 @@ TEST_F(TsharkDissector, EventRecords) {
 // master and a DP-V1 poll with no data (E.4).
 TEST(TsharkDissectorMore, SegmentsPartialFramesAndPolls) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
-  const auto path = (std::filesystem::temp_directory_path() / "pbvbus_tshark_more.pcapng").string();
+  const auto path = test::temp_capture_path("pbvbus_tshark_more");
   {
     bus::Scheduler sched;
     bus::Line line(sched, "dp1", bus::Baud::k187_5);
@@ -288,14 +294,45 @@ TEST(TsharkDissectorMore, SegmentsPartialFramesAndPolls) {
   EXPECT_EQ(rows[4][0], "10→51 DL MSAC_C1 not ready");
 }
 
+// Slave redundancy (protocol-facts.md §G.2/G.3): a Set_Prm with DPV1_Status_3 = PrmCmd |
+// Prm_Structure and an 8-octet PrmCmd block (Seq_Nr 1, Primary_Request, Output_Hold_Time 10 x
+// 10 ms), and a diagnosis with a Red_State status block (own: Primary + Data_Exchange; partner:
+// Backup).
+TEST(TsharkDissectorMore, SlaveRedundancyBlocks) {
+  if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  const auto path = test::temp_capture_path("pbvbus_tshark_red");
+  {
+    bus::Scheduler sched;
+    bus::Line line(sched, "dpA", bus::Baud::k1_5M);
+    auto w = PcapngWriter::open(path, {});
+    ASSERT_TRUE(w);
+    w->on_frame(test::tap_frame(line, kPrmCmd,
+                                1000));
+    w->on_frame(test::tap_frame(line, kRedState,
+                                2000));
+  }
+  using R = std::vector<std::string>;
+  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbdp.prm.prmcmd", "pbdp.prm.block_type",
+                                             "pbdp.red.seq_nr", "pbdp.red.primary_request",
+                                             "pbdp.red.output_hold_time", "pbdp.red.state_1",
+                                             "pbdp.red.state_2", "pbdp.red.state"});
+  std::filesystem::remove(path);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0], (R{"SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms PrmCmd Primary_Request FCB=0 FCV=1",
+                        "1", "0x02", "1", "1", "10", "", "", ""}));
+  EXPECT_EQ(rows[1], (R{"10→1 DL Slave_Diag.res ident 0x1234 master 1 [Ext_Diag, WD_On] ext: Red_State "
+                        "(own Primary, Data_Exchange; partner Backup)",
+                        "", "", "1", "1", "", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
+}
+
 // Mutated and random frames must never make the dissector raise a Lua error.
 TEST(TsharkDissectorRobustness, GarbageFramesDecodeWithoutLuaErrors) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
-  const auto path = (std::filesystem::temp_directory_path() / "pbvbus_tshark_garbage.pcapng").string();
+  const auto path = test::temp_capture_path("pbvbus_tshark_garbage");
   const std::vector<const Bytes*> goldens = {
       &test::kSlaveDiagReq, &test::kSlaveDiagRes, &test::kSetPrmDpv1, &test::kChkCfg,
       &test::kGlobalControlClear, &test::kDpv1Read, &test::kDpv1ReadNeg, &test::kSetSlaveAdd,
-      &kDiagExt, &kGetCfgRes, &kAlarmAck, &kC2Abort, &test::kToken_2_to_5};
+      &kDiagExt, &kGetCfgRes, &kAlarmAck, &kC2Abort, &test::kToken_2_to_5, &kPrmCmd, &kRedState};
   std::uint64_t rng = 0x9E3779B97F4A7C15ULL;
   auto next = [&] {
     rng ^= rng << 13;

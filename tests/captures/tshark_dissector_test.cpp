@@ -126,6 +126,11 @@ TEST_F(TsharkDissector, PlainTsharkOpensTheFile) {
   const auto enc = ts::run_command("tshark -n -r " + ts::shell_quote(s_path) +
                                      " -T fields -e frame.encap_type -c 1");
   EXPECT_EQ(enc.out, "45\n");  // WTAP_ENCAP_USER0
+  const auto v = ts::tshark(s_path, {"-V", "-c", "1"}, /*with_dissector=*/false);
+  EXPECT_NE(v.out.find("Encapsulation type: USER 0 (45)"), std::string::npos) << v.out;
+  EXPECT_NE(v.out.find("Interface name: dp0"), std::string::npos) << v.out;
+  // The first frame starts at 100 us of virtual time; if_tsresol 9 keeps the nanoseconds.
+  EXPECT_NE(v.out.find("Epoch Time: 0.000100000 seconds"), std::string::npos) << v.out;
 }
 
 TEST_F(TsharkDissector, InfoColumn) {

@@ -47,7 +47,18 @@ Frame Responder::fdl_status_reply(const Telegram& req, std::uint8_t own, Station
 
 const Frame& Responder::finish(const Telegram& req, std::uint8_t own, StationType type, const Reply& reply) {
   if (!m_initialised) reset();
-  Frame& out = m_scratch;
+  const RequestFn fn = fc_request_fn(req.fc);
+  const bool store = fn_uses_fcb(fn) && (fc_fcv(req.fc) || fc_fcb(req.fc));
+  if (store) {
+    // First frame (FCV=0, FCB=1) or a new action frame: remember its FCB, and encode the
+    // answer straight into the SA's slot (no copy per frame).
+    m_fcb[req.sa] = fc_fcb(req.fc) ? 1 : 0;
+    if (m_slot[req.sa] == kNone) {
+      m_slot[req.sa] = static_cast<std::uint8_t>(m_replies.size());
+      m_replies.emplace_back();
+    }
+  }
+  Frame& out = store ? m_replies[m_slot[req.sa]] : m_scratch;
   out.len = 0;
   FrameSpec spec;
   spec.da = req.sa;
@@ -77,16 +88,6 @@ const Frame& Responder::finish(const Telegram& req, std::uint8_t own, StationTyp
       if (encode_as(FrameType::SD1, s, out) != EncodeError::None) out.len = 0;
       break;
     }
-  }
-  const RequestFn fn = fc_request_fn(req.fc);
-  if (fn_uses_fcb(fn) && (fc_fcv(req.fc) || fc_fcb(req.fc))) {
-    // First frame (FCV=0, FCB=1) or a new action frame: remember its FCB and our answer.
-    m_fcb[req.sa] = fc_fcb(req.fc) ? 1 : 0;
-    if (m_slot[req.sa] == kNone) {
-      m_slot[req.sa] = static_cast<std::uint8_t>(m_replies.size());
-      m_replies.emplace_back();
-    }
-    m_replies[m_slot[req.sa]] = out;
   }
   return out;
 }

@@ -1,5 +1,5 @@
 #pragma once
-// Drives a dp::Master by hand, standing in for the FDL active station: it asks next_request()
+// Drives a dp::Master (or any fdl::InitiatorUser, e.g. dp::Class2Master) by hand, standing in for the FDL active station: it asks next_request()
 // the way the station does while holding the token, encodes each Request into the frame the
 // station would send (FCB/FCV per responder as in protocol-facts.md §C.6: first frame FCV=0/
 // FCB=1, then toggled after each valid reply, reset after a NoResponse), and feeds back the
@@ -25,7 +25,10 @@ namespace pbvbus::dp::test {
 
 class MasterDriver {
  public:
-  explicit MasterDriver(Master& m) : m_m(m) { m_fcb.fill(0); }
+  MasterDriver(fdl::InitiatorUser& u, std::uint8_t address) : m_m(u), m_addr(address) {
+    m_fcb.fill(0);
+  }
+  explicit MasterDriver(Master& m) : MasterDriver(m, m.address()) {}
 
   bus::Ticks now = 0;
   bus::Ticks step = bus::kTicksPerMs / 10;  ///< time each message cycle takes
@@ -63,7 +66,7 @@ class MasterDriver {
   Bytes encode_request(const fdl::Request& r) {
     fdl::FrameSpec s;
     s.da = r.da;
-    s.sa = m_m.address();
+    s.sa = m_addr;
     const bool fcb = fdl::fn_expects_reply(r.fn) && r.da != fdl::kBroadcast;
     const std::uint8_t st = fcb ? m_fcb[r.da] : 0;
     s.fc = fdl::make_request_fc(r.fn, fcb && st != 0, fcb && st != 1);
@@ -158,7 +161,7 @@ class MasterDriver {
   fdl::Indication indication(std::uint8_t da) {
     fdl::Indication ind;
     ind.now = now;
-    ind.sa = m_m.address();
+    ind.sa = m_addr;
     ind.da = req.da == fdl::kBroadcast ? fdl::kBroadcast : da;
     ind.fn = req.fn;
     ind.dsap = req.dsap;
@@ -179,7 +182,8 @@ class MasterDriver {
   }
   void confirm(const fdl::Confirmation& c) { m_m.on_confirmation(c); }
 
-  Master& m_m;
+  fdl::InitiatorUser& m_m;
+  std::uint8_t m_addr;
   bool m_visit_open = false;
   std::array<std::uint8_t, 128> m_fcb{};  ///< 0 = next is a first frame, 1 = next FCB 0, 2 = FCB 1
   std::map<std::uint8_t, SlaveEngine*> m_slaves;

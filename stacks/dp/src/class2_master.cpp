@@ -151,6 +151,9 @@ void Class2Master::on_power_on(bus::Ticks now) {
 void Class2Master::on_token(bus::Ticks now, bus::Ticks /*trr*/) {
   m_now = now;
   m_polled_this_visit = false;
+  // Nothing can be outstanding at a new token; a request the station never confirmed (it left
+  // the ring) is simply sent again.
+  m_outstanding = m_outstanding_idle = false;
 }
 
 bool Class2Master::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) {

@@ -218,6 +218,10 @@ void Master::on_power_on(bus::Ticks now) {
 
 void Master::on_token(bus::Ticks now, bus::Ticks /*trr*/) {
   m_now = now;
+  // A request is outstanding only while the station holds the token; one still marked at a
+  // new token was lost with the ring (the station never confirmed it): forget it.
+  m_out_kind = Kind::None;
+  m_out_slave = -1;
   if (!m_pass_active) start_pass();
 }
 

@@ -268,6 +268,41 @@ TEST_F(LoneMaster, ReplyStartingWithinTslIsAccepted) {
   EXPECT_EQ(rec.start_bits(4), rec.end_bits(3) + 37);
 }
 
+TEST_F(LoneMaster, CorruptReplyCountsAsMissingAndTheRepeatFollowsTid1AfterIt) {
+  // A responder whose reply has a bad FCS (10 01 05 08 0E 16 would be right; it sends 0F).
+  class BadFcs final : public bus::Device {
+   public:
+    void on_power_on(bus::Ticks) override {}
+    void on_timer(bus::Ticks) override {}
+    int receive_filter() const override { return 5; }
+    void on_frame(const bus::RxFrame& f) override {
+      if (f.bytes[0] == 0xDC) return;
+      const auto b = bytes_from_hex("10 01 05 08 0F 16");
+      port().transmit(f.end + 11 * ticks_per_bit(port().baud()), b);
+    }
+  } slave;
+  user.high_per_visit = 1;
+  user.high.da = 5;
+  user.high.fn = RequestFn::SrdHigh;
+  user.high.data = {0xAA};
+  start();
+  line.attach(slave);
+  line.set_power(1, true);
+  run_ms(5);
+  ASSERT_GT(rec.size(), 6u);
+  EXPECT_EQ(rec.hex(2), "68 04 04 68 05 01 6D AA 1D 16");
+  EXPECT_EQ(rec.hex(3), "10 01 05 08 0F 16");
+  // The repeat: same bytes, TID1 after the corrupt reply's end; then given up (max_retry 1).
+  EXPECT_EQ(rec.hex(4), "68 04 04 68 05 01 6D AA 1D 16");
+  EXPECT_EQ(rec.start_bits(4), rec.end_bits(3) + 37);
+  EXPECT_EQ(rec.hex(5), "10 01 05 08 0F 16");
+  EXPECT_EQ(rec.start_bits(6), rec.end_bits(5) + 37);
+  ASSERT_FALSE(user.confirmations.empty());
+  EXPECT_EQ(user.confirmations[0].result, Result::NoResponse);
+  EXPECT_EQ(user.confirmations[0].retries, 1u);
+  EXPECT_EQ(master.stats().invalid_replies, 2u + (master.stats().requests - 1));
+}
+
 // --- priorities and the token hold time -----------------------------------------------------
 
 struct VisitCounts {

@@ -6,6 +6,7 @@
 #include "pbvbus/dp/diagnosis.hpp"
 #include "pbvbus/dp/dpv1_pdu.hpp"
 #include "pbvbus/dp/prm.hpp"
+#include "pbvbus/dp/process_image.hpp"
 
 namespace pbvbus::dp {
 namespace {
@@ -198,6 +199,27 @@ TEST(Dpv1Pdu, Initiate) {
   Bytes shorter(rq.begin(), rq.end() - 1);
   EXPECT_FALSE(parse_initiate(shorter, ir));
   EXPECT_FALSE(parse_initiate(Bytes{0x57, 0x00}, ir));
+}
+
+TEST(ConsistentBuffer, SizesAndGenerations) {
+  ConsistentBuffer b(3);
+  Bytes out(3, 0xEE);
+  EXPECT_TRUE(b.read(out));
+  EXPECT_EQ(out, (Bytes{0, 0, 0}));
+  EXPECT_FALSE(b.write(Bytes{1, 2}));
+  EXPECT_TRUE(b.write(Bytes{1, 2, 3}));
+  EXPECT_EQ(b.generation(), 1u);
+  Bytes small(2);
+  EXPECT_FALSE(b.read(small));
+  EXPECT_TRUE(b.try_read(out, 1));
+  EXPECT_EQ(out, (Bytes{1, 2, 3}));
+  b.fill(0x7F);
+  EXPECT_EQ(b.generation(), 2u);
+  EXPECT_TRUE(b.read(out));
+  EXPECT_EQ(out, (Bytes{0x7F, 0x7F, 0x7F}));
+  ConsistentBuffer empty(0);
+  EXPECT_TRUE(empty.write(Bytes{}));
+  EXPECT_TRUE(empty.read(std::span<std::uint8_t>{}));
 }
 
 }  // namespace

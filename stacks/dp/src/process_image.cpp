@@ -1,6 +1,7 @@
 // Consistent process images (design.md "Consistent data", protocol-facts.md §F).
 #include "pbvbus/dp/process_image.hpp"
 
+#include <algorithm>
 #include <thread>
 
 namespace pbvbus::dp {
@@ -56,7 +57,14 @@ void ConsistentBuffer::fill(std::uint8_t value) {
 bool ConsistentBuffer::read(std::span<std::uint8_t> out) const {
   if (out.size() != m_len) return false;
   unsigned spins = 0;
-  for (;;) {
+  while (!try_read(out, 1))
+    if (++spins > 64) std::this_thread::yield();
+  return true;
+}
+
+bool ConsistentBuffer::try_read(std::span<std::uint8_t> out, int attempts) const {
+  if (out.size() != m_len) return false;
+  for (int a = 0; a < attempts; ++a) {
     const std::uint32_t s1 = m_seq.load(std::memory_order_acquire);
     if ((s1 & 1u) == 0) {
       for (std::size_t w = 0; w < m_words; ++w) {
@@ -67,20 +75,28 @@ bool ConsistentBuffer::read(std::span<std::uint8_t> out) const {
       }
       if (m_seq.load(std::memory_order_relaxed) == s1) return true;
     }
-    if (++spins > 64) std::this_thread::yield();
   }
+  return false;
 }
 
-ProcessImage::ProcessImage(const SlaveLayout& layout) : m_layout(layout.modules) {
+ProcessImage::ProcessImage(const SlaveLayout& layout)
+    : m_layout(layout.modules), m_last_inputs(layout.inputs, 0) {
   for (const auto& m : m_layout) {
     m_in.push_back(std::make_unique<ConsistentBuffer>(m.in_len));
     m_out.push_back(std::make_unique<ConsistentBuffer>(m.out_len));
   }
 }
 
-void ProcessImage::read_all_inputs(std::span<std::uint8_t> telegram) const {
-  for (std::size_t m = 0; m < m_layout.size(); ++m)
-    m_in[m]->read(telegram.subspan(m_layout[m].in_offset, m_layout[m].in_len));
+void ProcessImage::read_all_inputs(std::span<std::uint8_t> telegram) {
+  for (std::size_t m = 0; m < m_layout.size(); ++m) {
+    const auto off = static_cast<std::ptrdiff_t>(m_layout[m].in_offset);
+    const std::size_t len = m_layout[m].in_len;
+    const auto dst = telegram.subspan(m_layout[m].in_offset, len);
+    if (m_in[m]->try_read(dst, 4))
+      std::copy(dst.begin(), dst.end(), m_last_inputs.begin() + off);
+    else
+      std::copy_n(m_last_inputs.begin() + off, len, dst.begin());
+  }
 }
 
 void ProcessImage::write_all_outputs(std::span<const std::uint8_t> telegram) {

@@ -35,6 +35,10 @@ class ConsistentBuffer {
   void fill(std::uint8_t value);
   /// Copies the whole content, from one write. `out.size()` must equal size().
   bool read(std::span<std::uint8_t> out) const;
+  /// Like read(), but gives up (returns false, `out` undefined) after `attempts` tries that met
+  /// a write in progress: for a reader that must not wait for a writer thread that may have
+  /// been preempted in the middle of its copy.
+  bool try_read(std::span<std::uint8_t> out, int attempts) const;
   /// Number of completed writes (changes whenever the content was replaced).
   std::uint32_t generation() const { return m_seq.load(std::memory_order_acquire) / 2; }
 
@@ -61,8 +65,10 @@ class ProcessImage {
   const ConsistentBuffer& inputs(std::size_t m) const { return *m_in[m]; }
   const ConsistentBuffer& outputs(std::size_t m) const { return *m_out[m]; }
 
-  /// Bus side: assembles the input telegram (every module from one write of that module).
-  void read_all_inputs(std::span<std::uint8_t> telegram) const;
+  /// Bus side: assembles the input telegram, every module from one write of that module. Never
+  /// waits for a device thread: a module whose writer is busy right now (e.g. preempted in the
+  /// middle of its copy) contributes the complete value the bus read last time. Bus thread only.
+  void read_all_inputs(std::span<std::uint8_t> telegram);
   /// Bus side: hands the output telegram to the device, module by module.
   void write_all_outputs(std::span<const std::uint8_t> telegram);
   /// Bus side: outputs to the safe state (all zero).
@@ -70,6 +76,7 @@ class ProcessImage {
 
  private:
   std::vector<ModuleLayout> m_layout;
+  std::vector<std::uint8_t> m_last_inputs;  ///< last complete input telegram (bus thread)
   std::vector<std::unique_ptr<ConsistentBuffer>> m_in;
   std::vector<std::unique_ptr<ConsistentBuffer>> m_out;
 };

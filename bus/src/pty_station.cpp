@@ -222,6 +222,8 @@ void PtyStation::attach_io(PacedRunner& runner) {
   m_io->sd.async_wait(boost::asio::posix::stream_descriptor::wait_read, Reader{this, m_io->alive});
 }
 
+void PtyStation::detach_io() { m_io.reset(); }
+
 void PtyStation::feed(std::span<const std::uint8_t> bytes) {
   m_stats.bytes_in += bytes.size();
   if (!bound() || !m_powered) {

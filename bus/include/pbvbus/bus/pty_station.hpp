@@ -97,8 +97,11 @@ class PtyStation final : public Device {
   Stats stats() const;
 
   /// Reads from the pty whenever it becomes readable on runner.io_context() and feeds the bytes
-  /// in at the runner's virtual time. Call once, before running.
+  /// in at the runner's virtual time. Call once, before running. The runner must outlive the
+  /// station, or detach_io() must be called before the runner goes away.
   void attach_io(PacedRunner& runner);
+  /// Stops using the runner's io_context (pending waits are cancelled).
+  void detach_io();
   /// Reads whatever the program has written (waiting up to `wait` for the first byte) and feeds
   /// it in at the port's current time. Returns the number of octets read. For tests and the
   /// fast driver; do not mix with attach_io().

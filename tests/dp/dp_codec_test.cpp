@@ -109,6 +109,21 @@ TEST(Prm, ParseAndEncode) {
   EXPECT_EQ(alarm_mode_limit(7), 32u);
 }
 
+TEST(Prm, StructuredBlocks) {
+  std::vector<PrmBlock> blocks;
+  const Bytes two{0x08, 0x02, 0x00, 0x00, 0x02, 0x0C, 0x00, 0x0A, 0x05, 0x81, 0x01, 0x00, 0x33};
+  ASSERT_TRUE(split_prm_blocks(two, blocks));
+  ASSERT_EQ(blocks.size(), 2u);
+  EXPECT_EQ(blocks[0].type, kPrmBlockPrmCmd);
+  EXPECT_EQ(blocks[0].data().size(), 4u);
+  EXPECT_EQ(blocks[1].type, kPrmBlockUser);
+  EXPECT_EQ(blocks[1].slot, 1);
+  EXPECT_EQ(blocks[1].data()[0], 0x33);
+  EXPECT_FALSE(split_prm_blocks(Bytes{0x03, 0x02, 0x00}, blocks));
+  EXPECT_FALSE(split_prm_blocks(Bytes{0x08, 0x02, 0x00, 0x00}, blocks));
+  EXPECT_TRUE(split_prm_blocks(Bytes{}, blocks));
+}
+
 TEST(Diagnosis, StandardAndBlocksMatchWorkedExample) {
   // §D.5 worked example: 44 00 01 00 | 88 41 21 | 04 10 20 30.
   DiagBuilder d;

@@ -274,6 +274,67 @@ TEST(SlaveDpv1, CheckCfgModeLetsTheUserDecide) {
   EXPECT_EQ(asked, (std::vector<Bytes>{{0x10, 0x50}, {0x10, 0xA0}}));
 }
 
+TEST(SlaveDpv1, StructuredPrmAndPrmCmdWhereSupported) {
+  // DPV1_Status_3 = PrmCmd | Prm_Structure; one PrmCmd block (§G.2): 08 02 00 00 02 0C 00 0A.
+  const Bytes with_block{0x88, 0x0A, 0x0A, 0x0B, 0x12, 0x34, 0x00, 0x80, 0x00, 0x88,
+                         0x08, 0x02, 0x00, 0x00, 0x02, 0x0C, 0x00, 0x0A};
+  auto c = dpv1_config();
+  c.max_user_prm_len = 11;
+  {
+    SlaveEngine plain(c);  // without PrmCmd/Prm_Structure support: Prm_Fault
+    Harness h(plain);
+    h.req(kM1, kS, kSapSetPrm, with_block);
+    EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}), (Bytes{0x42, 0x05, 0x00, 0xFF, 0x12, 0x34}));
+  }
+  c.features.prm_structure = c.features.prm_cmd = true;
+  Bytes seen;
+  c.check_user_prm = [&](std::span<const std::uint8_t> u) {
+    seen.assign(u.begin(), u.end());
+    return true;
+  };
+  SlaveEngine e(c);
+  Harness h(e);
+  h.req(kM1, kS, kSapSetPrm, with_block);
+  EXPECT_EQ(e.state(), SlaveState::WaitCfg);
+  EXPECT_EQ(seen, Bytes(with_block.begin() + 7, with_block.end()));
+  EXPECT_TRUE(e.dpv1_status().prm_cmd());
+  // A block whose length runs past the end is a Prm_Fault.
+  Bytes broken = with_block;
+  broken[10] = 0x09;
+  h.req(kM1, kS, kSapSetPrm, broken);
+  EXPECT_EQ(e.state(), SlaveState::WaitPrm);
+  EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}), (Bytes{0x42, 0x05, 0x00, 0xFF, 0x12, 0x34}));
+}
+
+TEST(SlaveDpv1, StatusPdusFromTheApplication) {
+  SlaveEngine e(dpv1_config());
+  auto& app = e.application();
+  Harness h(e);
+  // Red_State (AUMA layout, §G.3): visible even before parameterisation.
+  EXPECT_TRUE(app.set_status(kRedState, 0, 0x01, Bytes{0x02, 0x01, 0x00, 0x00}));
+  EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}),
+            (Bytes{0x02, 0x05, 0x00, 0xFF, 0x12, 0x34, 0x08, 0x9F, 0x00, 0x01, 0x02, 0x01, 0x00,
+                   0x00}));
+  EXPECT_FALSE(app.set_status(0x10, 0, 0));          // not a status type
+  EXPECT_FALSE(app.set_status(kModuleStatus, 0, 0));  // built by the engine
+  start(h, prm(0x80, 0x00, 0x00));
+  h.req(kM1, kS, std::nullopt, {0x00});
+  // Set before the master owned the slave: DH until the owner has read the diagnosis.
+  EXPECT_EQ(h.last.status, ResponseStatus::DH);
+  h.req(kM1, kS, kSapSlaveDiag, {});
+  h.req(kM1, kS, std::nullopt, {0x00});
+  EXPECT_EQ(h.last.status, ResponseStatus::DL);
+  // Replacing it is new diagnosis: DH.
+  EXPECT_TRUE(app.set_status(kRedState, 0, 0x01, Bytes{0x0A, 0x01, 0x00, 0x00}));
+  h.req(kM1, kS, std::nullopt, {0x00});
+  EXPECT_EQ(h.last.status, ResponseStatus::DH);
+  EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}),
+            (Bytes{0x00, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x08, 0x9F, 0x00, 0x01, 0x0A, 0x01, 0x00,
+                   0x00}));
+  app.clear_status(kRedState, 0);
+  EXPECT_EQ(h.du(kM1, kS, kSapSlaveDiag, {}), (Bytes{0x00, 0x0C, 0x00, 0x01, 0x12, 0x34}));
+}
+
 // --- MSAC_C2 ------------------------------------------------------------------------------------
 
 SlaveConfig c2_config() {

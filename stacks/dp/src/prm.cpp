@@ -31,4 +31,21 @@ std::vector<std::uint8_t> encode_prm(const PrmHeader& h, std::span<const std::ui
   return du;
 }
 
+bool split_prm_blocks(std::span<const std::uint8_t> octets, std::vector<PrmBlock>& out) {
+  out.clear();
+  std::size_t i = 0;
+  while (i < octets.size()) {
+    const std::size_t len = octets[i];
+    if (len < 4 || octets.size() - i < len) return false;
+    PrmBlock b;
+    b.type = octets[i + 1];
+    b.slot = octets[i + 2];
+    b.specifier = octets[i + 3];
+    b.bytes = octets.subspan(i, len);
+    out.push_back(b);
+    i += len;
+  }
+  return true;
+}
+
 }  // namespace pbvbus::dp

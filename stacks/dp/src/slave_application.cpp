@@ -91,6 +91,39 @@ void SlaveApplication::set_module_state(std::size_t module, ModuleState s) {
   diag_changed();
 }
 
+bool SlaveApplication::set_status(std::uint8_t status_type, std::uint8_t slot,
+                                  std::uint8_t specifier, std::span<const std::uint8_t> data) {
+  if ((status_type & 0x80) == 0 || status_type == kModuleStatus || status_type == 0xFF ||
+      data.size() > 59)
+    return false;
+  Alarm st;
+  st.type = status_type;
+  st.slot = slot;
+  st.specifier = specifier;
+  st.len = static_cast<std::uint8_t>(data.size());
+  std::copy(data.begin(), data.end(), st.data.begin());
+  std::lock_guard lk(m_mu);
+  const auto it = std::find_if(m_status.begin(), m_status.end(), [&](const Alarm& a) {
+    return a.type == status_type && a.slot == slot;
+  });
+  if (it != m_status.end())
+    *it = st;
+  else
+    m_status.push_back(st);
+  diag_changed();
+  return true;
+}
+
+void SlaveApplication::clear_status(std::uint8_t status_type, std::uint8_t slot) {
+  std::lock_guard lk(m_mu);
+  const auto it = std::find_if(m_status.begin(), m_status.end(), [&](const Alarm& a) {
+    return a.type == status_type && a.slot == slot;
+  });
+  if (it == m_status.end()) return;
+  m_status.erase(it);
+  diag_changed();
+}
+
 AlarmResult SlaveApplication::raise_alarm(std::uint8_t type, std::uint8_t slot, AlarmSpec spec,
                                           bool add_ack, std::span<const std::uint8_t> data,
                                           std::uint8_t* seq_nr) {

@@ -202,9 +202,14 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
     if (d.check_cfg_mode() && !f.check_cfg_mode) fault = true;
     if (d.alarm_enables() & ~f.alarms_supported) fault = true;
     if (d.alarm_mode() > f.max_alarm_mode) fault = true;
-    // Redundancy commands, isochronous mode and structured prm belong to profiles this
-    // slave does not implement.
-    if (d.prm_cmd() || d.isom_req() || d.prm_structure()) fault = true;
+    // Isochronous mode is not implemented; structured blocks and PrmCmd only where the
+    // configuration says so (the blocks themselves go to check_user_prm).
+    if (d.isom_req()) fault = true;
+    if (d.prm_cmd() && !f.prm_cmd) fault = true;
+    if (d.prm_structure()) {
+      std::vector<PrmBlock> blocks;  // not on the cyclic path
+      if (!f.prm_structure || !split_prm_blocks(pv.user_prm.subspan(3), blocks)) fault = true;
+    }
     if (!d.dpv1_enable() && (d.alarm_enables() != 0 || d.check_cfg_mode())) fault = true;
   }
   if (!fault && m_cfg.check_user_prm && !m_cfg.check_user_prm(pv.user_prm)) fault = true;
@@ -298,6 +303,8 @@ void SlaveEngine::build_diag() {
   if (!m_scratch_ids.empty())
     m_diag.add_identifier_block(m_scratch_ids, std::max(m_cfg_fault_span, m_layout.modules.size()));
   if (dpv1 && module_fault) m_diag.add_module_status(m_app.m_module_states);
+  for (const auto& st : m_app.m_status)
+    m_diag.add_status(st.type, st.slot, st.specifier, {st.data.data(), st.len});
   for (const auto& c : m_app.m_channels) m_diag.add_channel(c);
   m_diag.add_device_block(m_app.m_device_diag);
   if (dpv1)

@@ -98,6 +98,26 @@ struct PrmView {
 /// Splits a Set_Prm DU; false if it is shorter than the 7-octet header.
 bool parse_prm(std::span<const std::uint8_t> du, PrmView& out);
 
+// Structured parameter blocks (Prm_Structure = 1), after DPV1_Status_3: each block is
+// `Structure_Length (incl. these 4 octets), Structure_Type, Slot_Number, Specifier, data...`.
+inline constexpr std::uint8_t kPrmBlockPrmCmd = 0x02;  ///< redundancy command (§G.2)
+inline constexpr std::uint8_t kPrmBlockDxbLink = 0x03;
+inline constexpr std::uint8_t kPrmBlockIsoM = 0x04;
+inline constexpr std::uint8_t kPrmBlockDxbSubscriber = 0x07;
+inline constexpr std::uint8_t kPrmBlockTimeAr = 0x08;
+inline constexpr std::uint8_t kPrmBlockUser = 0x81;
+
+struct PrmBlock {
+  std::uint8_t type = 0;
+  std::uint8_t slot = 0;
+  std::uint8_t specifier = 0;
+  std::span<const std::uint8_t> bytes;  ///< the whole block, header included
+  std::span<const std::uint8_t> data() const { return bytes.subspan(4); }
+};
+/// Splits the octets after DPV1_Status_3 into blocks; false if a length is below 4 or runs past
+/// the end.
+bool split_prm_blocks(std::span<const std::uint8_t> octets, std::vector<PrmBlock>& out);
+
 /// Builds a Set_Prm DU (master side and tests of the layout).
 std::vector<std::uint8_t> encode_prm(const PrmHeader& h, std::span<const std::uint8_t> user_prm);
 

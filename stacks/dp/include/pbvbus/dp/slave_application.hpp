@@ -109,6 +109,15 @@ class SlaveApplication {
   /// DP-V1 enabled, shows up in the Module_Status block.
   void set_module_state(std::size_t module, ModuleState s);
 
+  /// A DP-V1 status PDU (Status_Message 0x81, Prm_Cmd_Ack 0x9E, Red_State 0x9F, 0xA0..0xFE
+  /// manufacturer-specific) kept in every diagnosis until cleared, whatever the DP-V1 mode (a
+  /// redundancy layer shows Red_State before parameterisation). One per (type, slot): setting it
+  /// again replaces it. False for a type without bit 7, Module_Status (the engine builds that
+  /// from set_module_state()), or more than 59 octets.
+  bool set_status(std::uint8_t status_type, std::uint8_t slot, std::uint8_t specifier,
+                  std::span<const std::uint8_t> data = {});
+  void clear_status(std::uint8_t status_type, std::uint8_t slot);
+
   // --- DP-V1 alarms (any thread) ---
   /// Queues an alarm; its Seq_Nr is returned in *seq_nr.
   AlarmResult raise_alarm(std::uint8_t type, std::uint8_t slot, AlarmSpec spec, bool add_ack,
@@ -156,6 +165,7 @@ class SlaveApplication {
   std::vector<ChannelDiag> m_channels;
   std::vector<ModuleState> m_module_states;
   std::vector<Alarm> m_alarms;            ///< outstanding, oldest first
+  std::vector<Alarm> m_status;            ///< status PDUs (same layout as an alarm)
   bool m_alarms_open = false;             ///< Data_Exch with DPV1_Enable
   std::uint8_t m_alarm_enables = 0;       ///< DPV1_Status_2 enable bits accepted at Set_Prm
   std::uint8_t m_alarm_mode = 0;

@@ -36,6 +36,10 @@ struct SlaveFeatures {
   std::uint8_t max_alarm_mode = 0;      ///< highest Alarm_Mode (0..7) it accepts
   bool wd_base_1ms = false;             ///< WD_Base_1ms_supp
   bool check_cfg_mode = false;          ///< Check_Cfg_Mode_supp
+  /// Structured Set_Prm blocks (DPV1_Status_3 Prm_Structure) accepted; their content is for
+  /// SlaveConfig::check_user_prm (and for a redundancy layer above the engine).
+  bool prm_structure = false;
+  bool prm_cmd = false;                 ///< DPV1_Status_3 PrmCmd accepted (PrmCmd_supp)
 };
 
 struct SlaveModule {

@@ -785,7 +785,7 @@ local function dissect_dpv1(tvb, off, len, tree, is_req, c2)
       p = p + 3  -- reserved
       t:add(V.send_timeout, tvb(p, 2)); p = p + 2
     else
-      if len < 13 then t:add_proto_expert_info(E.dp, "Initiate.res shorter than 13 octets"); return name .. dir end
+      if len < 12 then t:add_proto_expert_info(E.dp, "Initiate.res shorter than 12 octets"); return name .. dir end
       t:add(V.max_len, tvb(p, 1)); p = p + 1
     end
     t:add(V.features_1, tvb(p, 1)); t:add(V.features_2, tvb(p + 1, 1))

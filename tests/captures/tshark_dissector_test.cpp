@@ -330,6 +330,47 @@ TEST(TsharkDissectorMore, SlaveRedundancyBlocks) {
                         "", "", "1", "1", "", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
 }
 
+// MSAC_C2 (protocol-facts.md §E.6): Initiate.req to the resource manager (SAP 49) from the
+// class-2 master's SAP 50, the RM answer naming server SAP 48 and Send_Timeout 100, the
+// Initiate.res from SAP 48, a Data_Transport and an Idle on the connection.
+TEST(TsharkDissectorMore, Msac2Connection) {
+  if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  const auto path = test::temp_capture_path("pbvbus_tshark_c2");
+  {
+    bus::Scheduler sched;
+    bus::Line line(sched, "dp0", bus::Baud::k1_5M);
+    auto w = PcapngWriter::open(path, {});
+    ASSERT_TRUE(w);
+    // 57 | 3 reserved | Send_Timeout 0x0064 | features 01 00 | profile features 00 00 |
+    // profile ident 0x0000 | S_Type 00 S_Len 02 D_Type 00 D_Len 02 | Addr_Data 4 octets
+    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x6D, 0x31, 0x32, 0x57, 0x00, 0x00, 0x00, 0x00, 0x64,
+                                           0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x02, 0x00, 0x02,
+                                           0x00, 0x01, 0x00, 0x02}),
+                                1000));
+    w->on_frame(test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x31, 0x56, 0x30, 0x00, 0x64}), 2000));
+    // Initiate.res: 57 | Max_Len_Data_Unit 0xF0 | 01 00 00 00 | 0000 | 00 02 00 02 | 4 octets
+    w->on_frame(test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x30, 0x57, 0xF0, 0x01, 0x00, 0x00, 0x00,
+                                           0x00, 0x00, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00, 0x02}),
+                                3000));
+    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x7D, 0x30, 0x32, 0x51, 0x01, 0x02, 0x03, 0xAA, 0xBB, 0xCC}),
+                                4000));
+    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x5D, 0x30, 0x32, 0x48, 0x00}), 5000));
+  }
+  using R = std::vector<std::string>;
+  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbdpv1.service", "pbdpv1.send_timeout",
+                                             "pbdpv1.server_sap", "pbdpv1.max_len_data_unit", "pbdpv1.s_len",
+                                             "pbdpv1.addr_data", "pbdpv1.data"});
+  std::filesystem::remove(path);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0], (R{"SRD_high 2→10 MSAC_C2 Initiate.req FCB=1 FCV=0", "Initiate.req", "100", "", "", "2",
+                        "00010002", ""}));
+  EXPECT_EQ(rows[1], (R{"10→2 DL MSAC_C2 RM.res server SAP 48", "RM.res", "100", "48", "", "", "", ""}));
+  EXPECT_EQ(rows[2], (R{"10→2 DL MSAC_C2 Initiate.res", "Initiate.res", "", "", "240", "2", "00010002", ""}));
+  EXPECT_EQ(rows[3], (R{"SRD_high 2→10 MSAC_C2 Data_Transport.req slot 1 index 2 len 3 FCB=1 FCV=1",
+                        "Data_Transport.req", "", "", "", "", "", "aabbcc"}));
+  EXPECT_EQ(rows[4][0], "SRD_high 2→10 MSAC_C2 Idle.req FCB=0 FCV=1");
+}
+
 // Mutated and random frames must never make the dissector raise a Lua error.
 TEST(TsharkDissectorRobustness, GarbageFramesDecodeWithoutLuaErrors) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;

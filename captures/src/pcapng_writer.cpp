@@ -333,6 +333,9 @@ void PcapngWriter::write_event(bus::Ticks time, const EventRecord& e) {
 }
 
 void PcapngWriter::on_line_event(const bus::LineEvent& e) {
+  // Declare the line before the events interface, so that lines keep the low interface ids
+  // even when a fault (or the power-on at start) comes before the first frame.
+  if (e.line && m_ok) interface_for(*e.line);
   EventRecord r;
   r.category = EventCategory::Line;
   r.code = static_cast<std::uint16_t>(e.kind);

@@ -12,6 +12,7 @@
 #include "frame_recorder.hpp"
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/dp/class2_master.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 #include "pbvbus/fdl/active_station.hpp"
@@ -225,6 +226,94 @@ TEST(DpMasterLine, Dpv1ReadAndAlarmAcknowledgement) {
   EXPECT_EQ(b.master->slave_stats(11).alarm_acks, 1u);
   EXPECT_EQ(b.master->slave_stats(11).dh, 1u);
   EXPECT_EQ(b.master->slave_state(11), SlaveStatusState::DataExchange);
+}
+
+TEST(DpMasterLine, SyncAndFreezeGroups) {
+  SlaveParams p = params10();
+  p.station_status |= kPrmSyncReq | kPrmFreezeReq;
+  p.group_ident = 0x01;
+  SlaveConfig c = config10();
+  c.features.sync = true;
+  c.features.freeze = true;
+  Bench b(MasterParams{}, {p}, {c});
+  b.run_for(20 * bus::kTicksPerMs);
+  ASSERT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  auto& app = b.engines[0]->application();
+  Bytes got(1);
+
+  // Freeze: the inputs sampled at the command are what the master keeps getting.
+  const Bytes in1{0x11}, in2{0x22};
+  app.write_inputs(0, in1);
+  b.run_for(2 * bus::kTicksPerMs);
+  b.master->global_control(kGcFreeze, 0x01);
+  b.run_for(2 * bus::kTicksPerMs);
+  EXPECT_TRUE(b.engines[0]->freeze_mode());
+  app.write_inputs(0, in2);
+  b.run_for(2 * bus::kTicksPerMs);
+  b.master->image(10).read_inputs(0, got);
+  EXPECT_EQ(got, in1);
+  b.master->global_control(kGcUnfreeze, 0x01);
+  b.run_for(2 * bus::kTicksPerMs);
+  b.master->image(10).read_inputs(0, got);
+  EXPECT_EQ(got, in2);
+
+  // Sync: outputs are latched at the command and held until the next one.
+  const Bytes out1{0x0F}, out2{0xF0};
+  b.master->image(10).write_outputs(1, out1);
+  b.run_for(2 * bus::kTicksPerMs);
+  b.master->global_control(kGcSync, 0x01);
+  b.run_for(2 * bus::kTicksPerMs);
+  EXPECT_TRUE(b.engines[0]->sync_mode());
+  b.master->image(10).write_outputs(1, out2);
+  b.run_for(2 * bus::kTicksPerMs);
+  app.read_outputs(1, got);
+  EXPECT_EQ(got, out1);
+  b.master->global_control(kGcSync, 0x01);
+  b.run_for(2 * bus::kTicksPerMs);
+  app.read_outputs(1, got);
+  EXPECT_EQ(got, out2);
+  // A command for another group does not reach it.
+  b.master->global_control(kGcUnsync, 0x02);
+  b.run_for(2 * bus::kTicksPerMs);
+  EXPECT_TRUE(b.engines[0]->sync_mode());
+  // Sync/Unsync at the start of a pass: "68 07 07 68 FF 81 46 3A 3E 10 02 50 16" went out.
+  bool seen = false;
+  for (std::size_t i = 0; i < b.rec.size(); ++i)
+    seen = seen || b.rec.hex(i) == "68 07 07 68 FF 81 46 3A 3E 10 02 50 16";
+  EXPECT_TRUE(seen);
+}
+
+TEST(DpMasterLine, Class2MasterNextToAClass1Master) {
+  Bench b(MasterParams{}, {params10()}, {config10()});
+  Class2Master c2({2, 100});
+  fdl::ActiveStation st2(2, b.bp, c2);
+  b.line.attach(st2, "master 2 (class 2)");
+  b.line.start();
+  b.run_for(50 * bus::kTicksPerMs);
+  ASSERT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  ASSERT_TRUE(st2.in_ring());
+  const Bytes in{0x5A}, out{0xA5};
+  b.engines[0]->application().write_inputs(0, in);
+  b.master->image(10).write_outputs(1, out);
+  b.run_for(2 * bus::kTicksPerMs);
+
+  std::vector<Class2Result> res;
+  auto cb = [&](const Class2Result& r) { res.push_back(r); };
+  c2.slave_diag(10, cb);
+  c2.get_cfg(10, cb);
+  c2.rd_inp(10, cb);
+  c2.rd_outp(10, cb);
+  b.run_for(10 * bus::kTicksPerMs);
+  ASSERT_EQ(res.size(), 4u);
+  for (const auto& r : res) EXPECT_EQ(r.status, AcyclicStatus::Ok) << to_string(r.service);
+  EXPECT_EQ(res[0].diag.master_add, 1);  // parameterised by master 1
+  EXPECT_EQ(res[0].diag.status_1 & kDiagMasterLock, 0);  // Master_Lock is for masters to set
+  EXPECT_EQ(res[1].data, (Bytes{0x10, 0x20}));
+  EXPECT_EQ(res[2].data, in);
+  EXPECT_EQ(res[3].data, out);
+  // The class-2 requests disturbed nothing.
+  EXPECT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  EXPECT_EQ(b.count(MasterEvent::Kind::StationFailure), 0);
 }
 
 }  // namespace

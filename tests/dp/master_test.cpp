@@ -796,5 +796,33 @@ TEST(DpMaster, DeactivatedSlaveIsNeverAddressed) {
   EXPECT_EQ(hex(m.slave_diag(kS)), "00 80 00 FF 12 34");
 }
 
+TEST(DpMaster, PollsInConfigurationOrderAndContinuesACutPass) {
+  // Configuration order 12, 10, 11 (not address order); no inputs or outputs: SD1 frames.
+  std::vector<SlaveParams> ps;
+  for (std::uint8_t a : {std::uint8_t{12}, std::uint8_t{10}, std::uint8_t{11}}) {
+    SlaveParams p = slave10({{0x00}});  // an empty slot: no data either way
+    p.address = a;
+    ps.push_back(p);
+  }
+  Master m(master1(), ps);
+  MasterDriver d(m);
+  m.on_power_on(0);
+  d.token();
+  take_gc(d, kGcOperate);
+  // Slave_Diag to each, in configuration order: 8C+81+6D+3C+3E = 1F4, 8A.. = 1F2, 8B.. = 1F3.
+  EXPECT_EQ(d.next(), "68 05 05 68 8C 81 6D 3C 3E F4 16");
+  d.confirm_none(0);
+  EXPECT_EQ(d.next(), "68 05 05 68 8A 81 6D 3C 3E F2 16");
+  d.confirm_none(0);
+  // The token hold time runs out here: the next visit goes on with slave 11, then the pass
+  // ends and the following visit starts again with 12.
+  d.token_keep();
+  EXPECT_EQ(d.next(), "68 05 05 68 8B 81 6D 3C 3E F3 16");
+  d.confirm_none(0);
+  EXPECT_EQ(d.next(), "");
+  d.token();
+  EXPECT_EQ(d.next(), "68 05 05 68 8C 81 6D 3C 3E F4 16");
+}
+
 }  // namespace
 }  // namespace pbvbus::dp

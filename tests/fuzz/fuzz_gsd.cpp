@@ -1,5 +1,7 @@
 // libFuzzer target for the GSD reader (PI 2.122): any byte string must give either a model or
 // located errors, and every model operation must work on an accepted model.
+//   build-fuzz/bin/fuzz_gsd -dict=tests/fuzz/gsd.dict -max_total_time=60 <scratch corpus dir> \
+//     tests/data/gsd examples/gsd
 #include <cstddef>
 #include <cstdint>
 #include <string_view>

@@ -27,6 +27,11 @@
 //   shorter than 3 bytes gets a warning, and the assembly fills the missing status bytes with the
 //   minimal DP-V1 values 0x80 (DPV1_Enable), 0x00, 0x00.
 // - Multi-byte parameters (Unsigned16/32, Signed16/32) are big-endian, as everything on PROFIBUS.
+// - Bit(b) / BitArea(a-b) count bits from the LSB (bit 0 = 0x01) of the byte at the reference's
+//   offset; several Ext_User_Prm_Data_Ref at one offset share that byte.
+// - A module without Ext_Module_Prm_Data_Len has a parameter area as long as its overlays reach.
+// - Configuration identifiers (§D.3): a special identifier's manufacturer count 15 means "none
+//   follow" (Chk_Cfg semantics, since the GSD bytes are what the master sends in Chk_Cfg).
 // - Mandatory keywords: Ident_Number missing, a `*_supp = 1` baud rate without its MaxTsdr, no
 //   baud rate at all, a slave without any Module, and Modular_Station = 1 without Max_Module are
 //   errors; missing Station_Type, Min_Slave_Intervall or Max_Diag_Data_Len only warn.

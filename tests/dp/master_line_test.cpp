@@ -316,5 +316,45 @@ TEST(DpMasterLine, Class2MasterNextToAClass1Master) {
   EXPECT_EQ(b.count(MasterEvent::Kind::StationFailure), 0);
 }
 
+TEST(DpMasterLine, WrongConfigurationShowsCfgFaultAndNeverExchangesData) {
+  SlaveParams p = params10();
+  p.modules = {{{0x10}, "DI 8"}, {{0x21}, "DO 16 (wrong)"}};
+  Bench b(MasterParams{}, {p}, {config10()});
+  b.run_for(20 * bus::kTicksPerMs);
+  EXPECT_NE(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  EXPECT_EQ(b.engines[0]->state(), SlaveState::WaitPrm);
+  const auto diag = b.master->slave_diag(10);
+  ASSERT_GE(diag.size(), 6u);
+  // The last diagnosis read after a Chk_Cfg: Cfg_Fault (plus the identifier block naming
+  // module 1), not parameterised.
+  EXPECT_NE(diag[0] & kDiagCfgFault, 0);
+  EXPECT_EQ(diag[3], 0xFF);
+  EXPECT_GT(b.master->slave_stats(10).startups, 3u);  // it keeps trying
+  EXPECT_EQ(b.master->slave_stats(10).data_exchanges, 0u);
+  EXPECT_EQ(b.count(MasterEvent::Kind::StationFailure), 0);
+}
+
+TEST(DpMasterLine, SecondClass1MasterSeesTheSlaveLocked) {
+  Bench b(MasterParams{}, {params10()}, {config10()});
+  b.run_for(20 * bus::kTicksPerMs);
+  ASSERT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  MasterParams mp2;
+  mp2.address = 3;
+  Master m3(mp2, {params10()});
+  fdl::ActiveStation st3(3, b.bp, m3);
+  b.line.attach(st3, "master 3");
+  b.line.start();
+  b.run_for(60 * bus::kTicksPerMs);
+  ASSERT_TRUE(st3.in_ring());
+  EXPECT_EQ(m3.slave_state(10), SlaveStatusState::Locked);
+  const auto diag = m3.slave_diag(10);
+  ASSERT_EQ(diag.size(), 6u);
+  EXPECT_EQ(diag[0], kDiagMasterLock);  // set by master 3 itself
+  EXPECT_EQ(diag[3], 1);                // owned by master 1
+  EXPECT_EQ(m3.slave_stats(10).startups, 0u);  // never tried to parameterise it
+  EXPECT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  EXPECT_EQ(b.engines[0]->master_address(), 1);
+}
+
 }  // namespace
 }  // namespace pbvbus::dp

@@ -237,6 +237,29 @@ GsdOutcome<GsdBytes> GsdFile::cfg_data(const std::vector<std::size_t>& modules) 
   return out;
 }
 
+std::optional<std::vector<std::size_t>> GsdFile::modules_for_cfg(const GsdBytes& cfg) const {
+  // Depth-first over positions; a position from which no split exists is remembered, so the
+  // search is linear in cfg.size() x modules.
+  std::vector<bool> dead(cfg.size() + 1, false);
+  std::vector<std::size_t> chosen;
+  auto search = [&](auto& self, std::size_t pos) -> bool {
+    if (pos == cfg.size()) return true;
+    if (dead[pos]) return false;
+    for (std::size_t i = 0; i < m_modules.size(); ++i) {
+      const auto& c = m_modules[i].config;
+      if (c.empty() || c.size() > cfg.size() - pos || !std::equal(c.begin(), c.end(), cfg.begin() + pos))
+        continue;
+      chosen.push_back(i);
+      if (self(self, pos + c.size())) return true;
+      chosen.pop_back();
+    }
+    dead[pos] = true;
+    return false;
+  };
+  if (!search(search, 0)) return std::nullopt;
+  return chosen;
+}
+
 GsdOutcome<std::pair<std::size_t, std::size_t>> GsdFile::check_modules(
     const std::vector<std::size_t>& modules) const {
   GsdOutcome<std::pair<std::size_t, std::size_t>> out;

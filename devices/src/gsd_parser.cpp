@@ -976,7 +976,7 @@ void GsdParser::in_prm_text(const Stmt& s) {
     m_block = Block::Top;
     top(s);
   } else {
-    warning(s.line, "unknown keyword '" + s.keyword + "'" + where + " ignored");
+    unknown(s, where);
   }
 }
 
@@ -1127,7 +1127,7 @@ void GsdParser::in_ext_prm(const Stmt& s) {
     m_block = Block::Top;
     top(s);
   } else {
-    warning(s.line, "unknown keyword '" + s.keyword + "' in " + what + " ignored");
+    unknown(s, " in " + what);
   }
 }
 
@@ -1150,7 +1150,7 @@ void GsdParser::in_diag_area(const Stmt& s) {
     m_block = Block::Top;
     top(s);
   } else {
-    warning(s.line, "unknown keyword '" + s.keyword + "' in Unit_Diag_Area ignored");
+    unknown(s, " in Unit_Diag_Area");
   }
 }
 
@@ -1165,7 +1165,7 @@ void GsdParser::in_slots(const Stmt& s) {
       m_block = Block::Top;
       top(s);
     } else {
-      warning(s.line, "unknown keyword '" + s.keyword + "' in SlotDefinition ignored");
+      unknown(s, " in SlotDefinition");
     }
     return;
   }

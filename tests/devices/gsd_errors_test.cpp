@@ -215,3 +215,15 @@ TEST(GsdSyntax, CommentsContinuationsCaseAndLineEndings) {
   EXPECT_EQ(r.file->modules().at(0).line, 14u);
   EXPECT_EQ(r.file->keyword("user_prm_data")->line, 11u);
 }
+
+TEST(GsdWarnings, UnknownKeywordsInsideBlocksAreKept) {
+  std::string text = make({}, {"PrmText = 1", "Text(0) = \"a\"", "Odd = 1", "EndPrmText", "ExtUserPrmData = 2 \"p\"",
+                               "Bit(0) 0 0-1", "Help = \"x\"", "EndExtUserPrmData"});
+  GsdParseResult r = parse_gsd(text, "w.gsd");
+  ASSERT_TRUE(r.ok());
+  ASSERT_EQ(r.warnings.size(), 2u);
+  EXPECT_EQ(r.warnings[0].to_string(), "w.gsd:13: unknown keyword 'Odd' in PrmText 1 kept");
+  EXPECT_EQ(r.warnings[1].to_string(), "w.gsd:17: unknown keyword 'Help' in ExtUserPrmData 2 'p' kept");
+  ASSERT_EQ(r.file->unknown_keywords().size(), 2u);
+  EXPECT_EQ(r.file->unknown_keywords()[1].value, "\"x\"");
+}

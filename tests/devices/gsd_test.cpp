@@ -367,6 +367,17 @@ TEST(Gsd, UserPrmDataTruncatedToMaxLen) {
   EXPECT_EQ(chk.errors[0], "User_Prm_Data of 4 bytes exceeds Max_User_Prm_Data_Len 3");
 }
 
+TEST(Gsd, ModulesForCfg) {
+  const GsdFile f = load_ok("examples/gsd/PBVB0A02.gsd");
+  EXPECT_EQ(f.modules_for_cfg({0x10, 0x21, 0xD3, 0x61}), (std::vector<std::size_t>{0, 3, 4, 5}));
+  EXPECT_EQ(f.modules_for_cfg({}), (std::vector<std::size_t>{}));
+  EXPECT_FALSE(f.modules_for_cfg({0x10, 0x22}));
+  // Multi-byte configs need backtracking: 0x40 alone is no module, 0x40 0xC3 is.
+  const GsdFile d = load_ok("examples/gsd/PBVB0A03.gsd");
+  EXPECT_EQ(d.modules_for_cfg({0x40, 0xC3, 0x10}), (std::vector<std::size_t>{3, 0}));
+  EXPECT_FALSE(d.modules_for_cfg({0x40, 0xC2}));
+}
+
 TEST(Gsd, ParameterSettings) {
   const GsdFile f = load_ok("examples/gsd/PBVB0A02.gsd");
   const std::vector<std::size_t> sel = {0, 3, 4, 5};  // 8DI, 16DO, 4AI, 2AO

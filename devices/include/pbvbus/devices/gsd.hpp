@@ -349,6 +349,9 @@ class GsdFile {
   GsdBytes prm_area_defaults(const GsdPrmArea& area) const;
   /// Chk_Cfg data: the concatenated config bytes of these modules. Errors: index out of range.
   GsdOutcome<GsdBytes> cfg_data(const std::vector<std::size_t>& modules) const;
+  /// Splits Chk_Cfg (or Get_Cfg) data into modules of this file: a module list whose
+  /// cfg_data() equals `cfg` (modules tried in file order at each position), or nullopt.
+  std::optional<std::vector<std::size_t>> modules_for_cfg(const GsdBytes& cfg) const;
   /// Checks a module selection against Max_Module, Max_Input_Len, Max_Output_Len, Max_Data_Len,
   /// Max_User_Prm_Data_Len and the 244-byte Chk_Cfg limit (and, for a non-modular station, that
   /// exactly one module is chosen). value = {input bytes, output bytes}.

@@ -149,6 +149,7 @@ TEST(DpMaster, GoldenStartupInClearThenOperate) {
   EXPECT_EQ(m.slave_stats(kS).startups, 1u);
   EXPECT_EQ(ev.count(MasterEvent::Kind::StationFailure), 0);
   EXPECT_EQ(ev.count(MasterEvent::Kind::ModeChange), 1);
+  EXPECT_EQ(ev.count(MasterEvent::Kind::Diagnosis), 0);  // start-up reads raise no events
 }
 
 TEST(DpMaster, GoldenDataExchangeTwoAndEightOutputBytes) {

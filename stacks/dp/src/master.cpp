@@ -450,7 +450,9 @@ void Master::store_diag(Slave& s, std::span<const std::uint8_t> du, std::uint8_t
   m_scratch[0] |= extra_status_1;
   const bool changed = m_scratch != s.diag;
   s.diag.swap(m_scratch);
-  if (changed || force_event) {
+  // Start-up reads are the master's own business; a diagnosis is news once the slave has been
+  // in data exchange (S7: OB 82 comes from slaves in operation).
+  if ((changed && s.in_dx) || force_event) {
     MasterEvent e;
     e.kind = MasterEvent::Kind::Diagnosis;
     e.time = now;

@@ -46,8 +46,9 @@
 //   NotPresent, its stored diagnosis is `01 00 00 FF idH idL` (Station_Non_Existent, ident from
 //   the configuration), and its Slave_Diag is retried once per pass (at most every
 //   failed_retry_interval). A return then runs the full start-up (re-parameterisation).
-// - Diagnosis events: on every Slave_Diag read because of DH, and on any other read whose
-//   octets differ from the stored diagnosis.
+// - Diagnosis events: on every Slave_Diag read because of DH, and on any other read, while the
+//   slave is in data exchange (or in Stat_Diag after it), whose octets differ from the stored
+//   diagnosis. The reads of the start-up raise none (StationFailure/Return carry the diag).
 // - DP-V1 (slave configured with DPV1_Enable in DPV1_Status_1): Read/Write go to slave SAP 51
 //   from SSAP 51 and Alarm_Ack to SAP 50 from SSAP 51. An SC or empty DL answer means "not
 //   ready": the master polls with an SRD without data on the same SAPs once per pass (§E.4)

@@ -71,7 +71,7 @@ class SlaveModel::User final : public fdl::ResponderUser {
     const bool dx = !ind.dsap && !ind.ssap && !ind.broadcast() &&
                     (ind.fn == fdl::RequestFn::SrdHigh || ind.fn == fdl::RequestFn::SrdLow) &&
                     e.state() == dp::SlaveState::DataExch && ind.sa == e.master_address();
-    m_model.refresh_inputs(ind.now, dx);
+    m_model.refresh_inputs(ind.now);
     e.on_request(ind, reply);
     if (dx) ++m_model.m_dp_cycles;
   }
@@ -242,9 +242,12 @@ SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleCh
     cfg.features.max_alarm_mode = mode;
     cfg.features.wd_base_1ms = v1.wd_base_1ms_supp;
     cfg.features.check_cfg_mode = v1.check_cfg_mode;
+    cfg.features.prm_structure = v1.prm_block_structure_supp;
+    cfg.features.prm_cmd = gsd.redundancy().prm_cmd_supp;
   }
   cfg.min_user_prm_len = prm.size();
-  cfg.max_user_prm_len = prm.size();
+  // Structured parameter blocks follow the GSD part when the slave accepts them.
+  cfg.max_user_prm_len = cfg.features.prm_structure ? dp::kMaxUserPrmLen : prm.size();
 
   // Every Ext_User_Prm_Data_Ref parameter at its place: station area, then the modules' areas.
   std::vector<PrmCheck> checks;
@@ -340,8 +343,7 @@ std::string SlaveModel::add_channel_behaviour(std::size_t module, std::size_t of
   return {};
 }
 
-void SlaveModel::refresh_inputs(bus::Ticks now, bool dp_cycle) {
-  (void)dp_cycle;
+void SlaveModel::refresh_inputs(bus::Ticks now) {
   dp::SlaveApplication& app = m_engine->application();
   for (std::size_t m = 0; m < m_modules.size(); ++m) {
     Module& mod = m_modules[m];
@@ -449,7 +451,7 @@ void SlaveModel::do_apply(const SlaveFault& f) {
       if (m_modules[f.module].pulled == pulled) break;
       m_modules[f.module].pulled = pulled;
       app.set_module_state(f.module, pulled ? dp::ModuleState::NoModule : dp::ModuleState::Ok);
-      if (pulled) refresh_inputs(port().now(), false);  // zero at once, not at the next request
+      if (pulled && bound()) refresh_inputs(port().now());  // zero now, not at the next request
       if (m_dpv1_pull_plug)
         app.raise_alarm(static_cast<std::uint8_t>(pulled ? dp::AlarmType::Pull : dp::AlarmType::Plug), slot,
                         pulled ? dp::AlarmSpec::Appears : dp::AlarmSpec::Disappears, false);

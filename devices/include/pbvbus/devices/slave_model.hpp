@@ -25,7 +25,8 @@
 //   (after truncation to Max_User_Prm_Data_Len), and every Ext_User_Prm_Data_Ref parameter in it
 //   (station area, then each module's area in module order) must hold a value its ExtUserPrmData
 //   allows; anything else → Prm_Fault. Constant octets are not checked (vendors differ; most
-//   ignore reserved bits).
+//   ignore reserved bits). A DP-V1 slave with Prm_Block_Structure_supp also accepts structured
+//   parameter blocks after that part (up to 237 octets in all); the check covers the GSD part.
 // - TSDR: the station's own delay in bit times; unset = the line's min TSDR (a fast ASIC). It must
 //   lie within [bus min TSDR, the GSD's MaxTsdr for the line's baud]; a baud the GSD does not
 //   support is a build error (a real slave would never sync to it).
@@ -169,7 +170,7 @@ class SlaveModel final : public bus::Device {
   SlaveModel() = default;
   std::string check_fault(const SlaveFault& f) const;
   void do_apply(const SlaveFault& f);
-  void refresh_inputs(bus::Ticks now, bool dp_cycle);
+  void refresh_inputs(bus::Ticks now);
   void run_due(bus::Ticks now);
   void rearm();
 

@@ -6,7 +6,10 @@ FdlPoller::FdlPoller(std::vector<PollItem> items)
     : m_items(std::move(items)),
       m_stats(m_items.size()),
       m_visit_done(m_items.size(), 0),
-      m_seq(m_items.size(), 0) {}
+      m_seq(m_items.size(), 0) {
+  for (std::size_t k = 0; k < m_items.size(); ++k)
+    m_by_prio[fdl::fn_is_high_priority(m_items[k].fn) ? 0 : 1].push_back(k);
+}
 
 PollStats FdlPoller::total() const {
   PollStats t;
@@ -27,16 +30,19 @@ void FdlPoller::on_power_on(bus::Ticks) {
 }
 
 bool FdlPoller::next_request(fdl::Priority prio, bus::Ticks, fdl::Request& out) {
-  const std::size_t n = m_items.size();
-  if (n == 0) return false;
-  const bool high = prio == fdl::Priority::High;
-  std::size_t& cursor = m_cursor[high ? 0 : 1];
+  const int p = prio == fdl::Priority::High ? 0 : 1;
+  const std::vector<std::size_t>& list = m_by_prio[p];
+  const std::size_t n = list.size();
+  // The station asks again after every message cycle, so the common case (the item at the
+  // cursor is due) costs one look; only the last, unsuccessful ask of a visit scans the list.
+  std::size_t& cursor = m_cursor[p];
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = (cursor + i) % n;
+    const std::size_t pos = cursor + i < n ? cursor + i : cursor + i - n;
+    const std::size_t k = list[pos];
+    if (m_visit_done[k] == m_visit) continue;
     const PollItem& it = m_items[k];
-    if (fdl::fn_is_high_priority(it.fn) != high || m_visit_done[k] == m_visit) continue;
     m_visit_done[k] = m_visit;
-    cursor = (k + 1) % n;
+    cursor = pos + 1 < n ? pos + 1 : 0;
     out.da = it.da;
     out.fn = it.fn;
     out.dsap.reset();

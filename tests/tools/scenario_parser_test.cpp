@@ -203,6 +203,8 @@ TEST(ScenarioParser, StationDetails) {
             Errs{"s.textproto:2:31: poll needs at least one address"});
   EXPECT_EQ(errors_of(kLine + "serial { line: \"A\" mode: MONITOR address: 3 }\n"),
             Errs{"s.textproto:2:34: a serial MONITOR has no address (only a STATION has one)"});
+  EXPECT_EQ(errors_of(kLine + "serial { line: \"A\" mode: STATION }\n"),
+            Errs{"s.textproto:2:1: a serial STATION needs the address of the external station"});
 }
 
 TEST(ScenarioParser, CollectsEveryError) {

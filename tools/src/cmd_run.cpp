@@ -8,6 +8,8 @@
 //  - `--capture -` streams pcapng to stdout; the report then goes to stderr, and --json (which
 //    would also need stdout) is refused.
 //  - --quiet prints nothing but errors and the --json report.
+//  - A paced run without a duration (none in the scenario, no --duration) runs until SIGINT or
+//    SIGTERM; either signal ends any run early, and the report covers the time run so far.
 //  - Progress (virtual time, speed) goes to stderr only when stderr is a terminal and the run
 //    has taken more than a second of wall time; it is erased before the report.
 //  - Exit codes: 0 done, 1 the run failed (capture could not be written), 2 bad usage or a bad
@@ -15,7 +17,10 @@
 
 #include <unistd.h>
 
+#include <boost/asio/signal_set.hpp>
+#include <charconv>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -24,6 +29,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/tools/commands.hpp"
 #include "pbvbus/tools/report.hpp"
@@ -43,12 +49,31 @@ constexpr const char* kUsage =
     "options:\n"
     "  --fast            run as fast as possible (default without serial attachments)\n"
     "  --paced           virtual time follows the wall clock (default with serial attachments)\n"
-    "  --duration T      how long to run, e.g. 500ms, 5s, 2min (overrides the scenario)\n"
+    "  --duration T      how long to run, e.g. 500ms, 5s, 2min (overrides the scenario);\n"
+    "                    a paced run without any duration runs until interrupted\n"
     "  --seed N          seed of the random choices (overrides the scenario)\n"
+    "  --speed N[/M]     paced runs: virtual time runs N/M times as fast as the wall clock\n"
+    "                    (e.g. 1/1000 to let a program behind a pty answer within TSDR)\n"
     "  --capture FILE    write a pcapng capture; '-' streams it to stdout\n"
     "  --json            print the report as JSON (schema pbvbus.run.report/1)\n"
     "  --quiet           print nothing but errors (and the --json report)\n"
     "  -h, --help        this text\n";
+
+/// "N" or "N/M", positive integers.
+std::optional<bus::Speed> parse_speed(const std::string& v) {
+  auto num = [](std::string_view t) -> std::optional<std::uint32_t> {
+    std::uint32_t x = 0;
+    auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), x);
+    if (ec != std::errc() || p != t.data() + t.size() || x == 0) return std::nullopt;
+    return x;
+  };
+  const auto slash = v.find('/');
+  auto n = num(std::string_view(v).substr(0, slash));
+  auto d = slash == std::string::npos ? std::optional<std::uint32_t>(1)
+                                      : num(std::string_view(v).substr(slash + 1));
+  if (!n || !d) return std::nullopt;
+  return bus::Speed{*n, *d};
+}
 
 struct RunArgs {
   std::optional<std::string> scenario;
@@ -57,6 +82,7 @@ struct RunArgs {
   std::optional<bus::Ticks> duration;
   std::optional<std::uint64_t> seed;
   std::optional<std::string> capture;
+  std::optional<bus::Speed> speed;
   bool json = false;
   bool quiet = false;
   bool help = false;
@@ -101,6 +127,12 @@ std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
       }
       if (used == 0 || used != v->size()) return "bad seed '" + *v + "' (expected an unsigned integer)";
       out.seed = s;
+    } else if (a == "--speed") {
+      auto v = value("--speed");
+      if (!v) return "--speed needs a value, e.g. --speed 1/1000";
+      auto sp = parse_speed(*v);
+      if (!sp) return "bad speed '" + *v + "' (expected N or N/M with positive integers)";
+      out.speed = *sp;
     } else if (a == "--capture") {
       auto v = value("--capture");
       if (!v || v->empty()) return "--capture needs a file name or '-'";
@@ -132,8 +164,12 @@ class Progress {
     const double w = std::chrono::duration<double>(wall).count();
     const double v = static_cast<double>(now) / bus::kTicksPerSecond;
     char buf[160];
-    std::snprintf(buf, sizeof buf, "\r%s / %s virtual, %.1fx real time   ",
-                  bus::format_duration(now).c_str(), bus::format_duration(m_total).c_str(), v / w);
+    if (m_total > 0)
+      std::snprintf(buf, sizeof buf, "\r%s / %s virtual, %.1fx real time   ",
+                    bus::format_duration(now).c_str(), bus::format_duration(m_total).c_str(), v / w);
+    else
+      std::snprintf(buf, sizeof buf, "\r%s virtual, %.3fx real time   ",
+                    bus::format_duration(now).c_str(), v / w);
     m_err << buf << std::flush;
     m_shown = true;
   }
@@ -151,6 +187,24 @@ class Progress {
   std::chrono::steady_clock::time_point m_t0;
   std::chrono::steady_clock::duration m_last{};
   bool m_shown = false;
+};
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_signal(int) { g_interrupted = 1; }
+
+/// Shows progress every 100 ms of virtual time during a paced run (run_until blocks).
+class ProgressTick final : public bus::EventTarget {
+ public:
+  ProgressTick(bus::Scheduler& s, Progress& p) : m_sched(s), m_progress(p) {}
+  void arm() { m_sched.schedule(m_sched.now() + 100 * bus::kTicksPerMs, *this); }
+  void on_event(bus::Ticks now, std::uint64_t) override {
+    m_progress.update(now);
+    arm();
+  }
+
+ private:
+  bus::Scheduler& m_sched;
+  Progress& m_progress;
 };
 
 }  // namespace
@@ -173,6 +227,23 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     return 2;
   }
 
+  const ScenarioPlan& plan = *loaded.plan;
+  bool has_serial = false;
+  for (const auto& l : plan.lines)
+    for (const auto& st : l.stations)
+      has_serial |= st.kind == StationKind::SerialMonitor || st.kind == StationKind::SerialStation;
+  const bool paced = ra.paced || (!ra.fast && has_serial);
+  const std::optional<bus::Ticks> duration = ra.duration ? ra.duration : plan.duration;
+  if (!duration && !paced) {
+    err << "pbvbus run: " << plan.file
+        << ": the scenario has no duration; add duration: \"5s\" or use --duration\n";
+    return 2;
+  }
+  if (ra.speed && !paced) {
+    err << "pbvbus run: --speed applies to paced runs only (add --paced)\n";
+    return 2;
+  }
+
   // With the capture on stdout, everything else goes to stderr.
   const bool capture_stdout = ra.capture && *ra.capture == "-";
   std::ostream& report_os = capture_stdout ? err : out;
@@ -188,48 +259,69 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   }
 
   SimulationOptions so;
-  so.duration = ra.duration;
+  so.duration = duration;
   so.seed = ra.seed;
   so.capture = capture.get();
   std::unique_ptr<Simulation> sim;
   try {
-    sim = std::make_unique<Simulation>(*loaded.plan, so);
+    sim = std::make_unique<Simulation>(plan, so);
   } catch (const std::exception& e) {
     err << "pbvbus run: " << e.what() << "\n";
     return 1;
   }
-  if (!sim->duration()) {
-    err << "pbvbus run: " << loaded.plan->file
-        << ": the scenario has no duration; add duration: \"5s\" or use --duration\n";
-    return 2;
-  }
-  const bus::Ticks end = *sim->duration();
-  const bool paced = ra.paced || (!ra.fast && sim->has_external_attachments());
+  // A paced run without a duration goes on until interrupted.
+  // (Ten years: far enough, and safe from overflow when the runner scales it to wall time.)
+  const bus::Ticks end = duration ? *duration : 10 * 365 * 24 * 3600 * bus::kTicksPerSecond;
 
   if (!ra.quiet) {
-    for (const auto& s : sim->serial_ports())
-      err << "serial " << s.mode << " on line " << s.line << ": " << s.path << "\n";
-    if (ra.fast && sim->has_external_attachments())
+    for (const auto& sp : sim->serial_ports()) {
+      err << "serial " << sp.mode << " on line " << sp.line << ": " << sp.path;
+      if (!sp.link.empty()) err << " (" << sp.link << ")";
+      err << "\n";
+    }
+    if (ra.fast && has_serial)
       err << "pbvbus run: warning: --fast with serial attachments: the bus runs faster than real "
              "time\n";
+    if (paced && !duration) err << "pbvbus run: running until interrupted (Ctrl-C)\n";
   }
 
   const bool show_progress = !ra.quiet && &err == &std::cerr && ::isatty(STDERR_FILENO) == 1;
-  Progress progress(err, show_progress, end);
-  if (paced) {
-    err << "pbvbus run: --paced needs bus::PacedRunner, not yet in this build\n";
-    return 1;
-  }
+  Progress progress(err, show_progress, duration.value_or(0));
+  g_interrupted = 0;
   sim->start();
-  // Run in slices so that progress can be shown; the slices do not change the result.
-  const bus::Ticks slice = 10 * bus::kTicksPerMs;
-  for (bus::Ticks t = 0; t < end;) {
-    t = std::min(end, t + slice);
-    sim->run_until(t);
-    progress.update(t);
+  if (paced) {
+    bus::PacedRunner runner(sim->scheduler(), ra.speed.value_or(bus::Speed{}));
+    sim->attach_io(runner);
+    boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
+    signals.async_wait([&runner](const boost::system::error_code& ec, int) {
+      if (!ec) {
+        g_interrupted = 1;
+        runner.stop();
+      }
+    });
+    ProgressTick tick(sim->scheduler(), progress);
+    tick.arm();
+    runner.run_until(end);
+    signals.cancel();
+  } else {
+    // Ctrl-C ends a fast run at the next slice, with a report.
+    auto old_int = std::signal(SIGINT, on_signal);
+    auto old_term = std::signal(SIGTERM, on_signal);
+    // Slices let progress show and ptys be read; they do not change the result.
+    const bus::Ticks slice = 10 * bus::kTicksPerMs;
+    for (bus::Ticks t = sim->scheduler().now(); t < end && !g_interrupted;) {
+      t = std::min(end, t + slice);
+      if (has_serial) sim->poll_serial();
+      sim->run_until(t);
+      progress.update(t);
+    }
+    std::signal(SIGINT, old_int);
+    std::signal(SIGTERM, old_term);
   }
   progress.clear();
   const double wall = progress.elapsed();
+  if (g_interrupted && !ra.quiet)
+    err << "pbvbus run: interrupted at " << bus::format_duration(sim->scheduler().now()) << "\n";
 
   int rc = 0;
   if (capture) {

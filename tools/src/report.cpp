@@ -92,7 +92,11 @@ void write_text(const Report& r, std::ostream& os) {
     os << " (" << fixed(static_cast<double>(r.duration) / bus::kTicksPerSecond / r.wall_seconds, 1)
        << "x real time)";
   os << ", " << r.events << " events\n";
-  for (const auto& s : r.serial) os << "serial " << s.mode << " on line " << s.line << ": " << s.path << "\n";
+  for (const auto& s : r.serial) {
+    os << "serial " << s.mode << " on line " << s.line << ": " << s.path;
+    if (!s.link.empty()) os << " (" << s.link << ")";
+    os << "\n";
+  }
   for (const auto& l : r.lines) {
     const auto bit = bus::ticks_per_bit(l.baud);
     os << "\nline " << l.name << " (" << bus::baud_name(l.baud) << "bit/s, TSL " << l.params.tsl
@@ -160,7 +164,7 @@ void write_json(const Report& r, std::ostream& os) {
   for (std::size_t i = 0; i < r.serial.size(); ++i) {
     const auto& s = r.serial[i];
     os << (i ? "," : "") << "{\"line\":" << json_string(s.line) << ",\"mode\":" << json_string(s.mode)
-       << ",\"path\":" << json_string(s.path) << "}";
+       << ",\"path\":" << json_string(s.path) << ",\"link\":" << json_string(s.link) << "}";
   }
   os << "],\n\"faults_not_reached\":[";
   for (std::size_t i = 0; i < r.faults_not_reached.size(); ++i)

@@ -290,6 +290,8 @@ class Planner {
       if (!e.address) {
         if (e.kind == StationKind::Master || e.kind == StationKind::Passive)
           error(e.where, what + " needs an address");
+        else if (e.kind == StationKind::SerialStation)
+          error(e.where, "a serial STATION needs the address of the external station");
       } else if (e.kind == StationKind::SerialMonitor) {
         error(aw, "a serial MONITOR has no address (only a STATION has one)");
       } else if (*e.address > kMaxAddress) {

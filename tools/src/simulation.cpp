@@ -4,6 +4,14 @@
 #include <array>
 #include <stdexcept>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include "pbvbus/bus/paced_runner.hpp"
+#include "pbvbus/bus/pty_station.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/devices/fdl_poller.hpp"
 #include "pbvbus/devices/fdl_responder.hpp"
@@ -42,7 +50,7 @@ struct Simulation::Station {
   std::unique_ptr<fdl::PassiveStation> passive;
   std::unique_ptr<fdl::ActiveStation> active;
   bus::AttachmentId position = -1;
-  std::unique_ptr<bus::Device> device;  // masters and attachments without a typed handle
+  std::unique_ptr<bus::PtyStation> pty;
 };
 
 struct Simulation::LineState {
@@ -58,7 +66,34 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
 }
 
-Simulation::~Simulation() = default;
+Simulation::~Simulation() {
+  for (const auto& l : m_links) ::unlink(l.c_str());
+}
+
+void Simulation::make_link(const std::string& target, const std::string& link) {
+  // Replace a stale link from an earlier run, but never a file that is not a symlink.
+  struct stat st;
+  if (::lstat(link.c_str(), &st) == 0) {
+    if (!S_ISLNK(st.st_mode))
+      throw std::runtime_error("cannot link the pty to " + link + ": a file of that name exists");
+    ::unlink(link.c_str());
+  }
+  if (::symlink(target.c_str(), link.c_str()) != 0)
+    throw std::runtime_error("cannot link the pty to " + link + ": " + std::strerror(errno));
+  m_links.push_back(link);
+}
+
+void Simulation::attach_io(bus::PacedRunner& runner) {
+  for (auto& ls : m_lines)
+    for (auto& s : ls->stations)
+      if (s.pty) s.pty->attach_io(runner);
+}
+
+void Simulation::poll_serial() {
+  for (auto& ls : m_lines)
+    for (auto& s : ls->stations)
+      if (s.pty) s.pty->poll_input();
+}
 
 void Simulation::build_line(std::size_t li) {
   const PlanLine& pl = m_plan.lines[li];
@@ -97,8 +132,25 @@ void Simulation::build_line(std::size_t li) {
         break;
       }
       case StationKind::SerialMonitor:
-      case StationKind::SerialStation:
-        throw std::runtime_error("serial attachments need bus::PtyStation, not yet in this build");
+      case StationKind::SerialStation: {
+        const auto& sp = m_plan.proto.serial(ps.source);
+        bus::PtyStation::Options o;
+        const bool station = ps.kind == StationKind::SerialStation;
+        o.mode = station ? bus::PtyStation::Mode::Station : bus::PtyStation::Mode::Monitor;
+        o.address = ps.address ? int(*ps.address) : -1;
+        try {
+          st.pty = std::make_unique<bus::PtyStation>(o);
+        } catch (const std::exception& e) {
+          throw std::runtime_error("cannot open a pseudo-terminal for line " + pl.name + ": " +
+                                   e.what());
+        }
+        label = station ? "serial station " + std::to_string(st.address) : "serial monitor";
+        st.position = ls->line->attach(*st.pty, label);
+        SerialReport sr{pl.name, station ? "station" : "monitor", st.pty->path(), sp.link()};
+        if (!sp.link().empty()) make_link(st.pty->path(), sp.link());
+        m_serial.push_back(std::move(sr));
+        break;
+      }
     }
     ls->stations.push_back(std::move(st));
   }

@@ -64,7 +64,8 @@ class FdlPoller final : public fdl::InitiatorUser {
   std::vector<std::uint64_t> m_visit_done;  ///< visit number in which item k was last sent
   std::vector<std::uint8_t> m_seq;          ///< per-item data counter
   std::uint64_t m_visit = 1;
-  std::size_t m_cursor[2] = {0, 0};  ///< per priority (High, Low)
+  std::vector<std::size_t> m_by_prio[2];  ///< item indices per priority (High, Low)
+  std::size_t m_cursor[2] = {0, 0};       ///< position in m_by_prio[p] to look at first
   std::uint64_t m_tokens = 0;
   std::vector<bus::Ticks> m_trr;
 };

@@ -12,7 +12,7 @@
 //     "duration_ns": int,            // virtual time simulated
 //     "wall_time_s": float, "speed": float,   // speed = virtual s / wall s
 //     "events": int,                 // scheduler events run
-//     "serial": [ { "line": str, "mode": "monitor"|"station", "path": str } ],
+//     "serial": [ { "line": str, "mode": "monitor"|"station", "path": str, "link": str } ],
 //     "faults_not_reached": [ str ], // scheduled after the end of the run
 //     "lines": [ {
 //       "name": str, "baud": int,
@@ -105,8 +105,9 @@ struct LineReport {
 
 struct SerialReport {
   std::string line;
-  std::string mode;
-  std::string path;
+  std::string mode;  ///< "monitor" or "station"
+  std::string path;  ///< the pty, e.g. /dev/pts/7
+  std::string link;  ///< the symlink to it, or ""
 };
 
 struct Report {

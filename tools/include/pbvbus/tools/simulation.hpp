@@ -10,6 +10,9 @@
 //    "serial monitor" or "serial station N" (the labels appear in fault descriptions).
 //  - Everything is powered at time 0; faults and repairs run as scheduler events at their
 //    time, before any station event of the same tick that was scheduled later.
+//  - A serial attachment opens a pseudo-terminal (bus::PtyStation); its `link`, if given, is
+//    created as a symbolic link to the pty (replacing an earlier symlink, never a file) and
+//    removed when the Simulation ends.
 //  - Faults scheduled after the end of the run (possible with a shorter --duration) are not
 //    applied and are listed in the report.
 
@@ -24,6 +27,9 @@
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
+namespace pbvbus::bus {
+class PacedRunner;
+}
 namespace pbvbus::captures {
 class PcapngWriter;
 }
@@ -67,6 +73,12 @@ class Simulation {
   bool has_external_attachments() const { return !m_serial.empty(); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
 
+  /// Paced driver: lets the pty attachments read their input on the runner's io_context.
+  /// Call once before runner.run_until().
+  void attach_io(bus::PacedRunner& runner);
+  /// Fast driver with ptys: reads what the programs wrote so far (call between slices).
+  void poll_serial();
+
   /// Powers every station and schedules the faults (done once; run_until calls it).
   void start();
   /// Fast driver: runs every event up to `t` as fast as the CPU allows.
@@ -81,6 +93,7 @@ class Simulation {
   void build_line(std::size_t li);
   void schedule_faults();
   void apply_fault(const PlanFault& f, bool on);
+  void make_link(const std::string& target, const std::string& link);
 
   ScenarioPlan m_plan;
   SimulationOptions m_opts;
@@ -90,6 +103,7 @@ class Simulation {
   std::vector<std::unique_ptr<LineState>> m_lines;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;
+  std::vector<std::string> m_links;  ///< symlinks to ptys, removed at the end
   bool m_started = false;
 };
 

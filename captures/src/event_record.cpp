@@ -32,17 +32,25 @@ std::size_t text_len(std::string_view text) {
 
 std::string_view to_string(EventCategory c) {
   switch (c) {
-    case EventCategory::Line: return "line";
-    case EventCategory::Station: return "station";
-    case EventCategory::Master: return "master";
-    case EventCategory::Redundancy: return "redundancy";
-    case EventCategory::Cpu: return "cpu";
-    case EventCategory::Note: return "note";
+    case EventCategory::Line:
+      return "line";
+    case EventCategory::Station:
+      return "station";
+    case EventCategory::Master:
+      return "master";
+    case EventCategory::Redundancy:
+      return "redundancy";
+    case EventCategory::Cpu:
+      return "cpu";
+    case EventCategory::Note:
+      return "note";
   }
   return "unknown";
 }
 
-std::size_t encoded_event_size(const EventRecord& e) { return kEventHeaderSize + text_len(e.text); }
+std::size_t encoded_event_size(const EventRecord& e) {
+  return kEventHeaderSize + text_len(e.text);
+}
 
 std::size_t encode_event(const EventRecord& e, std::span<std::uint8_t> out) {
   return encode_event(e, e.text, out);

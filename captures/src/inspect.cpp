@@ -16,43 +16,66 @@ bool is_fdl(std::uint16_t lt) {
   return lt == static_cast<std::uint16_t>(pcapng::LinkType::User0) ||
          lt == static_cast<std::uint16_t>(pcapng::LinkType::ProfibusDl);
 }
-bool is_events(std::uint16_t lt) { return lt == static_cast<std::uint16_t>(pcapng::LinkType::User1); }
+bool is_events(std::uint16_t lt) {
+  return lt == static_cast<std::uint16_t>(pcapng::LinkType::User1);
+}
 
 std::string_view sap_service(std::uint8_t sap) {
   switch (sap) {
-    case 49: return "MSAC_C2 RM";
-    case 50: return "Alarm_Ack";
-    case 51: return "MSAC_C1";
-    case 55: return "Set_Slave_Add";
-    case 56: return "Rd_Inp";
-    case 57: return "Rd_Outp";
-    case 58: return "Global_Control";
-    case 59: return "Get_Cfg";
-    case 60: return "Slave_Diag";
-    case 61: return "Set_Prm";
-    case 62: return "Chk_Cfg";
-    default: return sap <= 48 ? "MSAC_C2" : "";
+    case 49:
+      return "MSAC_C2 RM";
+    case 50:
+      return "Alarm_Ack";
+    case 51:
+      return "MSAC_C1";
+    case 55:
+      return "Set_Slave_Add";
+    case 56:
+      return "Rd_Inp";
+    case 57:
+      return "Rd_Outp";
+    case 58:
+      return "Global_Control";
+    case 59:
+      return "Get_Cfg";
+    case 60:
+      return "Slave_Diag";
+    case 61:
+      return "Set_Prm";
+    case 62:
+      return "Chk_Cfg";
+    default:
+      return sap <= 48 ? "MSAC_C2" : "";
   }
 }
 
 std::string frame_type_of(std::span<const std::uint8_t> b) {
   if (b.empty()) return "empty";
   switch (b[0]) {
-    case fdl::kSD1: return "SD1";
-    case fdl::kSD2: return "SD2";
-    case fdl::kSD3: return "SD3";
-    case fdl::kSD4: return "SD4";
-    case fdl::kSC: return "SC";
-    default: return "garbage";
+    case fdl::kSD1:
+      return "SD1";
+    case fdl::kSD2:
+      return "SD2";
+    case fdl::kSD3:
+      return "SD3";
+    case fdl::kSD4:
+      return "SD4";
+    case fdl::kSC:
+      return "SC";
+    default:
+      return "garbage";
   }
 }
 
 void add_flag_reasons(std::uint32_t flags, std::vector<std::string>& out) {
   static const std::pair<std::uint32_t, const char*> kNames[] = {
-      {pcapng::kFlagSymbolError, "symbol error"}, {pcapng::kFlagPreambleError, "preamble error"},
+      {pcapng::kFlagSymbolError, "symbol error"},
+      {pcapng::kFlagPreambleError, "preamble error"},
       {pcapng::kFlagStartDelimiterError, "start delimiter error"},
-      {pcapng::kFlagUnalignedError, "unaligned frame"}, {pcapng::kFlagWrongIfg, "wrong inter-frame gap"},
-      {pcapng::kFlagTooShort, "packet too short"}, {pcapng::kFlagTooLong, "packet too long"},
+      {pcapng::kFlagUnalignedError, "unaligned frame"},
+      {pcapng::kFlagWrongIfg, "wrong inter-frame gap"},
+      {pcapng::kFlagTooShort, "packet too short"},
+      {pcapng::kFlagTooLong, "packet too long"},
       {pcapng::kFlagCrcError, "CRC error"}};
   for (const auto& [bit, name] : kNames)
     if (flags & bit) out.emplace_back(name);
@@ -61,8 +84,10 @@ void add_flag_reasons(std::uint32_t flags, std::vector<std::string>& out) {
 std::string format_ts(std::int64_t ns) {
   char buf[48];
   const char* sign = ns < 0 ? "-" : "";
-  const std::uint64_t a = ns < 0 ? static_cast<std::uint64_t>(-(ns + 1)) + 1 : static_cast<std::uint64_t>(ns);
-  std::snprintf(buf, sizeof buf, "%s%llu.%09llu s", sign, static_cast<unsigned long long>(a / 1'000'000'000),
+  const std::uint64_t a =
+      ns < 0 ? static_cast<std::uint64_t>(-(ns + 1)) + 1 : static_cast<std::uint64_t>(ns);
+  std::snprintf(buf, sizeof buf, "%s%llu.%09llu s", sign,
+                static_cast<unsigned long long>(a / 1'000'000'000),
                 static_cast<unsigned long long>(a % 1'000'000'000));
   return buf;
 }
@@ -73,7 +98,8 @@ std::string format_speed(std::uint64_t s) {
   if (s >= 1'000'000 && s % 1'000'000 == 0)
     std::snprintf(buf, sizeof buf, "%llu Mbit/s", static_cast<unsigned long long>(s / 1'000'000));
   else if (s >= 1'000'000)
-    std::snprintf(buf, sizeof buf, "%llu.%llu Mbit/s", static_cast<unsigned long long>(s / 1'000'000),
+    std::snprintf(buf, sizeof buf, "%llu.%llu Mbit/s",
+                  static_cast<unsigned long long>(s / 1'000'000),
                   static_cast<unsigned long long>(s % 1'000'000 / 100'000));
   else if (s % 1000 == 0)
     std::snprintf(buf, sizeof buf, "%llu kbit/s", static_cast<unsigned long long>(s / 1000));
@@ -81,7 +107,8 @@ std::string format_speed(std::uint64_t s) {
     std::string frac = std::to_string(s % 1000);
     frac = std::string(3 - frac.size(), '0') + frac;
     while (!frac.empty() && frac.back() == '0') frac.pop_back();
-    std::snprintf(buf, sizeof buf, "%llu.%s kbit/s", static_cast<unsigned long long>(s / 1000), frac.c_str());
+    std::snprintf(buf, sizeof buf, "%llu.%s kbit/s", static_cast<unsigned long long>(s / 1000),
+                  frac.c_str());
   } else
     std::snprintf(buf, sizeof buf, "%llu bit/s", static_cast<unsigned long long>(s));
   return buf;
@@ -89,10 +116,14 @@ std::string format_speed(std::uint64_t s) {
 
 std::string link_name(std::uint16_t lt) {
   switch (lt) {
-    case 147: return "USER0";
-    case 148: return "USER1";
-    case 257: return "PROFIBUS_DL";
-    default: return "link type " + std::to_string(lt);
+    case 147:
+      return "USER0";
+    case 148:
+      return "USER1";
+    case 257:
+      return "PROFIBUS_DL";
+    default:
+      return "link type " + std::to_string(lt);
   }
 }
 
@@ -100,15 +131,26 @@ std::string json_escape(std::string_view s) {
   std::string o;
   for (char c : s) {
     switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\r': o += "\\r"; break;
-      case '\t': o += "\\t"; break;
+      case '"':
+        o += "\\\"";
+        break;
+      case '\\':
+        o += "\\\\";
+        break;
+      case '\n':
+        o += "\\n";
+        break;
+      case '\r':
+        o += "\\r";
+        break;
+      case '\t':
+        o += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+          std::snprintf(buf, sizeof buf, "\\u%04x",
+                        static_cast<unsigned>(static_cast<unsigned char>(c)));
           o += buf;
         } else {
           o += c;
@@ -178,9 +220,12 @@ void count_frame(InterfaceSummary& s, Tracker& tr, const PcapngRecord& r) {
     reasons.erase(std::unique(reasons.begin(), reasons.end()), reasons.end());
     for (const auto& why : reasons) ++s.bad_by_reason[why];
   }
-  if (err == fdl::DecodeError::None && t.type != fdl::FrameType::SC && t.type != fdl::FrameType::SD4) {
+  if (err == fdl::DecodeError::None && t.type != fdl::FrameType::SC &&
+      t.type != fdl::FrameType::SD4) {
     if (t.is_request()) {
-      ++s.by_request[t.fc == fdl::kFcClockValue ? std::string("CV") : std::string(fdl::to_string(fdl::fc_request_fn(t.fc)))];
+      ++s.by_request[t.fc == fdl::kFcClockValue
+                         ? std::string("CV")
+                         : std::string(fdl::to_string(fdl::fc_request_fn(t.fc)))];
     } else {
       ++s.by_response[std::string(fdl::to_string(fdl::fc_status(t.fc)))];
     }
@@ -284,14 +329,15 @@ std::optional<CaptureSummary> inspect_file(const std::string& path, PcapngError&
 
 std::string to_text(const CaptureSummary& s) {
   std::string o;
-  o += "Records: " + std::to_string(s.records) + " (" + std::to_string(s.events.size()) + " events)\n";
+  o += "Records: " + std::to_string(s.records) + " (" + std::to_string(s.events.size()) +
+       " events)\n";
   if (s.first_ns)
     o += "Time span: " + format_ts(*s.first_ns) + " .. " + format_ts(*s.last_ns) + " (" +
          format_ts(*s.last_ns - *s.first_ns) + ")\n";
   for (std::size_t i = 0; i < s.interfaces.size(); ++i) {
     const InterfaceSummary& is = s.interfaces[i];
-    o += "Interface " + std::to_string(i) + " '" + is.name + "' (" + link_name(is.link_type) + ", " +
-         format_speed(is.speed) + "): " + std::to_string(is.frames) + " records, " +
+    o += "Interface " + std::to_string(i) + " '" + is.name + "' (" + link_name(is.link_type) +
+         ", " + format_speed(is.speed) + "): " + std::to_string(is.frames) + " records, " +
          std::to_string(is.octets) + " octets\n";
     if (is.first_ns)
       o += "  time span: " + format_ts(*is.first_ns) + " .. " + format_ts(*is.last_ns) + "\n";
@@ -311,26 +357,31 @@ std::string to_text(const CaptureSummary& s) {
   o += "Events: " + std::to_string(s.events.size()) + "\n";
   for (const EventSummary& e : s.events)
     o += "  " + format_ts(e.ts_ns) + "  [" + e.category + "] " + e.text + "\n";
-  if (s.bad_event_records) o += "Unreadable event records: " + std::to_string(s.bad_event_records) + "\n";
+  if (s.bad_event_records)
+    o += "Unreadable event records: " + std::to_string(s.bad_event_records) + "\n";
   return o;
 }
 
 std::string to_json(const CaptureSummary& s) {
-  std::string o = "{\"records\":" + std::to_string(s.records) + ",\"first_ns\":" + json_opt(s.first_ns) +
-                  ",\"last_ns\":" + json_opt(s.last_ns) + ",\"interfaces\":[";
+  std::string o = "{\"records\":" + std::to_string(s.records) +
+                  ",\"first_ns\":" + json_opt(s.first_ns) + ",\"last_ns\":" + json_opt(s.last_ns) +
+                  ",\"interfaces\":[";
   for (std::size_t i = 0; i < s.interfaces.size(); ++i) {
     const InterfaceSummary& is = s.interfaces[i];
     if (i) o += ",";
-    o += "{\"id\":" + std::to_string(i) + ",\"name\":\"" + json_escape(is.name) + "\",\"description\":\"" +
-         json_escape(is.description) + "\",\"link_type\":" + std::to_string(is.link_type) +
+    o += "{\"id\":" + std::to_string(i) + ",\"name\":\"" + json_escape(is.name) +
+         "\",\"description\":\"" + json_escape(is.description) +
+         "\",\"link_type\":" + std::to_string(is.link_type) +
          ",\"speed\":" + std::to_string(is.speed) + ",\"records\":" + std::to_string(is.frames) +
          ",\"octets\":" + std::to_string(is.octets) + ",\"first_ns\":" + json_opt(is.first_ns) +
          ",\"last_ns\":" + json_opt(is.last_ns);
     if (is_fdl(is.link_type)) {
       o += ",\"frame_types\":" + json_map(is.by_type) + ",\"requests\":" + json_map(is.by_request) +
-           ",\"responses\":" + json_map(is.by_response) + ",\"services\":" + json_map(is.by_service) +
-           ",\"bad_frames\":" + std::to_string(is.bad_frames) + ",\"bad_by_reason\":" +
-           json_map(is.bad_by_reason) + ",\"min_idle_bits\":" + json_opt(is.min_idle_bits) +
+           ",\"responses\":" + json_map(is.by_response) +
+           ",\"services\":" + json_map(is.by_service) +
+           ",\"bad_frames\":" + std::to_string(is.bad_frames) +
+           ",\"bad_by_reason\":" + json_map(is.bad_by_reason) +
+           ",\"min_idle_bits\":" + json_opt(is.min_idle_bits) +
            ",\"overlaps\":" + std::to_string(is.overlaps);
     }
     o += "}";

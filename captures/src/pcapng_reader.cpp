@@ -12,7 +12,9 @@ namespace pbvbus::captures {
 namespace {
 __extension__ typedef __int128 i128;
 
-constexpr std::size_t pad4(std::size_t n) { return (n + 3) & ~std::size_t{3}; }
+constexpr std::size_t pad4(std::size_t n) {
+  return (n + 3) & ~std::size_t{3};
+}
 
 std::int64_t saturate(i128 v) {
   if (v > std::numeric_limits<std::int64_t>::max()) return std::numeric_limits<std::int64_t>::max();
@@ -38,10 +40,14 @@ std::int64_t to_ns(std::uint64_t ts, std::uint8_t tsresol, std::int64_t offset_s
 
 std::string block_name(std::uint32_t type) {
   switch (type) {
-    case pcapng::kBlockShb: return "SHB";
-    case pcapng::kBlockIdb: return "IDB";
-    case pcapng::kBlockEpb: return "EPB";
-    case pcapng::kBlockSpb: return "SPB";
+    case pcapng::kBlockShb:
+      return "SHB";
+    case pcapng::kBlockIdb:
+      return "IDB";
+    case pcapng::kBlockEpb:
+      return "EPB";
+    case pcapng::kBlockSpb:
+      return "SPB";
     default: {
       char buf[32];
       std::snprintf(buf, sizeof buf, "block 0x%08X", type);
@@ -84,7 +90,8 @@ bool PcapngReader::fail(std::uint64_t offset, std::string msg) {
 
 std::uint16_t PcapngReader::u16(std::size_t off) const {
   const std::uint8_t* p = m_data.data() + off;
-  return m_be ? static_cast<std::uint16_t>(p[0] << 8 | p[1]) : static_cast<std::uint16_t>(p[1] << 8 | p[0]);
+  return m_be ? static_cast<std::uint16_t>(p[0] << 8 | p[1])
+              : static_cast<std::uint16_t>(p[1] << 8 | p[0]);
 }
 std::uint32_t PcapngReader::u32(std::size_t off) const {
   const std::uint8_t* p = m_data.data() + off;
@@ -100,7 +107,8 @@ std::uint64_t PcapngReader::u64(std::size_t off) const {
 }
 
 template <class F>
-bool PcapngReader::read_options(std::size_t off, std::size_t end, const char* block, F&& on_option) {
+bool PcapngReader::read_options(std::size_t off, std::size_t end, const char* block,
+                                F&& on_option) {
   while (off < end) {
     if (end - off < 4) return fail(off, std::string(block) + ": option header runs past the block");
     const std::uint16_t code = u16(off);
@@ -119,7 +127,8 @@ bool PcapngReader::read_shb(std::size_t off, std::size_t len) {
   // len was checked against the buffer by next(); body starts at off + 8.
   if (len < 28) return fail(off, "SHB block length " + std::to_string(len) + " is below 28");
   const std::uint16_t major = u16(off + 12);
-  if (major != 1) return fail(off + 12, "unsupported pcapng major version " + std::to_string(major));
+  if (major != 1)
+    return fail(off + 12, "unsupported pcapng major version " + std::to_string(major));
   m_in_section = true;
   m_section = m_sections_seen++;
   m_section_base = m_ifs.size();
@@ -133,28 +142,36 @@ bool PcapngReader::read_idb(std::size_t off, std::size_t len) {
   i.link_type = u16(off + 8);
   i.snaplen = u32(off + 12);
   i.section = m_section;
-  const bool ok = read_options(off + 16, off + len - 4, "IDB",
-                               [&](std::uint16_t code, std::size_t v, std::size_t n) {
-    const char* s = reinterpret_cast<const char*>(m_data.data() + v);
-    switch (code) {
-      case pcapng::kIfName: i.name.assign(s, n); break;
-      case pcapng::kIfDescription: i.description.assign(s, n); break;
-      case pcapng::kIfSpeed:
-        if (n != 8) return fail(v - 4, "IDB: if_speed has length " + std::to_string(n) + ", not 8");
-        i.speed = u64(v);
-        break;
-      case pcapng::kIfTsresol:
-        if (n != 1) return fail(v - 4, "IDB: if_tsresol has length " + std::to_string(n) + ", not 1");
-        i.tsresol = m_data[v];
-        break;
-      case pcapng::kIfTsoffset:
-        if (n != 8) return fail(v - 4, "IDB: if_tsoffset has length " + std::to_string(n) + ", not 8");
-        i.tsoffset_s = static_cast<std::int64_t>(u64(v));
-        break;
-      default: break;
-    }
-    return true;
-  });
+  const bool ok = read_options(
+      off + 16, off + len - 4, "IDB", [&](std::uint16_t code, std::size_t v, std::size_t n) {
+        const char* s = reinterpret_cast<const char*>(m_data.data() + v);
+        switch (code) {
+          case pcapng::kIfName:
+            i.name.assign(s, n);
+            break;
+          case pcapng::kIfDescription:
+            i.description.assign(s, n);
+            break;
+          case pcapng::kIfSpeed:
+            if (n != 8)
+              return fail(v - 4, "IDB: if_speed has length " + std::to_string(n) + ", not 8");
+            i.speed = u64(v);
+            break;
+          case pcapng::kIfTsresol:
+            if (n != 1)
+              return fail(v - 4, "IDB: if_tsresol has length " + std::to_string(n) + ", not 1");
+            i.tsresol = m_data[v];
+            break;
+          case pcapng::kIfTsoffset:
+            if (n != 8)
+              return fail(v - 4, "IDB: if_tsoffset has length " + std::to_string(n) + ", not 8");
+            i.tsoffset_s = static_cast<std::int64_t>(u64(v));
+            break;
+          default:
+            break;
+        }
+        return true;
+      });
   if (!ok) return false;
   m_ifs.push_back(std::move(i));
   return true;
@@ -164,7 +181,8 @@ bool PcapngReader::read_epb(std::size_t off, std::size_t len, PcapngRecord& r) {
   if (len < 32) return fail(off, "EPB block length " + std::to_string(len) + " is below 32");
   const std::uint32_t if_id = u32(off + 8);
   if (if_id >= m_ifs.size() - m_section_base)
-    return fail(off + 8, "EPB refers to interface " + std::to_string(if_id) + ", but the section declares " +
+    return fail(off + 8, "EPB refers to interface " + std::to_string(if_id) +
+                             ", but the section declares " +
                              std::to_string(m_ifs.size() - m_section_base));
   const std::uint32_t caplen = u32(off + 20);
   if (pad4(caplen) > len - 32)
@@ -180,17 +198,19 @@ bool PcapngReader::read_epb(std::size_t off, std::size_t len, PcapngRecord& r) {
   r.flags = 0;
   r.comment.clear();
   r.offset = off;
-  return read_options(off + 28 + pad4(caplen), off + len - 4, "EPB",
-                      [&](std::uint16_t code, std::size_t v, std::size_t n) {
-    if (code == pcapng::kEpbFlags) {
-      if (n != 4) return fail(v - 4, "EPB: epb_flags has length " + std::to_string(n) + ", not 4");
-      r.flags = u32(v);
-    } else if (code == pcapng::kOptComment) {
-      if (!r.comment.empty()) r.comment += "; ";
-      r.comment.append(reinterpret_cast<const char*>(m_data.data() + v), n);
-    }
-    return true;
-  });
+  return read_options(
+      off + 28 + pad4(caplen), off + len - 4, "EPB",
+      [&](std::uint16_t code, std::size_t v, std::size_t n) {
+        if (code == pcapng::kEpbFlags) {
+          if (n != 4)
+            return fail(v - 4, "EPB: epb_flags has length " + std::to_string(n) + ", not 4");
+          r.flags = u32(v);
+        } else if (code == pcapng::kOptComment) {
+          if (!r.comment.empty()) r.comment += "; ";
+          r.comment.append(reinterpret_cast<const char*>(m_data.data() + v), n);
+        }
+        return true;
+      });
 }
 
 bool PcapngReader::read_spb(std::size_t off, std::size_t len, PcapngRecord& r) {
@@ -215,15 +235,20 @@ bool PcapngReader::next(PcapngRecord& r) {
   while (m_pos < m_data.size()) {
     const std::size_t off = m_pos;
     const std::size_t left = m_data.size() - off;
-    if (left < 12) return fail(off, "truncated block: " + std::to_string(left) + " octets left, a block needs at least 12");
+    if (left < 12)
+      return fail(off, "truncated block: " + std::to_string(left) +
+                           " octets left, a block needs at least 12");
     std::uint32_t type;
     std::memcpy(&type, m_data.data() + off, 4);  // SHB type is a palindrome: any order works
     if (type == pcapng::kBlockShb) {
       static constexpr std::uint8_t kLe[4] = {0x4D, 0x3C, 0x2B, 0x1A};
       static constexpr std::uint8_t kBe[4] = {0x1A, 0x2B, 0x3C, 0x4D};
-      if (std::memcmp(m_data.data() + off + 8, kLe, 4) == 0) m_be = false;
-      else if (std::memcmp(m_data.data() + off + 8, kBe, 4) == 0) m_be = true;
-      else return fail(off + 8, "SHB byte-order magic is not 1A2B3C4D in either byte order");
+      if (std::memcmp(m_data.data() + off + 8, kLe, 4) == 0)
+        m_be = false;
+      else if (std::memcmp(m_data.data() + off + 8, kBe, 4) == 0)
+        m_be = true;
+      else
+        return fail(off + 8, "SHB byte-order magic is not 1A2B3C4D in either byte order");
     } else if (!m_in_section) {
       return fail(off, off == 0 ? "not a pcapng file: it does not start with a Section Header Block"
                                 : "block before any Section Header Block");
@@ -235,10 +260,12 @@ bool PcapngReader::next(PcapngRecord& r) {
       return fail(off + 4, block_name(type) + " block length " + std::to_string(len) +
                                " is below 12 or not a multiple of 4");
     if (len > left)
-      return fail(off + 4, block_name(type) + " block length " + std::to_string(len) + " runs past the end of the file (" +
-                               std::to_string(left) + " octets left)");
+      return fail(off + 4, block_name(type) + " block length " + std::to_string(len) +
+                               " runs past the end of the file (" + std::to_string(left) +
+                               " octets left)");
     if (u32(off + len - 4) != len)
-      return fail(off + len - 4, block_name(type) + " trailing block length " + std::to_string(u32(off + len - 4)) +
+      return fail(off + len - 4, block_name(type) + " trailing block length " +
+                                     std::to_string(u32(off + len - 4)) +
                                      " differs from the leading one (" + std::to_string(len) + ")");
     m_pos = off + len;
     switch (type) {
@@ -248,9 +275,12 @@ bool PcapngReader::next(PcapngRecord& r) {
       case pcapng::kBlockIdb:
         if (!read_idb(off, len)) return false;
         break;
-      case pcapng::kBlockEpb: return read_epb(off, len, r);
-      case pcapng::kBlockSpb: return read_spb(off, len, r);
-      default: break;  // unknown or uninteresting block: skipped by its length
+      case pcapng::kBlockEpb:
+        return read_epb(off, len, r);
+      case pcapng::kBlockSpb:
+        return read_spb(off, len, r);
+      default:
+        break;  // unknown or uninteresting block: skipped by its length
     }
   }
   return false;

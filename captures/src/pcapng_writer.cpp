@@ -15,14 +15,24 @@ namespace {
 
 constexpr std::size_t kBufferSize = 1u << 20;
 
-inline void put16(std::uint8_t* p, std::uint16_t v) { std::memcpy(p, &v, 2); }
-inline void put32(std::uint8_t* p, std::uint32_t v) { std::memcpy(p, &v, 4); }
-inline void put64(std::uint8_t* p, std::uint64_t v) { std::memcpy(p, &v, 8); }
+inline void put16(std::uint8_t* p, std::uint16_t v) {
+  std::memcpy(p, &v, 2);
+}
+inline void put32(std::uint8_t* p, std::uint32_t v) {
+  std::memcpy(p, &v, 4);
+}
+inline void put64(std::uint8_t* p, std::uint64_t v) {
+  std::memcpy(p, &v, 8);
+}
 static_assert(std::endian::native == std::endian::little,
               "the writer emits native-order (little-endian) sections");
 
-constexpr std::size_t pad4(std::size_t n) { return (n + 3) & ~std::size_t{3}; }
-constexpr std::size_t option_size(std::size_t value_len) { return 4 + pad4(value_len); }
+constexpr std::size_t pad4(std::size_t n) {
+  return (n + 3) & ~std::size_t{3};
+}
+constexpr std::size_t option_size(std::size_t value_len) {
+  return 4 + pad4(value_len);
+}
 
 /// Writes an option at p; returns the octets used (padding zeroed).
 std::size_t put_option(std::uint8_t* p, std::uint16_t code, const void* value, std::size_t len) {
@@ -98,15 +108,25 @@ std::uint32_t classify_frame(std::span<const std::uint8_t> bytes, std::uint16_t 
   fdl::Telegram t;
   const fdl::DecodeError err = fdl::decode(bytes, t);
   switch (err) {
-    case fdl::DecodeError::None: break;
-    case fdl::DecodeError::BadFcs: flags |= pcapng::kFlagCrcError; break;
+    case fdl::DecodeError::None:
+      break;
+    case fdl::DecodeError::BadFcs:
+      flags |= pcapng::kFlagCrcError;
+      break;
     case fdl::DecodeError::Empty:
-    case fdl::DecodeError::Truncated: flags |= pcapng::kFlagTooShort; break;
-    case fdl::DecodeError::TrailingOctets: flags |= pcapng::kFlagTooLong; break;
+    case fdl::DecodeError::Truncated:
+      flags |= pcapng::kFlagTooShort;
+      break;
+    case fdl::DecodeError::TrailingOctets:
+      flags |= pcapng::kFlagTooLong;
+      break;
     case fdl::DecodeError::UnknownDelimiter:
     case fdl::DecodeError::BadSecondDelimiter:
-    case fdl::DecodeError::BadEndDelimiter: flags |= pcapng::kFlagStartDelimiterError; break;
-    default: break;  // well formed on the wire, invalid for FDL: comment only
+    case fdl::DecodeError::BadEndDelimiter:
+      flags |= pcapng::kFlagStartDelimiterError;
+      break;
+    default:
+      break;  // well formed on the wire, invalid for FDL: comment only
   }
   // A partial frame is truncated by definition; saying so twice helps nobody.
   if (err != fdl::DecodeError::None &&
@@ -118,7 +138,9 @@ std::uint32_t classify_frame(std::span<const std::uint8_t> bytes, std::uint16_t 
 std::string describe_line_event(const bus::LineEvent& e) {
   std::string s;
   if (e.line) s = e.line->name() + ": ";
-  auto name = [&](int a) { return e.line ? station_name(*e.line, a) : "station #" + std::to_string(a); };
+  auto name = [&](int a) {
+    return e.line ? station_name(*e.line, a) : "station #" + std::to_string(a);
+  };
   switch (e.kind) {
     case bus::LineEventKind::CableCut:
     case bus::LineEventKind::CableRepaired:
@@ -133,7 +155,9 @@ std::string describe_line_event(const bus::LineEvent& e) {
       break;
     case bus::LineEventKind::ShortCircuit:
     case bus::LineEventKind::ShortRepaired:
-    case bus::LineEventKind::NoiseOff: s += bus::to_string(e.kind); break;
+    case bus::LineEventKind::NoiseOff:
+      s += bus::to_string(e.kind);
+      break;
     default:
       s += bus::to_string(e.kind);
       if (e.a >= 0) s += ": '" + name(e.a) + "'";
@@ -151,10 +175,12 @@ PcapngWriter::PcapngWriter(Sink sink, PcapngWriterOptions opts)
   write_shb();
 }
 
-PcapngWriter::~PcapngWriter() { flush(); }
+PcapngWriter::~PcapngWriter() {
+  flush();
+}
 
-std::unique_ptr<PcapngWriter> PcapngWriter::open(const std::string& path,
-                                                 PcapngWriterOptions opts, std::string* error) {
+std::unique_ptr<PcapngWriter> PcapngWriter::open(const std::string& path, PcapngWriterOptions opts,
+                                                 std::string* error) {
   if (path == "-") {
     opts.streaming = true;
     return std::make_unique<PcapngWriter>(
@@ -249,7 +275,9 @@ std::uint32_t PcapngWriter::add_interface(std::string_view name, std::string_vie
   return m_next_if++;
 }
 
-std::uint32_t PcapngWriter::add_line(const bus::Line& line) { return interface_for(line); }
+std::uint32_t PcapngWriter::add_line(const bus::Line& line) {
+  return interface_for(line);
+}
 
 std::uint32_t PcapngWriter::interface_for(const bus::Line& line) {
   if (&line == m_last_line) return m_last_id;
@@ -277,8 +305,8 @@ std::uint32_t PcapngWriter::events_interface() {
 void PcapngWriter::write_epb(std::uint32_t if_id, std::int64_t ts_ns,
                              std::span<const std::uint8_t> data, std::uint32_t flags,
                              std::string_view comment) {
-  const std::size_t opts = (flags ? option_size(4) : 0) +
-                           (comment.empty() ? 0 : option_size(comment.size()));
+  const std::size_t opts =
+      (flags ? option_size(4) : 0) + (comment.empty() ? 0 : option_size(comment.size()));
   const std::size_t total = 32 + pad4(data.size()) + (opts ? opts + 4 : 0);
   std::uint8_t* p = reserve(total);
   const auto ts = static_cast<std::uint64_t>(std::max<std::int64_t>(ts_ns, 0));
@@ -299,7 +327,8 @@ void PcapngWriter::write_epb(std::uint32_t if_id, std::int64_t ts_ns,
       put32(v, flags);
       o += put_option(p + o, pcapng::kEpbFlags, v, 4);
     }
-    if (!comment.empty()) o += put_option(p + o, pcapng::kOptComment, comment.data(), comment.size());
+    if (!comment.empty())
+      o += put_option(p + o, pcapng::kOptComment, comment.data(), comment.size());
     o += put_option(p + o, pcapng::kOptEndOfOpt, nullptr, 0);
   }
   put32(p + o, static_cast<std::uint32_t>(total));
@@ -328,7 +357,8 @@ void PcapngWriter::write_event(bus::Ticks time, const EventRecord& e) {
   if (!m_ok) return;
   const std::uint32_t id = events_interface();
   const std::size_t n = encode_event(e, m_event_buf);
-  write_epb(id, bus::ticks_to_ns(time), std::span<const std::uint8_t>(m_event_buf.data(), n), 0, {});
+  write_epb(id, bus::ticks_to_ns(time), std::span<const std::uint8_t>(m_event_buf.data(), n), 0,
+            {});
   ++m_events;
 }
 

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "capture_fixture.hpp"
+
 #include "pbvbus/captures/inspect.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
@@ -21,7 +22,8 @@ class Talker final : public bus::Device {
  public:
   explicit Talker(std::vector<std::pair<std::int64_t, Bytes>> plan) : m_plan(std::move(plan)) {}
   void on_power_on(bus::Ticks now) override {
-    for (const auto& [bits, bytes] : m_plan) port().transmit(now + bus::bits_to_ticks(bits, port().baud()), bytes);
+    for (const auto& [bits, bytes] : m_plan)
+      port().transmit(now + bus::bits_to_ticks(bits, port().baud()), bytes);
   }
   void on_frame(const bus::RxFrame&) override {}
   void on_timer(bus::Ticks) override {}
@@ -35,7 +37,8 @@ TEST(LineCapture, TimingAndFaultsFromARealLine) {
   bus::Line line(sched, "dp0", bus::Baud::k12M);
   // Bit times: request 0..121 (11 octets), reply after TSDR 11 at 132..286, token after 33
   // idle bits at 319..352, Data_Exchange after 40 at 392..513, its reply after 15 at 528.
-  Talker master({{100, test::kSlaveDiagReq}, {419, test::kToken_2_to_5}, {492, test::kDataExchange}});
+  Talker master(
+      {{100, test::kSlaveDiagReq}, {419, test::kToken_2_to_5}, {492, test::kDataExchange}});
   Talker slave({{232, test::kSlaveDiagRes}, {628, test::kDataExchangeRes}});
   line.attach(master, "master 1");
   line.attach(slave, "slave 10");
@@ -45,7 +48,8 @@ TEST(LineCapture, TimingAndFaultsFromARealLine) {
     line.add_tap(w);
     line.start();
     // The slave loses power 50 bit times into its Data_Exchange reply: 4 whole characters out.
-    sched.schedule(bus::bits_to_ticks(628 + 50, bus::Baud::k12M), [&] { line.set_power(1, false); });
+    sched.schedule(bus::bits_to_ticks(628 + 50, bus::Baud::k12M),
+                   [&] { line.set_power(1, false); });
     sched.run_until(bus::bits_to_ticks(2000, bus::Baud::k12M));
     line.remove_tap(w);
   }
@@ -54,7 +58,7 @@ TEST(LineCapture, TimingAndFaultsFromARealLine) {
   std::vector<PcapngRecord> recs;
   while (reader.next(r)) recs.push_back(r);
   ASSERT_FALSE(reader.error()) << reader.error()->to_string();
-  ASSERT_EQ(recs.size(), 8u);  // 2 power-on events, 5 frames, the power-off event
+  ASSERT_EQ(recs.size(), 8u);        // 2 power-on events, 5 frames, the power-off event
   EXPECT_EQ(recs[0].interface, 1u);  // events; the line keeps interface 0
   EXPECT_EQ(recs[2].bytes, test::kSlaveDiagReq);
   EXPECT_EQ(recs[2].ts_ns, 8333);   // 100 bits at 12 Mbit/s = 8333.3 ns
@@ -63,7 +67,8 @@ TEST(LineCapture, TimingAndFaultsFromARealLine) {
   for (std::size_t i = 0; i < recs.size(); ++i)
     if (recs[i].flags == pcapng::kFlagTooShort) partial = i;
   ASSERT_TRUE(partial);
-  EXPECT_EQ(recs[*partial].bytes, Bytes(test::kDataExchangeRes.begin(), test::kDataExchangeRes.begin() + 4));
+  EXPECT_EQ(recs[*partial].bytes,
+            Bytes(test::kDataExchangeRes.begin(), test::kDataExchangeRes.begin() + 4));
   EXPECT_EQ(recs[*partial].comment, "partial: 4 of 10 octets");
 
   PcapngReader again(mem.data);

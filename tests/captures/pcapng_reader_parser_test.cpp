@@ -1,13 +1,13 @@
 // PcapngReader on hand-made, broken and mutated files: clear errors with file offsets, big-endian
 // sections, unknown blocks skipped, and no crash on any seeded mutation (runs under ASan+UBSan).
 
-#include "pbvbus/captures/pcapng_reader.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "capture_fixture.hpp"
+
+#include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 
 namespace pbvbus::captures {
@@ -103,7 +103,8 @@ TEST(PcapngReader, GarbageGetsAClearErrorWithTheOffset) {
   g = f;
   g[124 + 4] = 0xF0;
   g[124 + 5] = 0xFF;  // EPB length 0xFFF0 runs past the end
-  EXPECT_EQ(error_of(g).rfind("offset 128: EPB block length 65520 runs past the end of the file", 0), 0u)
+  EXPECT_EQ(
+      error_of(g).rfind("offset 128: EPB block length 65520 runs past the end of the file", 0), 0u)
       << error_of(g);
   g = f;
   g[124 + 8] = 7;  // interface 7
@@ -113,7 +114,8 @@ TEST(PcapngReader, GarbageGetsAClearErrorWithTheOffset) {
   EXPECT_EQ(error_of(g), "offset 144: EPB captured length 200 exceeds the block (44 octets)");
   g = f;
   g[124 + 40] = 0x30;  // trailing length differs
-  EXPECT_EQ(error_of(g), "offset 164: EPB trailing block length 48 differs from the leading one (44)");
+  EXPECT_EQ(error_of(g),
+            "offset 164: EPB trailing block length 48 differs from the leading one (44)");
   g = f;
   g[44 + 16 + 2] = 0x40;  // if_name option length 64 runs past the IDB
   EXPECT_EQ(error_of(g), "offset 60: IDB: option 2 of length 64 runs past the block");
@@ -138,10 +140,18 @@ TEST(PcapngReader, SeededMutationsNeverCrash) {
     for (int e = 0; e < edits; ++e) {
       const std::size_t pos = rng() % m.size();
       switch (rng() % 4) {
-        case 0: m[pos] = static_cast<std::uint8_t>(rng()); break;
-        case 1: m[pos] ^= static_cast<std::uint8_t>(1u << (rng() % 8)); break;
-        case 2: m.resize(pos); break;
-        default: m.insert(m.begin() + static_cast<std::ptrdiff_t>(pos), static_cast<std::uint8_t>(rng())); break;
+        case 0:
+          m[pos] = static_cast<std::uint8_t>(rng());
+          break;
+        case 1:
+          m[pos] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+          break;
+        case 2:
+          m.resize(pos);
+          break;
+        default:
+          m.insert(m.begin() + static_cast<std::ptrdiff_t>(pos), static_cast<std::uint8_t>(rng()));
+          break;
       }
       if (m.empty()) break;
     }

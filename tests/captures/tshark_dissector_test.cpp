@@ -9,8 +9,9 @@
 #include <filesystem>
 
 #include "capture_fixture.hpp"
-#include "pbvbus/captures/pcapng_writer.hpp"
 #include "tshark_helpers.hpp"
+
+#include "pbvbus/captures/pcapng_writer.hpp"
 
 namespace pbvbus::captures {
 namespace {
@@ -20,7 +21,8 @@ namespace ts = ::pbvbus::test;
 
 /// SD2 frame from its DA..DU octets (the B.1 layout), FCS summed by hand.
 Bytes sd2(const Bytes& body) {
-  Bytes f = {0x68, static_cast<std::uint8_t>(body.size()), static_cast<std::uint8_t>(body.size()), 0x68};
+  Bytes f = {0x68, static_cast<std::uint8_t>(body.size()), static_cast<std::uint8_t>(body.size()),
+             0x68};
   unsigned sum = 0;
   for (auto b : body) {
     f.push_back(b);
@@ -35,14 +37,14 @@ Bytes sd2(const Bytes& body) {
 // master 1, ident 0x1234), the §D.5 worked example (identifier block: module 8; channel block:
 // module 8 channel 1 input bit short circuit; device block 3 octets), then a DP-V1
 // Diagnostic_Alarm block for slot 2 with Seq_Nr 4, "error appears", 4 octets of user data.
-const Bytes kDiagExt = sd2({0x81, 0x8A, 0x08, 0x3E, 0x3C, 0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x44,
-                            0x00, 0x01, 0x00, 0x88, 0x41, 0x21, 0x04, 0x10, 0x20, 0x30, 0x08, 0x01,
-                            0x02, 0x21, 0xAA, 0xBB, 0xCC, 0xDD});
+const Bytes kDiagExt =
+    sd2({0x81, 0x8A, 0x08, 0x3E, 0x3C, 0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x44, 0x00, 0x01, 0x00,
+         0x88, 0x41, 0x21, 0x04, 0x10, 0x20, 0x30, 0x08, 0x01, 0x02, 0x21, 0xAA, 0xBB, 0xCC, 0xDD});
 // Get_Cfg response 10 -> 1: 0x13 (4 B in), 0x31 (2 B in/out), 0xD7 (8 words in, consistent),
 // special 0xC2: output length 0x81 (2 B consistent), input length 0x03 (4 B), 2 manufacturer
 // octets AA BB; 0x00 empty slot.
-const Bytes kGetCfgRes = sd2({0x81, 0x8A, 0x08, 0x3E, 0x3B, 0x13, 0x31, 0xD7, 0xC2, 0x81, 0x03,
-                              0xAA, 0xBB, 0x00});
+const Bytes kGetCfgRes =
+    sd2({0x81, 0x8A, 0x08, 0x3E, 0x3B, 0x13, 0x31, 0xD7, 0xC2, 0x81, 0x03, 0xAA, 0xBB, 0x00});
 // Alarm_Ack 1 -> 10 to SAP 50 from SAP 51: slot 2, Diagnostic_Alarm, Seq_Nr 4 / error appears.
 const Bytes kAlarmAck = sd2({0x8A, 0x81, 0x7D, 0x32, 0x33, 0x5C, 0x02, 0x01, 0x21});
 // MSAC_C2 Abort from class-2 master 2 (SAP 50) to slave 10 connection SAP 48: subnet local,
@@ -50,10 +52,10 @@ const Bytes kAlarmAck = sd2({0x8A, 0x81, 0x7D, 0x32, 0x33, 0x5C, 0x02, 0x01, 0x2
 const Bytes kC2Abort = sd2({0x8A, 0x82, 0x6D, 0x30, 0x32, 0x58, 0x01, 0x13, 0x00});
 
 // Slave redundancy frames (§G.2/G.3), see SlaveRedundancyBlocks.
-const Bytes kPrmCmd = sd2({0x8A, 0x81, 0x5D, 0x3D, 0x3E, 0x88, 0x0A, 0x0A, 0x0B, 0x12, 0x34, 0x00, 0x80,
-                           0x00, 0x88, 0x08, 0x02, 0x00, 0x08, 0x02, 0x00, 0x00, 0x0A});
-const Bytes kRedState = sd2({0x81, 0x8A, 0x08, 0x3E, 0x3C, 0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x08, 0x9F,
-                             0x00, 0x08, 0x02, 0x0A, 0x01, 0x00});
+const Bytes kPrmCmd = sd2({0x8A, 0x81, 0x5D, 0x3D, 0x3E, 0x88, 0x0A, 0x0A, 0x0B, 0x12, 0x34, 0x00,
+                           0x80, 0x00, 0x88, 0x08, 0x02, 0x00, 0x08, 0x02, 0x00, 0x00, 0x0A});
+const Bytes kRedState = sd2({0x81, 0x8A, 0x08, 0x3E, 0x3C, 0x08, 0x0C, 0x00, 0x01, 0x12, 0x34, 0x08,
+                             0x9F, 0x00, 0x08, 0x02, 0x0A, 0x01, 0x00});
 
 class TsharkDissector : public ::testing::Test {
  protected:
@@ -75,28 +77,28 @@ class TsharkDissector : public ::testing::Test {
       t += 100 * us;
       w->on_frame(test::tap_frame(line, b, t, flags));
     };
-    put(test::kSlaveDiagReq);       // 1
-    put(test::kSlaveDiagRes);       // 2
-    put(test::kSetPrm);             // 3
-    put(test::kSc);                 // 4
-    put(test::kSetPrmDpv1);         // 5
-    put(test::kChkCfg);             // 6
-    put(test::kGlobalControlClear); // 7
-    put(test::kDataExchange);       // 8
-    put(test::kDataExchangeRes);    // 9
-    put(test::kDpv1Read);           // 10
-    put(test::kDpv1ReadRes);        // 11
-    put(test::kDpv1ReadNeg);        // 12
-    put(test::kToken_2_to_5);       // 13
+    put(test::kSlaveDiagReq);        // 1
+    put(test::kSlaveDiagRes);        // 2
+    put(test::kSetPrm);              // 3
+    put(test::kSc);                  // 4
+    put(test::kSetPrmDpv1);          // 5
+    put(test::kChkCfg);              // 6
+    put(test::kGlobalControlClear);  // 7
+    put(test::kDataExchange);        // 8
+    put(test::kDataExchangeRes);     // 9
+    put(test::kDpv1Read);            // 10
+    put(test::kDpv1ReadRes);         // 11
+    put(test::kDpv1ReadNeg);         // 12
+    put(test::kToken_2_to_5);        // 13
     Bytes hit = test::kDataExchange;
-    hit[7] = 0xFF;                  // AA -> FF: the FCS no longer matches
-    put(hit, bus::kRxCollision);    // 14
-    put(kDiagExt);                  // 15
-    put(kGetCfgRes);                // 16
-    put(kAlarmAck);                 // 17
-    put(kC2Abort);                  // 18
-    put(test::kSetSlaveAdd);        // 19
-    put(test::kFdlStatusReq);       // 20
+    hit[7] = 0xFF;                // AA -> FF: the FCS no longer matches
+    put(hit, bus::kRxCollision);  // 14
+    put(kDiagExt);                // 15
+    put(kGetCfgRes);              // 16
+    put(kAlarmAck);               // 17
+    put(kC2Abort);                // 18
+    put(test::kSetSlaveAdd);      // 19
+    put(test::kFdlStatusReq);     // 20
     sched.schedule(t + 50 * us, [&] { line.set_cut_between(0, 1, true); });
     sched.run_until(t + 100 * us);  // 21: event
     line.remove_tap(*w);
@@ -110,9 +112,10 @@ class TsharkDissector : public ::testing::Test {
 std::string TsharkDissector::s_path;
 
 TEST_F(TsharkDissector, PlainTsharkOpensTheFile) {
-  const auto r = ts::tshark(s_path, {"-T", "fields", "-e", "frame.number", "-e",
-                                       "frame.interface_name", "-e", "frame.len"},
-                              /*with_dissector=*/false);
+  const auto r = ts::tshark(
+      s_path,
+      {"-T", "fields", "-e", "frame.number", "-e", "frame.interface_name", "-e", "frame.len"},
+      /*with_dissector=*/false);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("1\tdp0\t11\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("21\tevents\t"), std::string::npos) << r.out;
@@ -124,7 +127,7 @@ TEST_F(TsharkDissector, PlainTsharkOpensTheFile) {
     EXPECT_NE(c.out.find("USER 1 (1)"), std::string::npos) << c.out;
   }
   const auto enc = ts::run_command("tshark -n -r " + ts::shell_quote(s_path) +
-                                     " -T fields -e frame.encap_type -c 1");
+                                   " -T fields -e frame.encap_type -c 1");
   EXPECT_EQ(enc.out, "45\n");  // WTAP_ENCAP_USER0
   const auto v = ts::tshark(s_path, {"-V", "-c", "1"}, /*with_dissector=*/false);
   EXPECT_NE(v.out.find("Encapsulation type: USER 0 (45)"), std::string::npos) << v.out;
@@ -137,7 +140,8 @@ TEST_F(TsharkDissector, InfoColumn) {
   const auto info = ts::tshark_info(s_path);
   ASSERT_EQ(info.size(), 21u);
   EXPECT_EQ(info[0], "SRD_high 1→10 Slave_Diag.req FCB=1 FCV=0");
-  EXPECT_EQ(info[1], "10→1 DL Slave_Diag.res ident 0x1234 master none [Station_Not_Ready, Prm_Req]");
+  EXPECT_EQ(info[1],
+            "10→1 DL Slave_Diag.res ident 0x1234 master none [Station_Not_Ready, Prm_Req]");
   EXPECT_EQ(info[2], "SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms FCB=0 FCV=1");
   EXPECT_EQ(info[3], "SC");
   EXPECT_EQ(info[5], "SRD_high 1→10 Chk_Cfg.req 2 identifiers FCB=1 FCV=1");
@@ -149,7 +153,8 @@ TEST_F(TsharkDissector, InfoColumn) {
   EXPECT_EQ(info[11], "10→1 DL MSAC_C1 Read.res- access: invalid index");
   EXPECT_EQ(info[12], "Token 2→5");
   EXPECT_EQ(info[13], "SRD_high 1→10 Data_Exchange.req 2 B FCB=0 FCV=1 [FCS mismatch]");
-  EXPECT_EQ(info[16], "SRD_high 1→10 MSAC_C1 alarm Alarm_Ack.req slot 2 Diagnostic_Alarm seq 4 FCB=1 FCV=1");
+  EXPECT_EQ(info[16],
+            "SRD_high 1→10 MSAC_C1 alarm Alarm_Ack.req slot 2 Diagnostic_Alarm seq 4 FCB=1 FCV=1");
   EXPECT_EQ(info[17], "SRD_high 2→10 MSAC_C2 Abort.req connection timeout FCB=1 FCV=0");
   EXPECT_EQ(info[18], "SRD_high 1→126 Set_Slave_Add.req new address 5 ident 0x1234 FCB=1 FCV=0");
   EXPECT_EQ(info[19], "FDL_Status 1→3");
@@ -157,30 +162,37 @@ TEST_F(TsharkDissector, InfoColumn) {
 }
 
 TEST_F(TsharkDissector, FdlFields) {
-  const auto rows = ts::tshark_fields(
-      s_path, {"frame.number", "_ws.col.Protocol", "pbfdl.type", "pbfdl.da", "pbfdl.sa",
-               "pbfdl.dsap", "pbfdl.ssap", "pbfdl.fc", "pbfdl.fc.name", "pbfdl.fc.fcb",
-               "pbfdl.fc.fcv", "pbfdl.data", "pbfdl.fcs_ok"},
-      "pbfdl");
+  const auto rows =
+      ts::tshark_fields(s_path,
+                        {"frame.number", "_ws.col.Protocol", "pbfdl.type", "pbfdl.da", "pbfdl.sa",
+                         "pbfdl.dsap", "pbfdl.ssap", "pbfdl.fc", "pbfdl.fc.name", "pbfdl.fc.fcb",
+                         "pbfdl.fc.fcv", "pbfdl.data", "pbfdl.fcs_ok"},
+                        "pbfdl");
   ASSERT_EQ(rows.size(), 20u);
   using R = std::vector<std::string>;
-  EXPECT_EQ(rows[0], (R{"1", "DP", "SD2", "10", "1", "60", "62", "0x6d", "SRD_high", "1", "0", "", "1"}));
-  EXPECT_EQ(rows[1], (R{"2", "DP", "SD3", "1", "10", "62", "60", "0x08", "DL", "", "", "020500ff1234", "1"}));
+  EXPECT_EQ(rows[0],
+            (R{"1", "DP", "SD2", "10", "1", "60", "62", "0x6d", "SRD_high", "1", "0", "", "1"}));
+  EXPECT_EQ(rows[1], (R{"2", "DP", "SD3", "1", "10", "62", "60", "0x08", "DL", "", "",
+                        "020500ff1234", "1"}));
   EXPECT_EQ(rows[3], (R{"4", "FDL", "SC", "", "", "", "", "", "", "", "", "", ""}));
-  EXPECT_EQ(rows[7], (R{"8", "DP", "SD2", "10", "1", "", "", "0x5d", "SRD_high", "0", "1", "aa55", "1"}));
+  EXPECT_EQ(rows[7],
+            (R{"8", "DP", "SD2", "10", "1", "", "", "0x5d", "SRD_high", "0", "1", "aa55", "1"}));
   EXPECT_EQ(rows[12], (R{"13", "FDL", "SD4", "5", "2", "", "", "", "", "", "", "", ""}));
   EXPECT_EQ(rows[13][12], "0");  // the collided frame: FCS wrong
-  EXPECT_EQ(rows[19], (R{"20", "FDL", "SD1", "3", "1", "", "", "0x49", "FDL_Status", "0", "0", "", "1"}));
+  EXPECT_EQ(rows[19],
+            (R{"20", "FDL", "SD1", "3", "1", "", "", "0x49", "FDL_Status", "0", "0", "", "1"}));
 }
 
 TEST_F(TsharkDissector, BadFrameHasExpertInfoAndPcapngFlags) {
   const auto rows = ts::tshark_fields(
-      s_path, {"frame.number", "_ws.expert.message", "frame.comment", "frame.packet_flags_symbol_error",
-               "frame.packet_flags_crc_error", "pbfdl.fcs_calc"},
+      s_path,
+      {"frame.number", "_ws.expert.message", "frame.comment", "frame.packet_flags_symbol_error",
+       "frame.packet_flags_crc_error", "pbfdl.fcs_calc"},
       "pbfdl.fcs_bad");
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0][0], "14");
-  EXPECT_NE(rows[0][1].find("FCS mismatch: 0x67 in the frame, 0xBC computed"), std::string::npos) << rows[0][1];
+  EXPECT_NE(rows[0][1].find("FCS mismatch: 0x67 in the frame, 0xBC computed"), std::string::npos)
+      << rows[0][1];
   EXPECT_EQ(rows[0][2], "collision, FCS mismatch");
   EXPECT_EQ(rows[0][3], "1");
   EXPECT_EQ(rows[0][4], "1");
@@ -189,11 +201,12 @@ TEST_F(TsharkDissector, BadFrameHasExpertInfoAndPcapngFlags) {
 
 TEST_F(TsharkDissector, DpDecodes) {
   using R = std::vector<std::string>;
-  auto prm = ts::tshark_fields(s_path, {"pbdp.prm.lock_req", "pbdp.prm.wd_on", "pbdp.prm.wd_fact_1",
-                                          "pbdp.prm.wd_fact_2", "pbdp.prm.min_tsdr", "pbdp.ident",
-                                          "pbdp.prm.group_ident", "pbdp.prm.dpv1_enable",
-                                          "pbdp.prm.watchdog_ms"},
-                                 "pbdp.service == \"Set_Prm.req\"");
+  auto prm =
+      ts::tshark_fields(s_path,
+                        {"pbdp.prm.lock_req", "pbdp.prm.wd_on", "pbdp.prm.wd_fact_1",
+                         "pbdp.prm.wd_fact_2", "pbdp.prm.min_tsdr", "pbdp.ident",
+                         "pbdp.prm.group_ident", "pbdp.prm.dpv1_enable", "pbdp.prm.watchdog_ms"},
+                        "pbdp.service == \"Set_Prm.req\"");
   ASSERT_EQ(prm.size(), 2u);
   EXPECT_EQ(prm[0], (R{"1", "1", "10", "10", "11", "0x1234", "0x00", "", "1000"}));
   EXPECT_EQ(prm[1], (R{"1", "1", "10", "10", "11", "0x1234", "0x00", "1", "1000"}));
@@ -201,62 +214,74 @@ TEST_F(TsharkDissector, DpDecodes) {
   auto cfg = ts::tshark_fields(s_path, {"pbdp.cfg.id", "pbdp.cfg.text"}, "frame.number == 6");
   ASSERT_EQ(cfg.size(), 1u);
   EXPECT_EQ(cfg[0], (R{"0x10,0x20", "1 byte in,1 byte out"}));
-  auto get = ts::tshark_fields(s_path, {"pbdp.service", "pbdp.cfg.id", "pbdp.cfg.format", "pbdp.cfg.text"},
-                                 "frame.number == 16");
+  auto get =
+      ts::tshark_fields(s_path, {"pbdp.service", "pbdp.cfg.id", "pbdp.cfg.format", "pbdp.cfg.text"},
+                        "frame.number == 16");
   ASSERT_EQ(get.size(), 1u);
   EXPECT_EQ(get[0][0], "Get_Cfg.res");
   EXPECT_EQ(get[0][1], "0x13,0x31,0xd7,0xc2,0x00");
   EXPECT_EQ(get[0][2], "general,general,general,special,special");
-  EXPECT_EQ(get[0][3], "4 bytes in,2 bytes in/out,8 words in consistent,"
-                       "2 bytes out consistent, 4 bytes in, 2 manufacturer octets,empty slot");
+  EXPECT_EQ(get[0][3],
+            "4 bytes in,2 bytes in/out,8 words in consistent,"
+            "2 bytes out consistent, 4 bytes in, 2 manufacturer octets,empty slot");
 
-  auto diag = ts::tshark_fields(s_path, {"pbdp.diag.station_not_ready", "pbdp.diag.prm_req",
-                                           "pbdp.diag.master_add", "pbdp.ident", "pbdp.diag.status"},
-                                  "frame.number == 2");
+  auto diag = ts::tshark_fields(s_path,
+                                {"pbdp.diag.station_not_ready", "pbdp.diag.prm_req",
+                                 "pbdp.diag.master_add", "pbdp.ident", "pbdp.diag.status"},
+                                "frame.number == 2");
   EXPECT_EQ(diag[0], (R{"1", "1", "255", "0x1234", "Station_Not_Ready, Prm_Req"}));
-  auto ext = ts::tshark_fields(s_path, {"pbdp.diag.status", "pbdp.diag.block_type", "pbdp.diag.faulty_modules",
-                                          "pbdp.diag.channel.module", "pbdp.diag.channel.number",
-                                          "pbdp.diag.channel.error", "pbdpv1.alarm_type", "pbdpv1.slot",
-                                          "pbdpv1.seq_nr", "pbdpv1.specifier"},
-                                 "frame.number == 15");
-  EXPECT_EQ(ext[0], (R{"Ext_Diag, WD_On", "identifier-related,channel-related,device-related,device-related",
-                       "8", "8", "1", "1", "1", "2", "4", "1"}));
+  auto ext = ts::tshark_fields(
+      s_path,
+      {"pbdp.diag.status", "pbdp.diag.block_type", "pbdp.diag.faulty_modules",
+       "pbdp.diag.channel.module", "pbdp.diag.channel.number", "pbdp.diag.channel.error",
+       "pbdpv1.alarm_type", "pbdpv1.slot", "pbdpv1.seq_nr", "pbdpv1.specifier"},
+      "frame.number == 15");
+  EXPECT_EQ(ext[0], (R{"Ext_Diag, WD_On",
+                       "identifier-related,channel-related,device-related,device-related", "8", "8",
+                       "1", "1", "1", "2", "4", "1"}));
 
-  auto gc = ts::tshark_fields(s_path, {"pbdp.gc.clear_data", "pbdp.gc.sync", "pbdp.gc.group_select"},
-                                "pbdp.service == \"Global_Control.req\"");
+  auto gc =
+      ts::tshark_fields(s_path, {"pbdp.gc.clear_data", "pbdp.gc.sync", "pbdp.gc.group_select"},
+                        "pbdp.service == \"Global_Control.req\"");
   EXPECT_EQ(gc[0], (R{"1", "0", "0x00"}));
-  auto dx = ts::tshark_fields(s_path, {"pbdp.outputs", "pbdp.inputs"}, "pbdp.service contains \"Data_Exchange\"");
+  auto dx = ts::tshark_fields(s_path, {"pbdp.outputs", "pbdp.inputs"},
+                              "pbdp.service contains \"Data_Exchange\"");
   ASSERT_EQ(dx.size(), 3u);
   EXPECT_EQ(dx[0], (R{"aa55", ""}));
   EXPECT_EQ(dx[1], (R{"", "3c"}));
-  auto ssa = ts::tshark_fields(s_path, {"pbdp.ssa.new_address", "pbdp.ident", "pbdp.ssa.no_add_chg"},
-                                 "frame.number == 19");
+  auto ssa = ts::tshark_fields(
+      s_path, {"pbdp.ssa.new_address", "pbdp.ident", "pbdp.ssa.no_add_chg"}, "frame.number == 19");
   EXPECT_EQ(ssa[0], (R{"5", "0x1234", "0x00"}));
 }
 
 TEST_F(TsharkDissector, Dpv1Decodes) {
   using R = std::vector<std::string>;
-  auto rows = ts::tshark_fields(
-      s_path, {"frame.number", "_ws.col.Protocol", "pbdpv1.service", "pbdpv1.slot", "pbdpv1.index",
-               "pbdpv1.length", "pbdpv1.data", "pbdpv1.error_decode", "pbdpv1.error_class",
-               "pbdpv1.error_code", "pbdpv1.error_text"},
-      "pbdpv1.function_num");
+  auto rows =
+      ts::tshark_fields(s_path,
+                        {"frame.number", "_ws.col.Protocol", "pbdpv1.service", "pbdpv1.slot",
+                         "pbdpv1.index", "pbdpv1.length", "pbdpv1.data", "pbdpv1.error_decode",
+                         "pbdpv1.error_class", "pbdpv1.error_code", "pbdpv1.error_text"},
+                        "pbdpv1.function_num");
   ASSERT_EQ(rows.size(), 5u);
   EXPECT_EQ(rows[0], (R{"10", "DP-V1", "Read.req", "0", "0", "64", "", "", "", "", ""}));
   EXPECT_EQ(rows[1], (R{"11", "DP-V1", "Read.res", "0", "0", "2", "abcd", "", "", "", ""}));
-  EXPECT_EQ(rows[2], (R{"12", "DP-V1", "Read.res-", "", "", "", "", "0x80", "0x0b", "0x00", "access: invalid index"}));
+  EXPECT_EQ(rows[2], (R{"12", "DP-V1", "Read.res-", "", "", "", "", "0x80", "0x0b", "0x00",
+                        "access: invalid index"}));
   EXPECT_EQ(rows[3][2], "Alarm_Ack.req");
   EXPECT_EQ(rows[4][2], "Abort.req");
-  auto ab = ts::tshark_fields(s_path, {"pbdpv1.abort.subnet", "pbdpv1.abort.instance", "pbdpv1.abort.reason"},
-                                "frame.number == 18");
+  auto ab = ts::tshark_fields(
+      s_path, {"pbdpv1.abort.subnet", "pbdpv1.abort.instance", "pbdpv1.abort.reason"},
+      "frame.number == 18");
   EXPECT_EQ(ab[0], (R{"1", "1", "3"}));
 }
 
 TEST_F(TsharkDissector, EventRecords) {
   using R = std::vector<std::string>;
-  auto rows = ts::tshark_fields(s_path, {"frame.number", "_ws.col.Protocol", "pbevent.category", "pbevent.code",
-                                           "pbevent.code_name", "pbevent.a", "pbevent.b", "pbevent.text"},
-                                  "pbevent");
+  auto rows =
+      ts::tshark_fields(s_path,
+                        {"frame.number", "_ws.col.Protocol", "pbevent.category", "pbevent.code",
+                         "pbevent.code_name", "pbevent.a", "pbevent.b", "pbevent.text"},
+                        "pbevent");
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_EQ(rows[0], (R{"21", "Event", "1", "0", "cable cut", "0", "1",
                         "dp0: cable cut between 'master 3' and 'slave 10'"}));
@@ -285,8 +310,9 @@ TEST(TsharkDissectorMore, SegmentsPartialFramesAndPolls) {
     w->on_frame(test::tap_frame(line, sd2({0xB3, 0x8A, 0x08, 0x33, 0x33}), 5000));
   }
   using R = std::vector<std::string>;
-  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbfdl.da_segment", "pbfdl.dsap", "pbfdl.ssap",
-                                             "pbfdl.fc.station_type", "_ws.expert.message"});
+  const auto rows =
+      ts::tshark_fields(path, {"_ws.col.Info", "pbfdl.da_segment", "pbfdl.dsap", "pbfdl.ssap",
+                               "pbfdl.fc.station_type", "_ws.expert.message"});
   std::filesystem::remove(path);
   ASSERT_EQ(rows.size(), 5u);
   EXPECT_EQ(rows[0], (R{"SRD_low 1→10 Slave_Diag.req FCB=0 FCV=0", "5", "60", "62", "", ""}));
@@ -311,23 +337,25 @@ TEST(TsharkDissectorMore, SlaveRedundancyBlocks) {
     bus::Line line(sched, "dpA", bus::Baud::k1_5M);
     auto w = PcapngWriter::open(path, {});
     ASSERT_TRUE(w);
-    w->on_frame(test::tap_frame(line, kPrmCmd,
-                                1000));
-    w->on_frame(test::tap_frame(line, kRedState,
-                                2000));
+    w->on_frame(test::tap_frame(line, kPrmCmd, 1000));
+    w->on_frame(test::tap_frame(line, kRedState, 2000));
   }
   using R = std::vector<std::string>;
-  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbdp.prm.prmcmd", "pbdp.prm.block_type",
-                                             "pbdp.red.seq_nr", "pbdp.red.primary_request",
-                                             "pbdp.red.output_hold_time", "pbdp.red.state_1",
-                                             "pbdp.red.state_2", "pbdp.red.state"});
+  const auto rows = ts::tshark_fields(
+      path, {"_ws.col.Info", "pbdp.prm.prmcmd", "pbdp.prm.block_type", "pbdp.red.seq_nr",
+             "pbdp.red.primary_request", "pbdp.red.output_hold_time", "pbdp.red.state_1",
+             "pbdp.red.state_2", "pbdp.red.state"});
   std::filesystem::remove(path);
   ASSERT_EQ(rows.size(), 2u);
-  EXPECT_EQ(rows[0], (R{"SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms PrmCmd Primary_Request FCB=0 FCV=1",
-                        "1", "0x02", "1", "1", "10", "", "", ""}));
-  EXPECT_EQ(rows[1], (R{"10→1 DL Slave_Diag.res ident 0x1234 master 1 [Ext_Diag, WD_On] ext: Red_State "
-                        "(own Primary, Data_Exchange; partner Backup)",
-                        "", "", "1", "1", "", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
+  EXPECT_EQ(
+      rows[0],
+      (R{"SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms PrmCmd Primary_Request FCB=0 FCV=1",
+         "1", "0x02", "1", "1", "10", "", "", ""}));
+  EXPECT_EQ(
+      rows[1],
+      (R{"10→1 DL Slave_Diag.res ident 0x1234 master 1 [Ext_Diag, WD_On] ext: Red_State "
+         "(own Primary, Data_Exchange; partner Backup)",
+         "", "", "1", "1", "", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
 }
 
 // MSAC_C2 (protocol-facts.md §E.6): Initiate.req to the resource manager (SAP 49) from the
@@ -343,29 +371,33 @@ TEST(TsharkDissectorMore, Msac2Connection) {
     ASSERT_TRUE(w);
     // 57 | 3 reserved | Send_Timeout 0x0064 | features 01 00 | profile features 00 00 |
     // profile ident 0x0000 | S_Type 00 S_Len 02 D_Type 00 D_Len 02 | Addr_Data 4 octets
-    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x6D, 0x31, 0x32, 0x57, 0x00, 0x00, 0x00, 0x00, 0x64,
-                                           0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x02, 0x00, 0x02,
-                                           0x00, 0x01, 0x00, 0x02}),
-                                1000));
-    w->on_frame(test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x31, 0x56, 0x30, 0x00, 0x64}), 2000));
+    w->on_frame(test::tap_frame(
+        line, sd2({0x8A, 0x82, 0x6D, 0x31, 0x32, 0x57, 0x00, 0x00, 0x00, 0x00, 0x64, 0x01, 0x00,
+                   0x00, 0x00, 0x00, 0x00, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00, 0x02}),
+        1000));
+    w->on_frame(
+        test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x31, 0x56, 0x30, 0x00, 0x64}), 2000));
     // Initiate.res: 57 | Max_Len_Data_Unit 0xF0 | 01 00 00 00 | 0000 | 00 02 00 02 | 4 octets
-    w->on_frame(test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x30, 0x57, 0xF0, 0x01, 0x00, 0x00, 0x00,
-                                           0x00, 0x00, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00, 0x02}),
-                                3000));
-    w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x7D, 0x30, 0x32, 0x51, 0x01, 0x02, 0x03, 0xAA, 0xBB, 0xCC}),
-                                4000));
+    w->on_frame(
+        test::tap_frame(line, sd2({0x82, 0x8A, 0x08, 0x32, 0x30, 0x57, 0xF0, 0x01, 0x00, 0x00, 0x00,
+                                   0x00, 0x00, 0x00, 0x02, 0x00, 0x02, 0x00, 0x01, 0x00, 0x02}),
+                        3000));
+    w->on_frame(test::tap_frame(
+        line, sd2({0x8A, 0x82, 0x7D, 0x30, 0x32, 0x51, 0x01, 0x02, 0x03, 0xAA, 0xBB, 0xCC}), 4000));
     w->on_frame(test::tap_frame(line, sd2({0x8A, 0x82, 0x5D, 0x30, 0x32, 0x48, 0x00}), 5000));
   }
   using R = std::vector<std::string>;
-  const auto rows = ts::tshark_fields(path, {"_ws.col.Info", "pbdpv1.service", "pbdpv1.send_timeout",
-                                             "pbdpv1.server_sap", "pbdpv1.max_len_data_unit", "pbdpv1.s_len",
-                                             "pbdpv1.addr_data", "pbdpv1.data"});
+  const auto rows = ts::tshark_fields(
+      path, {"_ws.col.Info", "pbdpv1.service", "pbdpv1.send_timeout", "pbdpv1.server_sap",
+             "pbdpv1.max_len_data_unit", "pbdpv1.s_len", "pbdpv1.addr_data", "pbdpv1.data"});
   std::filesystem::remove(path);
   ASSERT_EQ(rows.size(), 5u);
-  EXPECT_EQ(rows[0], (R{"SRD_high 2→10 MSAC_C2 Initiate.req FCB=1 FCV=0", "Initiate.req", "100", "", "", "2",
+  EXPECT_EQ(rows[0], (R{"SRD_high 2→10 MSAC_C2 Initiate.req FCB=1 FCV=0", "Initiate.req", "100", "",
+                        "", "2", "00010002", ""}));
+  EXPECT_EQ(rows[1],
+            (R{"10→2 DL MSAC_C2 RM.res server SAP 48", "RM.res", "100", "48", "", "", "", ""}));
+  EXPECT_EQ(rows[2], (R{"10→2 DL MSAC_C2 Initiate.res", "Initiate.res", "", "", "240", "2",
                         "00010002", ""}));
-  EXPECT_EQ(rows[1], (R{"10→2 DL MSAC_C2 RM.res server SAP 48", "RM.res", "100", "48", "", "", "", ""}));
-  EXPECT_EQ(rows[2], (R{"10→2 DL MSAC_C2 Initiate.res", "Initiate.res", "", "", "240", "2", "00010002", ""}));
   EXPECT_EQ(rows[3], (R{"SRD_high 2→10 MSAC_C2 Data_Transport.req slot 1 index 2 len 3 FCB=1 FCV=1",
                         "Data_Transport.req", "", "", "", "", "", "aabbcc"}));
   EXPECT_EQ(rows[4][0], "SRD_high 2→10 MSAC_C2 Idle.req FCB=0 FCV=1");
@@ -375,10 +407,21 @@ TEST(TsharkDissectorMore, Msac2Connection) {
 TEST(TsharkDissectorRobustness, GarbageFramesDecodeWithoutLuaErrors) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
   const auto path = test::temp_capture_path("pbvbus_tshark_garbage");
-  const std::vector<const Bytes*> goldens = {
-      &test::kSlaveDiagReq, &test::kSlaveDiagRes, &test::kSetPrmDpv1, &test::kChkCfg,
-      &test::kGlobalControlClear, &test::kDpv1Read, &test::kDpv1ReadNeg, &test::kSetSlaveAdd,
-      &kDiagExt, &kGetCfgRes, &kAlarmAck, &kC2Abort, &test::kToken_2_to_5, &kPrmCmd, &kRedState};
+  const std::vector<const Bytes*> goldens = {&test::kSlaveDiagReq,
+                                             &test::kSlaveDiagRes,
+                                             &test::kSetPrmDpv1,
+                                             &test::kChkCfg,
+                                             &test::kGlobalControlClear,
+                                             &test::kDpv1Read,
+                                             &test::kDpv1ReadNeg,
+                                             &test::kSetSlaveAdd,
+                                             &kDiagExt,
+                                             &kGetCfgRes,
+                                             &kAlarmAck,
+                                             &kC2Abort,
+                                             &test::kToken_2_to_5,
+                                             &kPrmCmd,
+                                             &kRedState};
   std::uint64_t rng = 0x9E3779B97F4A7C15ULL;
   auto next = [&] {
     rng ^= rng << 13;
@@ -395,13 +438,19 @@ TEST(TsharkDissectorRobustness, GarbageFramesDecodeWithoutLuaErrors) {
     for (int i = 0; i < 600; ++i) {
       Bytes b = *goldens[next() % goldens.size()];
       switch (next() % 4) {
-        case 0: b.resize(next() % (b.size() + 1)); break;           // cut anywhere
-        case 1: b[next() % b.size()] = static_cast<std::uint8_t>(next()); break;
+        case 0:
+          b.resize(next() % (b.size() + 1));
+          break;  // cut anywhere
+        case 1:
+          b[next() % b.size()] = static_cast<std::uint8_t>(next());
+          break;
         case 2:
           for (auto& o : b) o = static_cast<std::uint8_t>(next());  // noise
           b[0] = std::array<std::uint8_t, 5>{0x10, 0x68, 0xA2, 0xDC, 0xE5}[next() % 5];
           break;
-        default: b.push_back(static_cast<std::uint8_t>(next())); break;
+        default:
+          b.push_back(static_cast<std::uint8_t>(next()));
+          break;
       }
       // Keep SD2 headers plausible often enough to reach the DP decoders with odd lengths.
       if (b.size() > 4 && b[0] == 0x68 && next() % 2 == 0) {

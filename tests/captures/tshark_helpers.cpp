@@ -61,9 +61,13 @@ std::optional<std::string> find_program(const std::string& name) {
   return std::nullopt;
 }
 
-bool tshark_available() { return find_program("tshark").has_value(); }
+bool tshark_available() {
+  return find_program("tshark").has_value();
+}
 
-std::string dissector_path() { return std::string(PBVBUS_SOURCE_DIR) + "/captures/lua/pbvbus.lua"; }
+std::string dissector_path() {
+  return std::string(PBVBUS_SOURCE_DIR) + "/captures/lua/pbvbus.lua";
+}
 
 CommandResult tshark(const std::string& file, const std::vector<std::string>& args,
                      bool with_dissector) {
@@ -102,8 +106,8 @@ std::vector<std::vector<std::string>> tshark_fields(const std::string& file,
     args.push_back("-Y");
     args.push_back(filter);
   }
-  for (const char* a : {"-T", "fields", "-E", "separator=|", "-E", "occurrence=a", "-E",
-                        "aggregator=,"})
+  for (const char* a :
+       {"-T", "fields", "-E", "separator=|", "-E", "occurrence=a", "-E", "aggregator=,"})
     args.push_back(a);
   for (const std::string& f : fields) {
     args.push_back("-e");

@@ -23,20 +23,20 @@ struct PcapngInterface {
   std::uint32_t snaplen = 0;
   std::string name;
   std::string description;
-  std::uint64_t speed = 0;       ///< if_speed in bit/s; 0 = not given
-  std::uint8_t tsresol = 6;      ///< if_tsresol as in the file (default 6: microseconds)
-  std::int64_t tsoffset_s = 0;   ///< if_tsoffset in seconds
-  std::uint32_t section = 0;     ///< index of the section that declared it
+  std::uint64_t speed = 0;      ///< if_speed in bit/s; 0 = not given
+  std::uint8_t tsresol = 6;     ///< if_tsresol as in the file (default 6: microseconds)
+  std::int64_t tsoffset_s = 0;  ///< if_tsoffset in seconds
+  std::uint32_t section = 0;    ///< index of the section that declared it
 };
 
 struct PcapngRecord {
-  std::uint32_t interface = 0;       ///< index into PcapngReader::interfaces()
-  std::int64_t ts_ns = 0;            ///< timestamp in ns (tsresol and tsoffset applied)
-  std::vector<std::uint8_t> bytes;   ///< captured octets
+  std::uint32_t interface = 0;      ///< index into PcapngReader::interfaces()
+  std::int64_t ts_ns = 0;           ///< timestamp in ns (tsresol and tsoffset applied)
+  std::vector<std::uint8_t> bytes;  ///< captured octets
   std::uint32_t orig_len = 0;
-  std::uint32_t flags = 0;           ///< epb_flags (0 if absent)
-  std::string comment;               ///< opt_comment ("" if absent)
-  std::uint64_t offset = 0;          ///< file offset of the block
+  std::uint32_t flags = 0;   ///< epb_flags (0 if absent)
+  std::string comment;       ///< opt_comment ("" if absent)
+  std::uint64_t offset = 0;  ///< file offset of the block
 };
 
 struct PcapngError {

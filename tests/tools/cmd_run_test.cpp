@@ -1,6 +1,7 @@
 // `pbvbus run`: argument errors, scenario errors, the text and JSON reports.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -159,6 +160,30 @@ TEST(CmdRun, JsonReportIsValidJsonWithTheDocumentedSchema) {
             "[(1, 'master_in_ring'), (2, 'master_in_ring'), (3, 'master_in_ring'), (10, "
             "'slave')] 2 True True\n");
   EXPECT_TRUE(r.err.empty()) << r.err;
+}
+
+// A serial attachment makes the run paced by default: virtual time follows the wall clock
+// (tolerant: only "not faster than real time" is checked, never an upper bound).
+TEST(CmdRun, SerialAttachmentMakesTheRunPaced) {
+  const std::string path = write_temp("cmd_run_paced.textproto",
+                                      "line { name: \"A\" }\n"
+                                      "master { address: 1 line: \"A\" }\n"
+                                      "serial { line: \"A\" mode: MONITOR }\n");
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = run({path, "--duration", "200ms", "--json"});
+  const auto wall = std::chrono::steady_clock::now() - t0;
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_GE(wall, std::chrono::milliseconds(195));
+  EXPECT_NE(r.out.find("\"duration_ns\":200000000,"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"serial\":[{\"line\":\"A\",\"mode\":\"monitor\",\"path\":\"/dev/pts/"),
+            std::string::npos)
+      << r.out;
+  // The pty path is announced on stderr before the run.
+  EXPECT_EQ(r.err.rfind("serial monitor on line A: /dev/pts/", 0), 0u) << r.err;
+  // --fast overrides the default, with a warning.
+  const auto f = run({path, "--duration", "200ms", "--fast"});
+  EXPECT_EQ(f.rc, 0);
+  EXPECT_NE(f.err.find("warning: --fast with serial attachments"), std::string::npos) << f.err;
 }
 
 TEST(CmdRun, CaptureToStdoutSendsTheReportToStderr) {

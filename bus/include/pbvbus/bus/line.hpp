@@ -17,6 +17,15 @@
 // A device's own telegrams never overlap each other: if it asks for a start while its previous
 // telegram is still going out, the new one follows back to back (one UART per station).
 //
+// Taps see each transmission from its sender's side of the cable: a frame that a cable cut
+// keeps from some receivers appears whole on the taps (the far side receives it partial), while
+// a frame cut short at its source (sender's power or transceiver lost, short circuit) appears
+// partial. Transmissions that never reach the cable (short circuit, failed transceiver) are
+// counted in LineStats::lost and not tapped.
+//
+// Receive filters are cached: the line re-reads Device::receive_filter() after every call into
+// the device, and on DevicePort::receive_filter_changed().
+//
 // Attachments keep the order in which they were attached: that is their position along the
 // cable, which is what a cable cut between two stations refers to.
 

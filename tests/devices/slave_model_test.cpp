@@ -394,6 +394,24 @@ TEST(SlaveModelLine, Dpv1ProcessAlarm) {
   EXPECT_EQ(b.model->application().alarms_outstanding(), 0u);
 }
 
+TEST(SlaveModelLine, Dpv1ChannelDiagnosisWithDiagnosticAlarm) {
+  const GsdFile gsd = load("PBVB0A03.gsd");
+  Bench b(gsd, dv4_modules(), 7);
+  // Wire break on channel 1 of the 2AI (module 2, identifier 2, slot 3), word input.
+  SlaveFault f = SlaveFault::channel_diag(2, 1, dp::ChannelError::LineBreak, dp::ChannelType::Word);
+  f.alarm = true;
+  ASSERT_EQ(b.model->schedule(15 * kMs, f), "");
+  b.start();
+  b.run_until(25 * kMs);
+  // Ext_Diag; channel block 82 41 A6; Diagnostic alarm 07 01 03 01 (type 1, slot 3, Seq_Nr 0,
+  // appears) carrying the channel octets.
+  EXPECT_TRUE(on_wire(b.rec, "68 15 15 68 81 87 08 3E 3C 08 0C 00 01 0A 03 82 41 A6 07 01 03 01 82 41 A6 8A 16"));
+  EXPECT_EQ(b.master->slave_stats(7).alarm_acks, 1u);
+  // Acknowledged: the alarm leaves the diagnosis, the channel diagnosis stays.
+  EXPECT_EQ(pbvbus::test::to_hex(b.model->engine().current_diag()), "08 0C 00 01 0A 03 82 41 A6");
+  EXPECT_EQ(b.master->slave_state(7), dp::SlaveStatusState::DataExchange);
+}
+
 // --- mute ---------------------------------------------------------------------------------------
 
 TEST(SlaveModelLine, MutedSlaveIsSilentThenReturns) {
@@ -405,8 +423,13 @@ TEST(SlaveModelLine, MutedSlaveIsSilentThenReturns) {
   b.run_until(15 * kMs);
   ASSERT_EQ(b.master->slave_state(5), dp::SlaveStatusState::DataExchange);
   const std::size_t from = b.rec.size();
+  const std::uint64_t heard = b.model->station().stats().requests;
+  const std::uint64_t cycles = b.model->dp_cycles();
   b.run_until(40 * kMs - 1);
   EXPECT_TRUE(b.model->muted());
+  // Deaf: nothing reached the passive station or the engine while muted.
+  EXPECT_EQ(b.model->station().stats().requests, heard);
+  EXPECT_EQ(b.model->dp_cycles(), cycles);
   int requests = 0;
   for (std::size_t i = from; i < b.rec.size(); ++i) {
     fdl::Telegram t;

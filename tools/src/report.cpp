@@ -149,6 +149,7 @@ void write_text(const Report& r, std::ostream& os) {
        << no_response(l) << ", retries " << retries(l) << "\n";
     for (const auto& f : t.faults) os << "  fault at " << bus::format_duration(f.time) << ": " << f.text << "\n";
   }
+  write_dp_text(r.dp_masters, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -230,7 +231,9 @@ void write_json(const Report& r, std::ostream& os) {
     }
     os << "]}";
   }
-  os << "]}\n";
+  os << "]";
+  write_dp_json(r.dp_masters, os);
+  os << "}\n";
 }
 
 }  // namespace pbvbus::tools

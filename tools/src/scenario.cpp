@@ -31,6 +31,8 @@ std::string_view to_string(StationKind k) {
     case StationKind::Passive: return "passive_station";
     case StationKind::SerialMonitor: return "serial monitor";
     case StationKind::SerialStation: return "serial station";
+    case StationKind::DpMaster: return "dp_master";
+    case StationKind::DpSlave: return "dp_slave";
   }
   return "?";
 }
@@ -148,6 +150,13 @@ class Planner {
       }
     }
     plan_lines(plan);
+    plan_dp(plan, [this](const char* rep, int index, const char* field, int element) {
+      Where w = nested(m_root, scenario::Scenario::descriptor(), rep, index);
+      if (field != nullptr)
+        w = at_field(w, scenario::Scenario::descriptor()->FindFieldByName(rep)->message_type(),
+                     field, element);
+      return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
+    }, m_errors);
     plan_stations(plan);
     plan_faults(plan);
     if (!m_errors.empty()) return std::nullopt;
@@ -271,6 +280,16 @@ class Planner {
                          nested(m_root, sd, "serial", i), s.line(),
                          s.has_address() ? std::optional(s.address()) : std::nullopt});
     }
+    for (int i = 0; i < m_proto.dp_master_size(); ++i) {
+      const auto& m = m_proto.dp_master(i);
+      entries.push_back({StationKind::DpMaster, i, nested(m_root, sd, "dp_master", i), m.line(),
+                         m.has_address() ? std::optional(m.address()) : std::nullopt});
+    }
+    for (int i = 0; i < m_proto.dp_slave_size(); ++i) {
+      const auto& p = m_proto.dp_slave(i);
+      entries.push_back({StationKind::DpSlave, i, nested(m_root, sd, "dp_slave", i), p.line(),
+                         p.has_address() ? std::optional(p.address()) : std::nullopt});
+    }
     // Cable order = order of appearance in the text. Without text, the order above.
     if (m_root.tree != nullptr) {
       std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
@@ -282,13 +301,15 @@ class Planner {
     for (const auto& e : entries) {
       const pb::Descriptor* d = e.kind == StationKind::Master    ? scenario::Master::descriptor()
                                 : e.kind == StationKind::Passive ? scenario::PassiveStation::descriptor()
-                                                                 : scenario::Serial::descriptor();
+                                : e.kind == StationKind::DpMaster ? scenario::DpMaster::descriptor()
+                                : e.kind == StationKind::DpSlave  ? scenario::DpSlave::descriptor()
+                                                                  : scenario::Serial::descriptor();
       const std::string what(to_string(e.kind));
       const int li = line_ref(e.where, d, e.line, what);
       const Where aw = at_field(e.where, d, "address");
       bool addr_ok = false;
       if (!e.address) {
-        if (e.kind == StationKind::Master || e.kind == StationKind::Passive)
+        if (e.kind != StationKind::SerialMonitor && e.kind != StationKind::SerialStation)
           error(e.where, what + " needs an address");
         else if (e.kind == StationKind::SerialStation)
           error(e.where, "a serial STATION needs the address of the external station");
@@ -296,6 +317,9 @@ class Planner {
         error(aw, "a serial MONITOR has no address (only a STATION has one)");
       } else if (*e.address > kMaxAddress) {
         error(aw, "address " + std::to_string(*e.address) + " is out of range 0..126");
+      } else if (e.kind == StationKind::DpSlave && *e.address > 125) {
+        error(aw, "DP slave address " + std::to_string(*e.address) +
+                      " is out of range 0..125 (126 is the address of an unassigned slave)");
       } else {
         addr_ok = true;
       }

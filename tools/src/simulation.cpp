@@ -51,6 +51,9 @@ struct Simulation::Station {
   std::unique_ptr<fdl::ActiveStation> active;
   bus::AttachmentId position = -1;
   std::unique_ptr<bus::PtyStation> pty;
+  std::unique_ptr<DpMasterNode> dp_master;
+  std::unique_ptr<DpSlaveNode> dp_slave;
+  const DpSlavePlan* dp_slave_plan = nullptr;
 };
 
 struct Simulation::LineState {
@@ -131,6 +134,23 @@ void Simulation::build_line(std::size_t li) {
         st.position = ls->line->attach(*st.passive, label);
         break;
       }
+      case StationKind::DpMaster: {
+        const auto it = std::find_if(m_plan.dp_masters.begin(), m_plan.dp_masters.end(),
+                                     [&](const DpMasterPlan& m) { return m.source == ps.source; });
+        st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
+        label = "dp master " + std::to_string(st.address);
+        st.position = ls->line->attach(st.dp_master->station(), label);
+        break;
+      }
+      case StationKind::DpSlave: {
+        const auto it = std::find_if(m_plan.dp_slaves.begin(), m_plan.dp_slaves.end(),
+                                     [&](const DpSlavePlan& s) { return s.source == ps.source; });
+        st.dp_slave = std::make_unique<DpSlaveNode>(*it, ps.params);
+        st.dp_slave_plan = &*it;
+        label = "dp slave " + std::to_string(st.address);
+        st.position = ls->line->attach(st.dp_slave->station(), label);
+        break;
+      }
       case StationKind::SerialMonitor:
       case StationKind::SerialStation: {
         const auto& sp = m_plan.proto.serial(ps.source);
@@ -174,6 +194,24 @@ const devices::FdlPoller* Simulation::poller(std::size_t li, std::uint8_t addr) 
 const devices::FdlResponder* Simulation::responder(std::size_t li, std::uint8_t addr) const {
   for (const auto& s : m_lines.at(li)->stations)
     if (s.kind == StationKind::Passive && s.address == addr) return s.responder.get();
+  return nullptr;
+}
+
+const DpMasterNode* Simulation::dp_master(std::size_t li, std::uint8_t addr) const {
+  for (const auto& s : m_lines.at(li)->stations)
+    if (s.dp_master && s.address == addr) return s.dp_master.get();
+  return nullptr;
+}
+
+DpMasterNode* Simulation::dp_master(std::size_t li, std::uint8_t addr) {
+  for (auto& s : m_lines.at(li)->stations)
+    if (s.dp_master && s.address == addr) return s.dp_master.get();
+  return nullptr;
+}
+
+const DpSlaveNode* Simulation::dp_slave(std::size_t li, std::uint8_t addr) const {
+  for (const auto& s : m_lines.at(li)->stations)
+    if (s.dp_slave && s.address == addr) return s.dp_slave.get();
   return nullptr;
 }
 
@@ -282,6 +320,25 @@ Report Simulation::report(double wall_seconds) const {
         sr.cycles = s.responder->cycle();
         lr.stations.push_back(sr);
       }
+    }
+    for (const Station& s : ls.stations) {
+      if (!s.dp_master) continue;
+      // A DP master is a ring member like any FDL master: its live list counts too.
+      if (ls.line->powered(s.position)) {
+        const fdl::ActiveStation& as = s.dp_master->station();
+        live[s.address] = std::max(live[s.address], as.in_ring() ? int(fdl::StationType::MasterInRing)
+                                                                 : int(fdl::StationType::MasterNotReady));
+        for (const auto& [addr, type] : as.live_list())
+          if (addr < 128) live[addr] = std::max(live[addr], int(type));
+      }
+      std::vector<const DpSlaveNode*> nodes;
+      std::vector<const DpSlavePlan*> plans;
+      for (const Station& t : ls.stations) {
+        if (!t.dp_slave || t.dp_slave_plan->master != s.address) continue;
+        nodes.push_back(t.dp_slave.get());
+        plans.push_back(t.dp_slave_plan);
+      }
+      r.dp_masters.push_back(dp_master_report(*s.dp_master, nodes, plans, pl.name, pl.baud));
     }
     for (int a = 0; a < 128; ++a)
       if (live[a] >= 0)

@@ -34,7 +34,22 @@
 //                      "polls": { "requests","ok","no_response","sent","retries",
 //                                 "data_octets": int } } ],
 //       "stations": [ { "address": int, "requests","replies","fdl_status","cycles": int } ]
-//     } ] }
+//     } ],
+//     "dp_masters": [ { "address": int, "line": str, "mode": "Operate"|"Clear"|"Stop"|"Offline",
+//       "global_controls": int, "data_control_time_ms": int,
+//       "slaves": [ { "address": int, "model": str, "modules": [str],
+//                     "state": str,          // the master's view, e.g. "DataExchange"
+//                     "slave_state": str,    // the slave's own, e.g. "Data_Exch"
+//                     "diag": "hex octets", "diag_bits": [str],   // e.g. "Always_1"
+//                     "input_len","output_len": int, "inputs","outputs": "hex octets",
+//                     "cycle": { "count","min_ns","median_ns","max_ns","min_bits",
+//                                "median_bits","max_bits": int },  // DP cycle time
+//                     "data_exchanges","startups","diag_reads","failures","returns",
+//                     "no_response","retries": int } ] } ] }
+//
+// The DP cycle time of a slave is the time between the starts of two consecutive
+// Data_Exchange requests to it (dp::MasterSlaveStats); its median is over the last 1024
+// cycles, min and max over the whole run.
 //
 // Token rotation times are the real rotation times (TRR) the master measured at each token
 // receipt over the whole run, so the maximum includes rotations disturbed by faults (a ring
@@ -50,6 +65,7 @@
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/fdl_poller.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/tools/dp_system.hpp"
 #include "pbvbus/tools/line_stats.hpp"
 
 namespace pbvbus::tools {
@@ -120,6 +136,7 @@ struct Report {
   std::vector<SerialReport> serial;
   std::vector<std::string> faults_not_reached;
   std::vector<LineReport> lines;
+  std::vector<DpMasterReport> dp_masters;
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

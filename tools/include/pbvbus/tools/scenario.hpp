@@ -28,6 +28,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/tools/dp_plan.hpp"
 #include "scenario.pb.h"
 
 namespace pbvbus::tools {
@@ -42,7 +43,7 @@ struct Diagnostic {
   std::string str() const;
 };
 
-enum class StationKind : std::uint8_t { Master, Passive, SerialMonitor, SerialStation };
+enum class StationKind : std::uint8_t { Master, Passive, SerialMonitor, SerialStation, DpMaster, DpSlave };
 std::string_view to_string(StationKind k);
 
 /// A station in cable order.
@@ -89,6 +90,8 @@ struct ScenarioPlan {
   std::optional<bus::Ticks> duration;  ///< from the file; the CLI may override it
   std::vector<PlanLine> lines;
   std::vector<PlanFault> faults;  ///< ordered by time of occurrence
+  std::vector<DpMasterPlan> dp_masters;  ///< in file order (dp_plan.hpp)
+  std::vector<DpSlavePlan> dp_slaves;    ///< in file order, valid ones only
 };
 
 struct LoadResult {

@@ -69,6 +69,11 @@ class Simulation {
   /// The user of passive station `addr` on line `li`, or nullptr.
   const devices::FdlResponder* responder(std::size_t li, std::uint8_t addr) const;
 
+  /// The DP master / DP slave node at `addr` on line `li`, or nullptr.
+  const DpMasterNode* dp_master(std::size_t li, std::uint8_t addr) const;
+  DpMasterNode* dp_master(std::size_t li, std::uint8_t addr);
+  const DpSlaveNode* dp_slave(std::size_t li, std::uint8_t addr) const;
+
   /// Whether something outside the process is attached (a pty): then the run must be paced.
   bool has_external_attachments() const { return !m_serial.empty(); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }

@@ -1,0 +1,128 @@
+#pragma once
+// DP master systems at run time (design.md "Configuration and command line"; protocol-facts.md
+// §D.9 class-1 master): the scenario's dp_master becomes an fdl::ActiveStation driven by a
+// dp::Master, each dp_slave an fdl::PassiveStation driven by a dp::SlaveEngine, with small
+// models on both sides so that data exchange is visible:
+//  - master side (DpMasterNode, "the test program"): at every token receipt it writes every
+//    output octet of every slave = the number of token receipts so far (mod 256), or zeros;
+//  - device side (DpSlaveNode): before each request reaches the engine, the inputs are set to
+//    the number of Data_Exchange requests received (mod 256) in every octet, or to the outputs
+//    (echo), or zeros.
+// Both hook in as decorators of the FDL user interfaces, so the DP stacks stay untouched and
+// the wire timing is exactly the stacks' (the hooks take no virtual time).
+//
+// Report (DpSlaveReport, DpMasterReport): the master's view of each slave (state, stored
+// diagnosis with decoded bits, in/out octets and their current values, DP cycle time
+// min/median/max from dp::MasterSlaveStats, failures/returns) and the slave's own state.
+// Global_Control frames are counted as the master hands them to its station.
+
+#include <cstdint>
+#include <iosfwd>
+#include <span>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pbvbus/dp/master.hpp"
+#include "pbvbus/dp/slave_engine.hpp"
+#include "pbvbus/fdl/active_station.hpp"
+#include "pbvbus/fdl/passive_station.hpp"
+#include "pbvbus/tools/dp_plan.hpp"
+
+namespace pbvbus::tools {
+
+/// dp::Master with the master-side test program and a Global_Control counter.
+class DpMasterNode final : public fdl::InitiatorUser {
+ public:
+  DpMasterNode(const DpMasterPlan& plan, const std::vector<DpSlavePlan>& slaves,
+               const fdl::BusParams& params);
+  fdl::ActiveStation& station() { return *m_station; }
+  const fdl::ActiveStation& station() const { return *m_station; }
+  dp::Master& master() { return m_master; }
+  const dp::Master& master() const { return m_master; }
+  std::uint64_t global_controls() const { return m_global_controls; }
+
+  void on_power_on(bus::Ticks now) override;
+  bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override;
+  void on_confirmation(const fdl::Confirmation& con) override { m_master.on_confirmation(con); }
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override {
+    m_master.on_request(ind, reply);
+  }
+  void on_token(bus::Ticks now, bus::Ticks trr) override;
+
+ private:
+  dp::Master m_master;
+  scenario::DpMaster::Outputs m_program;
+  std::unique_ptr<fdl::ActiveStation> m_station;
+  std::uint64_t m_tokens = 0;
+  std::uint64_t m_global_controls = 0;
+  std::vector<std::uint8_t> m_buf;
+};
+
+/// dp::SlaveEngine with its device model.
+class DpSlaveNode final : public fdl::ResponderUser {
+ public:
+  DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params);
+  fdl::PassiveStation& station() { return *m_station; }
+  const fdl::PassiveStation& station() const { return *m_station; }
+  dp::SlaveEngine& engine() { return m_engine; }
+  const dp::SlaveEngine& engine() const { return m_engine; }
+  std::uint64_t data_exchanges() const { return m_dx; }
+
+  void on_power_on(bus::Ticks now) override { m_engine.on_power_on(now); }
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override;
+  bus::Ticks next_deadline() const override { return m_engine.next_deadline(); }
+  void on_time(bus::Ticks now) override { m_engine.on_time(now); }
+
+ private:
+  void update_inputs();
+
+  dp::SlaveEngine m_engine;
+  scenario::DpSlave::Inputs m_io;
+  std::unique_ptr<fdl::PassiveStation> m_station;
+  std::uint64_t m_dx = 0;
+  std::vector<std::uint8_t> m_buf;
+  std::vector<std::uint8_t> m_echo;
+};
+
+struct DpSlaveReport {
+  std::uint8_t address = 0;
+  std::uint8_t master = 0;
+  std::string model;                 ///< GSD Model_Name
+  std::string gsd;                   ///< GSD path as written in the scenario
+  std::vector<std::string> modules;
+  std::string state;                 ///< the master's view, e.g. "DataExchange"
+  std::string slave_state;           ///< the slave's own, e.g. "Data_Exch"
+  std::vector<std::uint8_t> diag;    ///< last diagnosis the master stored
+  std::vector<std::string> diag_bits;  ///< names of the set bits of octets 1..3
+  std::size_t input_len = 0;
+  std::size_t output_len = 0;
+  std::vector<std::uint8_t> inputs;   ///< master image, current
+  std::vector<std::uint8_t> outputs;  ///< what the slave received last (Rd_Outp view)
+  dp::MasterSlaveStats stats;
+  bus::Ticks cycle_median = 0;
+};
+
+struct DpMasterReport {
+  std::uint8_t address = 0;
+  std::string line;
+  bus::Baud baud = bus::Baud::k1_5M;
+  std::string mode;  ///< "Operate", "Clear", "Stop", "Offline"
+  std::uint64_t global_controls = 0;
+  std::uint16_t data_control_time = 0;  ///< 10 ms units
+  std::vector<DpSlaveReport> slaves;
+};
+
+/// Names of the set bits of Slave_Diag octets 1..3 (Station_Non_Existent, ..., Deactivated).
+std::vector<std::string> diag_bit_names(std::span<const std::uint8_t> diag);
+
+DpMasterReport dp_master_report(const DpMasterNode& m, const std::vector<const DpSlaveNode*>& slaves,
+                                const std::vector<const DpSlavePlan*>& plans,
+                                const std::string& line, bus::Baud baud);
+
+/// The DP part of the text report (dp_report.cpp).
+void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os);
+/// The DP part of the JSON report: `,"dp_masters":[...]` (schema in report.hpp).
+void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os);
+
+}  // namespace pbvbus::tools

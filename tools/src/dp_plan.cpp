@@ -1,0 +1,358 @@
+// DP master systems in scenarios: GSD-driven slave configuration and derived bus parameters
+// (decisions in tools/include/pbvbus/tools/dp_plan.hpp).
+#include "pbvbus/tools/dp_plan.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/dp/prm.hpp"
+#include "pbvbus/tools/scenario.hpp"
+
+namespace pbvbus::tools {
+
+namespace {
+
+constexpr bus::Ticks kTenMs = bus::kTicksPerSecond / 100;
+
+std::uint64_t request_octets(std::uint64_t n) { return n == 0 ? 6 : n == 8 ? 14 : 9 + n; }
+std::uint64_t response_octets(std::uint64_t n) { return n == 0 ? 1 : request_octets(n); }
+
+/// Smallest factor pair (f1 <= f2, both 1..255) with f1 * f2 == units; nullopt if none.
+std::optional<std::pair<std::uint8_t, std::uint8_t>> wd_factors(std::uint64_t units) {
+  for (std::uint64_t f1 = 1; f1 <= 255; ++f1) {
+    if (units % f1 != 0) continue;
+    const std::uint64_t f2 = units / f1;
+    if (f2 >= f1 && f2 <= 255)
+      return std::pair(static_cast<std::uint8_t>(f1), static_cast<std::uint8_t>(f2));
+  }
+  return std::nullopt;
+}
+
+dp::SlaveFeatures features_of(const devices::GsdFile& g) {
+  dp::SlaveFeatures f;
+  const auto& s = g.slave_features();
+  const auto& v = g.dpv1();
+  f.sync = s.sync_mode_supp;
+  f.freeze = s.freeze_mode_supp;
+  f.fail_safe = s.fail_safe;
+  f.set_slave_add = s.set_slave_add_supp;
+  f.dpv1 = v.dpv1_slave;
+  f.c1_read_write = v.c1_read_write_supp;
+  f.c2 = v.c2_read_write_supp;
+  f.c2_connections = std::max<std::uint8_t>(1, v.c2_max_count_channels);
+  std::uint8_t al = 0;
+  if (v.pull_plug_alarm_supp) al |= dp::kEnablePullPlugAlarm;
+  if (v.process_alarm_supp) al |= dp::kEnableProcessAlarm;
+  if (v.diagnostic_alarm_supp) al |= dp::kEnableDiagnosticAlarm;
+  if (v.manufacturer_specific_alarm_supp) al |= dp::kEnableManufacturerAlarm;
+  if (v.status_alarm_supp) al |= dp::kEnableStatusAlarm;
+  if (v.update_alarm_supp) al |= dp::kEnableUpdateAlarm;
+  f.alarms_supported = al;
+  f.max_alarm_mode = v.alarm_type_mode_supp ? 7 : 0;
+  f.wd_base_1ms = v.wd_base_1ms_supp;
+  f.check_cfg_mode = v.check_cfg_mode;
+  f.prm_structure = v.prm_block_structure_supp;
+  f.prm_cmd = g.redundancy().prm_cmd_supp;
+  return f;
+}
+
+class DpPlanner {
+ public:
+  DpPlanner(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors)
+      : m_plan(plan), m_locate(locate), m_errors(errors) {}
+
+  void run() {
+    const auto& proto = m_plan.proto;
+    const std::filesystem::path base = std::filesystem::path(m_plan.file).parent_path();
+    for (int i = 0; i < proto.dp_master_size(); ++i) plan_master(i);
+    for (int i = 0; i < proto.dp_slave_size(); ++i) plan_slave(i, base);
+    derive_line_params();
+  }
+
+ private:
+  void error(const char* rep, int index, const char* field, int element, std::string msg) {
+    auto [l, c] = m_locate(rep, index, field, element);
+    m_errors.push_back({m_plan.file, l, c, std::move(msg)});
+  }
+
+  int line_index(const std::string& name) const {
+    for (std::size_t i = 0; i < m_plan.lines.size(); ++i)
+      if (m_plan.lines[i].name == name) return static_cast<int>(i);
+    return -1;
+  }
+
+  std::optional<bus::Ticks> ten_ms(const char* rep, int i, const char* field,
+                                   const std::string& text) {
+    auto t = bus::parse_duration(text);
+    if (!t) {
+      error(rep, i, field, -1, "bad duration \"" + text + "\" (e.g. \"120ms\")");
+      return std::nullopt;
+    }
+    if (*t == 0 || *t % kTenMs != 0) {
+      error(rep, i, field, -1, std::string(field) + " \"" + text +
+                                   "\" is not a positive multiple of 10 ms");
+      return std::nullopt;
+    }
+    return t;
+  }
+
+  void plan_master(int i) {
+    const auto& m = m_plan.proto.dp_master(i);
+    DpMasterPlan mp;
+    mp.source = i;
+    mp.line = line_index(m.line());  // unknown lines are reported by the station pass
+    mp.params.address = static_cast<std::uint8_t>(m.address() & 0x7F);
+    mp.params.auto_clear = m.auto_clear();
+    mp.outputs = m.outputs();
+    switch (m.mode()) {
+      case scenario::DpMaster::CLEAR: mp.params.initial_mode = dp::MasterMode::Clear; break;
+      case scenario::DpMaster::STOP: mp.params.initial_mode = dp::MasterMode::Stop; break;
+      default: mp.params.initial_mode = dp::MasterMode::Operate; break;
+    }
+    if (!m.data_control_time().empty()) {
+      if (auto t = ten_ms("dp_master", i, "data_control_time", m.data_control_time())) {
+        const auto units = *t / kTenMs;
+        if (units > 65535)
+          error("dp_master", i, "data_control_time", -1, "data_control_time is over 655.35 s");
+        else
+          mp.params.data_control_time = static_cast<std::uint16_t>(units);
+      }
+    }
+    if (mp.line >= 0 && m.has_address() &&
+        m.address() >= m_plan.lines[static_cast<std::size_t>(mp.line)].params.hsa)
+      error("dp_master", i, "address", -1,
+            "dp_master address " + std::to_string(m.address()) + " is not below HSA " +
+                std::to_string(m_plan.lines[static_cast<std::size_t>(mp.line)].params.hsa));
+    m_wd.push_back({dp::kPrmLockReq | dp::kPrmWdOn, 10, 10});
+    if (!m.watchdog().empty()) {
+      if (m.watchdog() == "off") {
+        m_wd.back().status = dp::kPrmLockReq;
+      } else if (auto t = ten_ms("dp_master", i, "watchdog", m.watchdog())) {
+        if (auto f = wd_factors(*t / kTenMs)) {
+          m_wd.back().f1 = f->first;
+          m_wd.back().f2 = f->second;
+        } else {
+          error("dp_master", i, "watchdog", -1,
+                "watchdog \"" + m.watchdog() +
+                    "\" is not a product of two factors 1..255 of 10 ms (max 650.25 s)");
+        }
+      }
+    }
+    m_plan.dp_masters.push_back(std::move(mp));
+  }
+
+  void plan_slave(int i, const std::filesystem::path& base) {
+    const auto& s = m_plan.proto.dp_slave(i);
+    DpSlavePlan sp;
+    sp.source = i;
+    sp.line = line_index(s.line());
+    sp.address = static_cast<std::uint8_t>(s.address() & 0x7F);
+    sp.io = s.inputs();
+    sp.tsdr = s.tsdr_bits();
+    bool ok = true;
+    // The master.
+    int mi = -1;
+    if (!s.has_master()) {
+      error("dp_slave", i, nullptr, -1, "dp_slave needs a master: the address of its dp_master");
+      ok = false;
+    } else {
+      for (std::size_t k = 0; k < m_plan.dp_masters.size(); ++k) {
+        const auto& mm = m_plan.proto.dp_master(m_plan.dp_masters[k].source);
+        if (mm.has_address() && mm.address() == s.master() && mm.line() == s.line())
+          mi = static_cast<int>(k);
+      }
+      if (mi < 0) {
+        error("dp_slave", i, "master", -1,
+              "no dp_master " + std::to_string(s.master()) + " on line \"" + s.line() + "\"");
+        ok = false;
+      }
+      sp.master = static_cast<std::uint8_t>(s.master() & 0x7F);
+    }
+    // The GSD.
+    if (s.gsd().empty()) {
+      error("dp_slave", i, nullptr, -1, "dp_slave needs a gsd file");
+      return;
+    }
+    std::filesystem::path p(s.gsd());
+    if (p.is_relative()) p = base / p;
+    sp.gsd_path = p.string();
+    auto loaded = devices::load_gsd(p);
+    if (!loaded.ok()) {
+      std::string why = loaded.errors.empty() ? "cannot be read" : loaded.errors.front().to_string();
+      error("dp_slave", i, "gsd", -1, "GSD file \"" + s.gsd() + "\": " + why);
+      return;
+    }
+    const devices::GsdFile& g = *loaded.file;
+    sp.model = g.info().model_name;
+    if (g.is_master()) {
+      error("dp_slave", i, "gsd", -1, "GSD file \"" + s.gsd() + "\" describes a DP master");
+      return;
+    }
+    if (sp.line >= 0) {
+      const bus::Baud baud = m_plan.lines[static_cast<std::size_t>(sp.line)].baud;
+      if (auto mt = g.max_tsdr(baud)) {
+        sp.gsd_max_tsdr = *mt;
+      } else {
+        error("dp_slave", i, "gsd", -1,
+              "\"" + sp.model + "\" (" + s.gsd() + ") does not support " +
+                  std::string(bus::baud_name(baud)) + "bit/s of line \"" + s.line() + "\"");
+        ok = false;
+      }
+      const auto& lp = m_plan.lines[static_cast<std::size_t>(sp.line)].params;
+      if (s.has_tsdr_bits() && sp.gsd_max_tsdr != 0 &&
+          (s.tsdr_bits() > sp.gsd_max_tsdr || s.tsdr_bits() < lp.min_tsdr)) {
+        error("dp_slave", i, "tsdr_bits", -1,
+              "tsdr_bits " + std::to_string(s.tsdr_bits()) + " is outside [min TSDR " +
+                  std::to_string(lp.min_tsdr) + ", MaxTsdr " + std::to_string(sp.gsd_max_tsdr) +
+                  " of " + s.gsd() + "]");
+        ok = false;
+      }
+    }
+    // Modules.
+    std::vector<std::size_t> mods;
+    if (s.modules_size() == 0 && !g.slave_features().modular_station && g.modules().size() == 1) {
+      mods.push_back(0);
+    } else if (s.modules_size() == 0) {
+      error("dp_slave", i, nullptr, -1,
+            "dp_slave with the modular GSD \"" + s.gsd() + "\" needs a module list");
+      ok = false;
+    }
+    for (int k = 0; k < s.modules_size(); ++k) {
+      if (auto idx = g.find_module(s.modules(k))) {
+        mods.push_back(*idx);
+      } else {
+        std::string known;
+        for (const auto& gm : g.modules()) known += (known.empty() ? "\"" : ", \"") + gm.name + "\"";
+        error("dp_slave", i, "modules", k,
+              "unknown module \"" + s.modules(k) + "\" in " + s.gsd() + " (it has " + known + ")");
+        ok = false;
+      }
+    }
+    if (!ok) return;
+    auto check = g.check_modules(mods);
+    if (!check.ok()) {
+      error("dp_slave", i, "modules", -1, "module list refused by " + s.gsd() + ": " + check.errors.front());
+      return;
+    }
+    auto prm = g.user_prm_data(mods);
+    if (!prm.ok()) {
+      error("dp_slave", i, "modules", -1, "User_Prm_Data of " + s.gsd() + ": " + prm.errors.front());
+      return;
+    }
+    sp.inputs = check.value->first;
+    sp.outputs = check.value->second;
+
+    dp::SlaveConfig& c = sp.config;
+    c.ident = g.ident_number();
+    c.features = features_of(g);
+    c.min_user_prm_len = prm.value->size();
+    c.max_user_prm_len = g.max_user_prm_data_len();
+    c.min_slave_interval = std::max<std::uint16_t>(1, g.slave_features().min_slave_intervall);
+    c.max_diag_len = std::max<std::size_t>(6, g.slave_features().max_diag_data_len);
+    for (std::size_t idx : mods) {
+      const auto& gm = g.modules()[idx];
+      c.modules.push_back({gm.config, gm.name});
+      sp.module_names.push_back(gm.name);
+    }
+    dp::SlaveParams& sm = sp.params;
+    sm.address = sp.address;
+    sm.name = sp.model;
+    sm.ident = c.ident;
+    if (mi >= 0) {
+      const auto& wd = m_wd[static_cast<std::size_t>(mi)];
+      sm.station_status = wd.status;
+      sm.wd_fact_1 = wd.f1;
+      sm.wd_fact_2 = wd.f2;
+    }
+    sm.user_prm = *prm.value;
+    sm.modules = c.modules;
+    sm.min_slave_interval = c.min_slave_interval;
+    sm.fail_safe = c.features.fail_safe;
+    if (g.dpv1().c1_response_timeout != 0) sm.c1_response_timeout = g.dpv1().c1_response_timeout;
+    if (std::string why = dp::build_layout(c, m_layout); !why.empty()) {
+      error("dp_slave", i, "modules", -1, "configuration of " + s.gsd() + ": " + why);
+      return;
+    }
+    if (mi >= 0)
+      m_plan.dp_masters[static_cast<std::size_t>(mi)].slaves.push_back(
+          static_cast<int>(m_plan.dp_slaves.size()));
+    m_plan.dp_slaves.push_back(std::move(sp));
+  }
+
+  void derive_line_params() {
+    for (std::size_t li = 0; li < m_plan.lines.size(); ++li) {
+      PlanLine& line = m_plan.lines[li];
+      const scenario::BusParameters& given = m_plan.proto.line(static_cast<int>(li)).bus_params();
+      std::vector<std::pair<std::size_t, std::size_t>> io;
+      std::uint32_t max_tsdr = line.params.max_tsdr;
+      for (const auto& s : m_plan.dp_slaves) {
+        if (s.line != static_cast<int>(li)) continue;
+        io.emplace_back(s.outputs, s.inputs);
+        max_tsdr = std::max<std::uint32_t>(max_tsdr, s.gsd_max_tsdr);
+      }
+      if (io.empty()) continue;
+      if (!given.has_max_tsdr()) line.params.max_tsdr = max_tsdr;
+      if (!given.has_tsl())
+        line.params.tsl = std::max(line.params.tsl, line.params.max_tsdr + fdl::BusParams::kTslMargin);
+      if (!given.has_ttr()) line.params.ttr = dp_ttr(line.params, io);
+      if (std::string why = line.params.validate(); !why.empty()) {
+        auto [l, c] = m_locate("line", static_cast<int>(li), nullptr, -1);
+        m_errors.push_back({m_plan.file, l, c,
+                            "bus parameters derived for the DP slaves of line \"" + line.name +
+                                "\": " + why});
+      }
+      for (const auto& s : m_plan.dp_slaves) {
+        if (s.line != static_cast<int>(li) || s.gsd_max_tsdr == 0) continue;
+        if (s.gsd_max_tsdr > line.params.max_tsdr) {
+          auto [l, c] = m_locate("dp_slave", s.source, nullptr, -1);
+          m_errors.push_back({m_plan.file, l, c,
+                              "MaxTsdr " + std::to_string(s.gsd_max_tsdr) + " of " +
+                                  m_plan.proto.dp_slave(s.source).gsd() +
+                                  " is above the max TSDR " + std::to_string(line.params.max_tsdr) +
+                                  " given for line \"" + line.name + "\""});
+        }
+      }
+    }
+    // Each slave's Set_Prm carries the line's min TSDR.
+    for (auto& s : m_plan.dp_slaves)
+      if (s.line >= 0)
+        s.params.min_tsdr = static_cast<std::uint8_t>(
+            m_plan.lines[static_cast<std::size_t>(s.line)].params.min_tsdr);
+  }
+
+  struct Wd {
+    std::uint8_t status;
+    std::uint8_t f1;
+    std::uint8_t f2;
+  };
+  ScenarioPlan& m_plan;
+  const DpLocator& m_locate;
+  std::vector<Diagnostic>& m_errors;
+  std::vector<Wd> m_wd;  // per dp_master
+  dp::SlaveLayout m_layout;
+};
+
+}  // namespace
+
+std::uint32_t dp_ttr(const fdl::BusParams& p,
+                     const std::vector<std::pair<std::size_t, std::size_t>>& io) {
+  std::uint64_t pass = 0;
+  for (const auto& [out, in] : io)
+    pass += 11 * request_octets(out) + p.max_tsdr + 11 * response_octets(in) + p.tid1();
+  pass += 11 * 3 + p.tid1();                   // token pass
+  pass += 11 * 13 + p.tid2();                  // Global_Control: SD2 with SAPs 58/62, 2 octets
+  pass += 11 * 6 + p.tsl + p.tid1();           // one unanswered GAP poll
+  // The token hold time is TTR - TRR: in steady state the last rotation (one pass) is deducted
+  // before this visit's pass may start, and the station keeps TSL + 100 back for its GAP poll.
+  const std::uint64_t ttr = 2 * pass + p.tsl + 100;
+  return static_cast<std::uint32_t>(
+      std::clamp<std::uint64_t>(ttr, fdl::BusParams::kTtrMin, fdl::BusParams::kTtrMax));
+}
+
+void plan_dp(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors) {
+  DpPlanner(plan, locate, errors).run();
+}
+
+}  // namespace pbvbus::tools

@@ -1,0 +1,160 @@
+// DP master systems at run time (tools/include/pbvbus/tools/dp_system.hpp).
+#include "pbvbus/tools/dp_system.hpp"
+
+#include <algorithm>
+
+#include "pbvbus/dp/sap.hpp"
+
+namespace pbvbus::tools {
+
+namespace {
+
+std::vector<dp::SlaveParams> slave_params(const DpMasterPlan& plan,
+                                          const std::vector<DpSlavePlan>& slaves) {
+  std::vector<dp::SlaveParams> out;
+  for (int i : plan.slaves) out.push_back(slaves.at(static_cast<std::size_t>(i)).params);
+  return out;
+}
+
+}  // namespace
+
+DpMasterNode::DpMasterNode(const DpMasterPlan& plan, const std::vector<DpSlavePlan>& slaves,
+                           const fdl::BusParams& params)
+    : m_master(plan.params, slave_params(plan, slaves)), m_program(plan.outputs) {
+  m_station = std::make_unique<fdl::ActiveStation>(plan.params.address, params, *this);
+}
+
+void DpMasterNode::on_power_on(bus::Ticks now) {
+  m_tokens = 0;
+  m_master.on_power_on(now);
+}
+
+bool DpMasterNode::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) {
+  if (!m_master.next_request(prio, now, out)) {
+    return false;
+  }
+  if (out.da == fdl::kBroadcast && out.dsap == dp::kSapGlobalControl) ++m_global_controls;
+  return true;
+}
+
+void DpMasterNode::on_token(bus::Ticks now, bus::Ticks trr) {
+  ++m_tokens;
+  // The "PLC program": one output update per token receipt, i.e. per bus cycle.
+  const auto value =
+      static_cast<std::uint8_t>(m_program == scenario::DpMaster::COUNT ? (m_tokens & 0xFF) : 0);
+  for (std::uint8_t a : m_master.addresses()) {
+    dp::MasterImage& img = m_master.image(a);
+    for (std::size_t mod = 0; mod < img.modules(); ++mod) {
+      const std::size_t n = img.module(mod).out_len;
+      if (n == 0) continue;
+      m_buf.assign(n, value);
+      img.write_outputs(mod, m_buf);
+    }
+  }
+  m_master.on_token(now, trr);
+}
+
+DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params)
+    : m_engine(plan.config), m_io(plan.io) {
+  m_station = std::make_unique<fdl::PassiveStation>(plan.address, params, *this, plan.tsdr);
+  m_buf.reserve(dp::kMaxIoLen);
+  update_inputs();
+}
+
+void DpSlaveNode::update_inputs() {
+  dp::SlaveApplication& app = m_engine.application();
+  if (m_io == scenario::DpSlave::ECHO) {
+    // The whole output telegram, octet for octet, into the whole input telegram.
+    m_echo.assign(dp::kMaxIoLen, 0);
+    for (std::size_t mod = 0; mod < app.modules(); ++mod) {
+      const dp::ModuleLayout& ml = app.module(mod);
+      if (ml.out_len == 0) continue;
+      app.read_outputs(mod, std::span(m_echo).subspan(ml.out_offset, ml.out_len));
+    }
+  }
+  for (std::size_t mod = 0; mod < app.modules(); ++mod) {
+    const dp::ModuleLayout& ml = app.module(mod);
+    if (ml.in_len == 0) continue;
+    m_buf.assign(ml.in_len, 0);
+    if (m_io == scenario::DpSlave::COUNTER)
+      std::fill(m_buf.begin(), m_buf.end(), static_cast<std::uint8_t>(m_dx & 0xFF));
+    else if (m_io == scenario::DpSlave::ECHO)
+      std::copy_n(m_echo.begin() + static_cast<std::ptrdiff_t>(ml.in_offset), ml.in_len, m_buf.begin());
+    app.write_inputs(mod, m_buf);
+  }
+}
+
+void DpSlaveNode::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
+  // Data_Exchange goes to the default SAP (no SAPs in the frame).
+  const bool dx = !ind.dsap && !ind.broadcast();
+  if (dx) {
+    ++m_dx;
+    if (m_io != scenario::DpSlave::ZERO) update_inputs();
+  }
+  m_engine.on_request(ind, reply);
+}
+
+std::vector<std::string> diag_bit_names(std::span<const std::uint8_t> d) {
+  static constexpr const char* kNames[3][8] = {
+      {"Station_Non_Existent", "Station_Not_Ready", "Cfg_Fault", "Ext_Diag", "Not_Supported",
+       "Invalid_Slave_Response", "Prm_Fault", "Master_Lock"},
+      {"Prm_Req", "Stat_Diag", "always_1", "WD_On", "Freeze_Mode", "Sync_Mode", "reserved",
+       "Deactivated"},
+      {"", "", "", "", "", "", "", "Ext_Diag_Overflow"}};
+  std::vector<std::string> out;
+  for (std::size_t o = 0; o < 3 && o < d.size(); ++o)
+    for (int b = 0; b < 8; ++b)
+      if ((d[o] >> b) & 1) out.emplace_back(kNames[o][b][0] ? kNames[o][b] : "reserved");
+  return out;
+}
+
+DpMasterReport dp_master_report(const DpMasterNode& node,
+                                const std::vector<const DpSlaveNode*>& slaves,
+                                const std::vector<const DpSlavePlan*>& plans,
+                                const std::string& line, bus::Baud baud) {
+  const dp::Master& m = node.master();
+  DpMasterReport r;
+  r.address = m.address();
+  r.line = line;
+  r.baud = baud;
+  r.mode = std::string(dp::to_string(m.mode()));
+  r.global_controls = node.global_controls();
+  r.data_control_time = m.params().data_control_time;
+  for (std::size_t i = 0; i < slaves.size(); ++i) {
+    const DpSlavePlan& p = *plans[i];
+    const dp::SlaveEngine& eng = slaves[i]->engine();
+    DpSlaveReport s;
+    s.address = p.address;
+    s.master = p.master;
+    s.model = p.model;
+    s.modules = p.module_names;
+    s.state = std::string(dp::to_string(m.slave_state(p.address)));
+    s.slave_state = std::string(dp::to_string(eng.state()));
+    const auto d = m.slave_diag(p.address);
+    s.diag.assign(d.begin(), d.end());
+    s.diag_bits = diag_bit_names(s.diag);
+    const dp::MasterImage& img = m.image(p.address);
+    s.input_len = img.input_length();
+    s.output_len = img.output_length();
+    s.inputs.assign(s.input_len, 0);
+    if (s.input_len > 0) img.read_all_inputs(s.inputs);
+    // What arrived at the device (after Clear_Data, the safe state): module by module.
+    s.outputs.assign(s.output_len, 0);
+    dp::SlaveEngine& e = const_cast<dp::SlaveEngine&>(eng);  // the application's reads are const
+    const dp::SlaveApplication& app = e.application();
+    std::vector<std::uint8_t> buf;
+    for (std::size_t mod = 0; mod < app.modules(); ++mod) {
+      const dp::ModuleLayout& ml = app.module(mod);
+      if (ml.out_len == 0) continue;
+      buf.assign(ml.out_len, 0);
+      if (app.read_outputs(mod, buf) && ml.out_offset + ml.out_len <= s.outputs.size())
+        std::copy(buf.begin(), buf.end(), s.outputs.begin() + static_cast<std::ptrdiff_t>(ml.out_offset));
+    }
+    s.stats = m.slave_stats(p.address);
+    s.cycle_median = m.cycle_median(p.address);
+    r.slaves.push_back(std::move(s));
+  }
+  return r;
+}
+
+}  // namespace pbvbus::tools

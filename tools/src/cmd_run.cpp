@@ -31,6 +31,7 @@
 
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
+#include "pbvbus/tools/class2_cli.hpp"
 #include "pbvbus/tools/commands.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
@@ -86,6 +87,7 @@ struct RunArgs {
   bool json = false;
   bool quiet = false;
   bool help = false;
+  Class2Options dp2;
 };
 
 /// Parses the arguments; on error returns the message (without the "pbvbus run: " prefix).
@@ -97,6 +99,10 @@ std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
       (void)opt;
       return args[++i];
     };
+    std::string c2_error;
+    const Class2ArgResult c2 = parse_class2_arg(args, i, out.dp2, c2_error);
+    if (c2 == Class2ArgResult::Error) return c2_error;
+    if (c2 == Class2ArgResult::Taken) continue;
     if (a == "-h" || a == "--help") {
       out.help = true;
     } else if (a == "--fast") {
@@ -216,7 +222,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     return 2;
   }
   if (ra.help) {
-    out << kUsage;
+    out << kUsage << kClass2Usage;
     return 0;
   }
 
@@ -268,6 +274,15 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   } catch (const std::exception& e) {
     err << "pbvbus run: " << e.what() << "\n";
     return 1;
+  }
+  std::unique_ptr<Class2Cli> dp2;
+  if (!ra.dp2.empty()) {
+    std::string why;
+    dp2 = Class2Cli::attach(*sim, ra.dp2, why);
+    if (!dp2) {
+      err << "pbvbus run: " << why << "\n";
+      return 2;
+    }
   }
   // A paced run without a duration goes on until interrupted.
   // (Ten years: far enough, and safe from overflow when the runner scales it to wall time.)
@@ -333,9 +348,14 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   }
   const Report report = sim->report(wall);
   if (ra.json) {
-    write_json(report, out);
+    std::ostringstream js;
+    write_json(report, js);
+    std::string j = js.str();
+    if (dp2) dp2->add_to_json(j);
+    out << j;
   } else if (!ra.quiet) {
     write_text(report, report_os);
+    if (dp2) dp2->write_text(report_os);
   }
   return rc;
 }

@@ -351,7 +351,13 @@ void Class2Cli::record(std::size_t k, const void* result, const char* prefix) {
   const auto& r = *static_cast<const dp::Class2Result*>(result);
   Class2Outcome& o = m_outcomes[k];
   o.done = m_impl->sched->now();
-  o.status = std::string(prefix) + std::string(dp::to_string(r.status));
+  o.status = std::string(prefix) + (r.ok() ? std::string("OK") : std::string(dp::to_string(r.status)));
+  const bool reads_data = o.op == Class2Op::GetCfg || o.op == Class2Op::SlaveDiag ||
+                          o.op == Class2Op::RdInp || o.op == Class2Op::RdOutp || o.op == Class2Op::Read;
+  if (r.ok() && reads_data && r.data.empty()) {
+    o.status = std::string(prefix) + (r.short_ack ? "no data (SC)" : "no data");
+    return;
+  }
   if (r.status == dp::AcyclicStatus::NotAvailable || r.status == dp::AcyclicStatus::InvalidResponse)
     o.status += " (" + std::string(fdl::to_string(r.fdl_status)) + ")";
   if (r.status == dp::AcyclicStatus::Negative) {

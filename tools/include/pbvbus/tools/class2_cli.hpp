@@ -25,6 +25,11 @@
 //    a slave is not left with a connection (its supervision would close it after 2 ×
 //    Send_Timeout anyway). A failed Initiate is reported as the read/write's result with
 //    "initiate: " before the status. The Abort's own result is not reported.
+//  - Status "OK" for a positive result, otherwise dp::to_string of the AcyclicStatus ("no
+//    response", "not available" + the FDL status, ...). A service that must return data
+//    (Get_Cfg, Slave_Diag, Rd_Inp/Outp, Read) but got an SC or an empty reply is reported as
+//    "no data (SC)": a DP slave always answers these with data, so this is a plain FDL station
+//    (which acknowledges any SRD) rather than a success.
 //  - A request that has not finished when the run ends is reported with status "pending".
 //  - The text report is one line per request after the run report; the JSON report gets an
 //    array "class2" as the last member of its top-level object (inserted before the final

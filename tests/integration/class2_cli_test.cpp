@@ -176,5 +176,25 @@ passive_station { address: 50 line: "dp" response_length: 0 }
   EXPECT_EQ(out[6].status, "no response");  // it is at 7 now
 }
 
+// examples/dp-basic.textproto (DP master system from the scenario): Get_Cfg of the compact
+// PBVB0A01 at 3 gives its module's identifiers; two MSAC_C2 requests to one slave at the same
+// time run one after the other (one connection per slave), neither is rejected.
+TEST(Class2Cli, DpBasicScenario) {
+  const Result r = run({PBVBUS_SOURCE_DIR "/examples/dp-basic.textproto", "--json", "--dp2", "1s:get_cfg:3",
+                        "--dp2", "1500ms:read:5:slot=1,index=2,len=8", "--dp2",
+                        "1500ms:write:5:slot=1,index=2,data=0102"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const std::size_t c2 = r.out.find(",\"class2\":[");
+  ASSERT_NE(c2, std::string::npos) << r.out;
+  const std::string j = r.out.substr(c2);
+  EXPECT_NE(j.find("\"service\":\"get_cfg\",\"station\":3,\"master\":0,\"status\":\"OK\",\"bytes\":\"1121\","
+                   "\"text\":\"2 B in, 2 B out\"}"),
+            std::string::npos)
+      << j;
+  EXPECT_EQ(j.find("pending"), std::string::npos) << j;
+  EXPECT_EQ(j.find("rejected"), std::string::npos) << j;
+  EXPECT_EQ(j.find("\"done_ns\":null"), std::string::npos) << j;
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

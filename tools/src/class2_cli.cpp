@@ -108,6 +108,9 @@ std::string json_escape(std::string_view s) {
   return o;
 }
 
+/// How often a read/write waiting for another one's MSAC_C2 connection to the same slave looks again.
+constexpr bus::Ticks kC2RetryDelay = 10 * bus::kTicksPerMs;
+
 struct OpName {
   Class2Op op;
   std::string_view name;
@@ -279,6 +282,7 @@ struct Class2Cli::Impl {
   dp::Class2Master master;
   fdl::ActiveStation station;
   bus::Scheduler* sched = nullptr;
+  std::set<std::uint8_t> c2_busy;  ///< slaves with a read/write session (initiate .. abort)
 };
 
 Class2Cli::Class2Cli(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}
@@ -400,25 +404,38 @@ void Class2Cli::submit(std::size_t k) {
       break;
     case Class2Op::Read:
     case Class2Op::Write:
+      if (m_impl->c2_busy.count(r.station) || m.c2_open(r.station)) {
+        // An earlier read/write to this slave still holds the connection: try again later.
+        m_impl->sched->schedule(m_impl->sched->now() + kC2RetryDelay, [this, k] { submit(k); });
+        return;
+      }
+      m_impl->c2_busy.insert(r.station);
       id = m.c2_initiate(r.station, [this, k](const dp::Class2Result& ini) {
         if (!ini.ok()) {
           record(k, &ini, "initiate: ");
+          m_impl->c2_busy.erase(m_requests[k].station);
           return;
         }
         const Class2Request& rq = m_requests[k];
         dp::Class2Master& mm = m_impl->master;
         auto then_abort = [this, k](const dp::Class2Result& res) {
           record(k, &res, "");
-          if (m_impl->master.c2_open(m_requests[k].station))
-            m_impl->master.c2_abort(m_requests[k].station, [](const dp::Class2Result&) {});
+          const std::uint8_t st = m_requests[k].station;
+          if (!m_impl->master.c2_open(st) ||
+              m_impl->master.c2_abort(st, [this, st](const dp::Class2Result&) { m_impl->c2_busy.erase(st); }) == 0)
+            m_impl->c2_busy.erase(st);
         };
         const std::uint32_t rid =
             rq.op == Class2Op::Read ? mm.c2_read(rq.station, rq.slot, rq.index, rq.length, then_abort)
                                     : mm.c2_write(rq.station, rq.slot, rq.index, rq.data, then_abort);
-        if (rid == 0) m_outcomes[k].status = "rejected by the class-2 master";
+        if (rid == 0) {
+          m_outcomes[k].status = "rejected by the class-2 master";
+          m_impl->c2_busy.erase(rq.station);
+        }
       });
       break;
   }
+  if (id == 0 && (r.op == Class2Op::Read || r.op == Class2Op::Write)) m_impl->c2_busy.erase(r.station);
   if (id == 0) m_outcomes[k].status = "rejected by the class-2 master (own address or open connection)";
 }
 

@@ -21,6 +21,8 @@
 //  - Requests run one at a time in the order of their times (Class2Master's queue); a request
 //    whose time comes while an earlier one is still running waits behind it. The report gives
 //    the time of the request as asked and the virtual time of its result.
+//  - One MSAC_C2 connection per slave (Class2Master): a read/write whose slave's connection is
+//    still in use by an earlier read/write looks again every 10 ms of virtual time.
 //  - read/write open an MSAC_C2 connection for the one request and abort it afterwards, so that
 //    a slave is not left with a connection (its supervision would close it after 2 ×
 //    Send_Timeout anyway). A failed Initiate is reported as the read/write's result with

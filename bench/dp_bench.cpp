@@ -1,6 +1,7 @@
 // DP master system speed and footprint (issue 3 "Must show"): one DP master class 1 (address 0)
 // and 125 DP slaves (addresses 1..125), each with 32 octets of inputs and 32 of outputs
-// (one configuration identifier 0xFF: 16 words in and out, consistent), at 12 Mbit/s, built
+// (one configuration identifier 0xFF: 16 words in and out, consistent; a minimal GSD with that
+// one module is parsed from text below; inputs = a DP cycle counter), at 12 Mbit/s, built
 // from the same tools::DpMasterNode / DpSlaveNode the scenario runner uses. Bus parameters:
 // the 12 Mbit/s defaults with the TTR the scenario loader derives (tools::dp_ttr).
 //
@@ -23,11 +24,13 @@
 #include <malloc.h>
 
 #include <ctime>
+#include <stdexcept>
 #include <memory>
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/devices/gsd.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
 #include "pbvbus/tools/dp_system.hpp"
 
@@ -40,6 +43,12 @@ namespace {
 
 using namespace pbvbus;
 
+constexpr const char* kGsd =
+    "#Profibus_DP\nGSD_Revision = 5\nVendor_Name = \"pbvbus\"\nModel_Name = \"bench 32/32\"\n"
+    "Ident_Number = 0x0AFF\nProtocol_Ident = 0\nStation_Type = 0\n12M_supp = 1\n"
+    "MaxTsdr_12M = 800\nMin_Slave_Intervall = 1\nModular_Station = 0\n"
+    "Module = \"32 in/32 out\" 0xFF\nEndModule\n";
+
 struct DpSystem {
   bus::Scheduler sched;
   std::unique_ptr<bus::Line> line;
@@ -48,6 +57,9 @@ struct DpSystem {
   std::vector<std::unique_ptr<tools::DpSlaveNode>> slaves;
 
   explicit DpSystem(int n) {
+    auto parsed = devices::parse_gsd(kGsd, "bench.gsd");
+    if (!parsed.ok()) throw std::runtime_error(parsed.errors.front().to_string());
+    auto gsd = std::make_shared<const devices::GsdFile>(std::move(*parsed.file));
     fdl::BusParams bp = fdl::BusParams::defaults(bus::Baud::k12M);
     std::vector<std::pair<std::size_t, std::size_t>> io(static_cast<std::size_t>(n), {32, 32});
     bp.ttr = tools::dp_ttr(bp, io);
@@ -58,7 +70,9 @@ struct DpSystem {
       tools::DpSlavePlan sp;
       sp.address = static_cast<std::uint8_t>(1 + i);
       sp.master = 0;
-      sp.config.ident = 0x0A02;
+      sp.gsd = gsd;
+      sp.gsd_modules = {0};
+      sp.config.ident = 0x0AFF;
       sp.config.modules = {{{0xFF}, "32 in/32 out"}};
       sp.config.min_slave_interval = 1;
       sp.params.address = sp.address;

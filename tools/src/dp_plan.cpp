@@ -241,6 +241,7 @@ class DpPlanner {
       error("dp_slave", i, "modules", -1, "User_Prm_Data of " + s.gsd() + ": " + prm.errors.front());
       return;
     }
+    sp.gsd_modules = mods;
     sp.inputs = check.value->first;
     sp.outputs = check.value->second;
 
@@ -275,6 +276,7 @@ class DpPlanner {
       error("dp_slave", i, "modules", -1, "configuration of " + s.gsd() + ": " + why);
       return;
     }
+    sp.gsd = std::make_shared<const devices::GsdFile>(g);
     if (mi >= 0)
       m_plan.dp_masters[static_cast<std::size_t>(mi)].slaves.push_back(
           static_cast<int>(m_plan.dp_slaves.size()));

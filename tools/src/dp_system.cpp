@@ -2,6 +2,7 @@
 #include "pbvbus/tools/dp_system.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "pbvbus/dp/sap.hpp"
 
@@ -54,45 +55,42 @@ void DpMasterNode::on_token(bus::Ticks now, bus::Ticks trr) {
   m_master.on_token(now, trr);
 }
 
-DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params)
-    : m_engine(plan.config), m_io(plan.io) {
-  m_station = std::make_unique<fdl::PassiveStation>(plan.address, params, *this, plan.tsdr);
-  m_buf.reserve(dp::kMaxIoLen);
-  update_inputs();
-}
-
-void DpSlaveNode::update_inputs() {
-  dp::SlaveApplication& app = m_engine.application();
-  if (m_io == scenario::DpSlave::ECHO) {
-    // The whole output telegram, octet for octet, into the whole input telegram.
-    m_echo.assign(dp::kMaxIoLen, 0);
-    for (std::size_t mod = 0; mod < app.modules(); ++mod) {
-      const dp::ModuleLayout& ml = app.module(mod);
-      if (ml.out_len == 0) continue;
-      app.read_outputs(mod, std::span(m_echo).subspan(ml.out_offset, ml.out_len));
-    }
-  }
-  for (std::size_t mod = 0; mod < app.modules(); ++mod) {
-    const dp::ModuleLayout& ml = app.module(mod);
+DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params) {
+  devices::SlaveModelOptions o;
+  o.address = plan.address;
+  o.bus_params = params;
+  if (plan.tsdr != 0) o.tsdr = plan.tsdr;
+  std::vector<devices::ModuleChoice> mods;
+  for (std::size_t i : plan.gsd_modules) mods.push_back(devices::ModuleChoice::at(i));
+  auto b = devices::SlaveModel::build(*plan.gsd, mods, o);
+  if (!b.ok())
+    throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " +
+                             (b.errors.empty() ? std::string("cannot be built") : b.errors.front()));
+  m_model = std::move(b.model);
+  const dp::SlaveApplication& app = m_model->application();
+  std::optional<std::size_t> first_out;
+  for (std::size_t m = 0; m < app.modules(); ++m)
+    if (app.module(m).out_len > 0 && !first_out) first_out = m;
+  for (std::size_t m = 0; m < app.modules(); ++m) {
+    const dp::ModuleLayout& ml = app.module(m);
     if (ml.in_len == 0) continue;
-    m_buf.assign(ml.in_len, 0);
-    if (m_io == scenario::DpSlave::COUNTER)
-      std::fill(m_buf.begin(), m_buf.end(), static_cast<std::uint8_t>(m_dx & 0xFF));
-    else if (m_io == scenario::DpSlave::ECHO)
-      std::copy_n(m_echo.begin() + static_cast<std::ptrdiff_t>(ml.in_offset), ml.in_len, m_buf.begin());
-    app.write_inputs(mod, m_buf);
+    devices::IoBehaviour beh = devices::IoBehaviour::constant_value({});
+    if (plan.io == scenario::DpSlave::COUNTER) {
+      beh = devices::IoBehaviour::counter_per_cycle();
+    } else if (plan.io == scenario::DpSlave::ECHO && (ml.out_len > 0 || first_out)) {
+      beh = devices::IoBehaviour::echo(ml.out_len > 0 ? std::optional<std::size_t>(m) : first_out);
+    }
+    if (std::string why = m_model->set_behaviour(m, beh); !why.empty())
+      throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " + why);
   }
 }
 
-void DpSlaveNode::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
-  // Data_Exchange goes to the default SAP (no SAPs in the frame).
-  const bool dx = !ind.dsap && !ind.broadcast();
-  if (dx) {
-    ++m_dx;
-    if (m_io != scenario::DpSlave::ZERO) update_inputs();
-  }
-  m_engine.on_request(ind, reply);
+DpSlaveNode::~DpSlaveNode() = default;
+dp::SlaveEngine& DpSlaveNode::engine() { return m_model->engine(); }
+const dp::SlaveEngine& DpSlaveNode::engine() const {
+  return const_cast<devices::SlaveModel&>(*m_model).engine();
 }
+std::uint64_t DpSlaveNode::data_exchanges() const { return m_model->dp_cycles(); }
 
 std::vector<std::string> diag_bit_names(std::span<const std::uint8_t> d) {
   static constexpr const char* kNames[3][8] = {

@@ -30,6 +30,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,6 +39,10 @@
 #include "pbvbus/dp/slave_config.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
 #include "scenario.pb.h"
+
+namespace pbvbus::devices {
+class GsdFile;
+}
 
 namespace pbvbus::tools {
 
@@ -52,6 +57,8 @@ struct DpSlavePlan {
   std::string gsd_path;                 ///< resolved path
   std::string model;                    ///< GSD Model_Name
   std::vector<std::string> module_names;
+  std::shared_ptr<const devices::GsdFile> gsd;  ///< the parsed file (devices::SlaveModel)
+  std::vector<std::size_t> gsd_modules;          ///< indices into gsd->modules()
   dp::SlaveConfig config;               ///< the device
   dp::SlaveParams params;               ///< the master's database entry
   std::uint32_t tsdr = 0;               ///< own response delay; 0 = min TSDR

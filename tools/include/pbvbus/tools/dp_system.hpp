@@ -5,11 +5,12 @@
 // models on both sides so that data exchange is visible:
 //  - master side (DpMasterNode, "the test program"): at every token receipt it writes every
 //    output octet of every slave = the number of token receipts so far (mod 256), or zeros;
-//  - device side (DpSlaveNode): before each request reaches the engine, the inputs are set to
-//    the number of Data_Exchange requests received (mod 256) in every octet, or to the outputs
-//    (echo), or zeros.
-// Both hook in as decorators of the FDL user interfaces, so the DP stacks stay untouched and
-// the wire timing is exactly the stacks' (the hooks take no virtual time).
+//  - device side (DpSlaveNode): a devices::SlaveModel built from the GSD and module list, with
+//    one I/O behaviour per module that has inputs: COUNTER = a big-endian counter of the DP
+//    cycles over the module's input octets; ECHO = the module's own outputs, or, for an
+//    input-only module, those of the first module with outputs; ZERO = constant zeros.
+// The master-side hook is a decorator of fdl::InitiatorUser, so the DP stack stays untouched
+// and the wire timing is exactly the stacks' (the hooks take no virtual time).
 //
 // Report (DpSlaveReport, DpMasterReport): the master's view of each slave (state, stored
 // diagnosis with decoded bits, in/out octets and their current values, DP cycle time
@@ -26,6 +27,7 @@
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 #include "pbvbus/fdl/active_station.hpp"
+#include "pbvbus/devices/slave_model.hpp"
 #include "pbvbus/fdl/passive_station.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
 
@@ -59,30 +61,21 @@ class DpMasterNode final : public fdl::InitiatorUser {
   std::vector<std::uint8_t> m_buf;
 };
 
-/// dp::SlaveEngine with its device model.
-class DpSlaveNode final : public fdl::ResponderUser {
+/// A DP slave: devices::SlaveModel (PassiveStation + SlaveEngine + I/O behaviours).
+class DpSlaveNode {
  public:
+  /// Throws std::runtime_error if the model cannot be built (the loader checks the same).
   DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params);
-  fdl::PassiveStation& station() { return *m_station; }
-  const fdl::PassiveStation& station() const { return *m_station; }
-  dp::SlaveEngine& engine() { return m_engine; }
-  const dp::SlaveEngine& engine() const { return m_engine; }
-  std::uint64_t data_exchanges() const { return m_dx; }
-
-  void on_power_on(bus::Ticks now) override { m_engine.on_power_on(now); }
-  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override;
-  bus::Ticks next_deadline() const override { return m_engine.next_deadline(); }
-  void on_time(bus::Ticks now) override { m_engine.on_time(now); }
+  ~DpSlaveNode();
+  /// The device to attach to the line.
+  bus::Device& station() { return *m_model; }
+  devices::SlaveModel& model() { return *m_model; }
+  dp::SlaveEngine& engine();
+  const dp::SlaveEngine& engine() const;
+  std::uint64_t data_exchanges() const;
 
  private:
-  void update_inputs();
-
-  dp::SlaveEngine m_engine;
-  scenario::DpSlave::Inputs m_io;
-  std::unique_ptr<fdl::PassiveStation> m_station;
-  std::uint64_t m_dx = 0;
-  std::vector<std::uint8_t> m_buf;
-  std::vector<std::uint8_t> m_echo;
+  std::unique_ptr<devices::SlaveModel> m_model;
 };
 
 struct DpSlaveReport {

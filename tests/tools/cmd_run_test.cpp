@@ -124,15 +124,31 @@ TEST(CmdRun, DefaultScenarioRunsAndReports) {
   EXPECT_TRUE(r.err.empty()) << r.err;
   EXPECT_EQ(r.out.rfind("scenario default (<built-in default>), seed 1\nsimulated 2.000 s in ", 0), 0u)
       << r.out;
-  // Two masters in one ring, four slaves; station 12's power loss and return are reported.
+  // A DP master and an FDL master in one ring; three DP slaves built from the shipped GSDs and
+  // one passive FDL station; slave 4's power loss and return are reported by the line and seen
+  // by DP master 1 as one station failure and one return with a second start-up.
   EXPECT_NE(r.out.find("  live list:\n    1\tmaster in ring\n    2\tmaster in ring\n"
-                       "    10\tslave\n    11\tslave\n    12\tslave\n    13\tslave\n"),
+                       "    3\tslave\n    4\tslave\n    5\tslave\n    20\tslave\n"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("  fault at 1.000 s: A: power off: 'slave 12'\n"
-                       "  fault at 1.500 s: A: power on: 'slave 12'\n"),
+  EXPECT_NE(r.out.find("  fault at 1.000 s: PROFIBUS_DP_1: power off: 'dp slave 4'\n"
+                       "  fault at 1.500 s: PROFIBUS_DP_1: power on: 'dp slave 4'\n"),
             std::string::npos)
       << r.out;
+  const auto s4 = r.out.find("  dp slave 4 ");
+  ASSERT_NE(s4, std::string::npos) << r.out;
+  const auto s4_end = r.out.find("  dp slave 5 ", s4);
+  const std::string slave4 = r.out.substr(s4, s4_end - s4);
+  EXPECT_NE(slave4.find(": data exchange"), std::string::npos) << slave4;
+  EXPECT_NE(slave4.find("start-ups 2, diagnosis reads 4, failures 1, returns 1"), std::string::npos)
+      << slave4;
+  // The other two slaves never left data exchange.
+  for (const char* other : {"  dp slave 3 ", "  dp slave 5 "}) {
+    const auto p = r.out.find(other);
+    ASSERT_NE(p, std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("start-ups 1, diagnosis reads 2, failures 0, returns 0", p), std::string::npos)
+        << r.out.substr(p, 600);
+  }
 }
 
 TEST(CmdRun, QuietPrintsNothing) {

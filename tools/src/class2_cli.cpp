@@ -1,6 +1,7 @@
 // `pbvbus run --dp2 SPEC`: class-2 master services against a running scenario
 // (class2_cli.hpp documents the command line and the decisions).
 
+#include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/class2_cli.hpp"
 
 #include <cstdio>
@@ -89,23 +90,6 @@ std::string format_time(bus::Ticks t) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%llu.%03llu s", ms / 1000, ms % 1000);
   return buf;
-}
-
-std::string json_escape(std::string_view s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-      o += buf;
-    } else {
-      o += c;
-    }
-  }
-  return o;
 }
 
 /// How often a read/write waiting for another one's MSAC_C2 connection to the same slave looks again.
@@ -461,8 +445,8 @@ std::string Class2Cli::json() const {
     j += "{\"time_ns\":" + std::to_string(bus::ticks_to_ns(o.at)) + ",\"done_ns\":" +
          (o.done ? std::to_string(bus::ticks_to_ns(o.done)) : std::string("null")) + ",\"service\":\"" +
          std::string(to_string(o.op)) + "\",\"station\":" + std::to_string(o.station) +
-         ",\"master\":" + std::to_string(address()) + ",\"status\":\"" + json_escape(o.status) +
-         "\",\"bytes\":\"" + hex_plain(o.bytes) + "\",\"text\":\"" + json_escape(o.text) + "\"}";
+         ",\"master\":" + std::to_string(address()) + ",\"status\":" + json_quote(o.status) +
+         ",\"bytes\":\"" + hex_plain(o.bytes) + "\",\"text\":" + json_quote(o.text) + "}";
   }
   return j + "]";
 }

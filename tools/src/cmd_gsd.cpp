@@ -11,6 +11,7 @@
 #include <string>
 
 #include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {
@@ -184,29 +185,6 @@ void print_text(const GsdFile& f, std::ostream& out) {
 
 // --- JSON output -------------------------------------------------------------------------------
 
-std::string js(std::string_view s) {
-  std::string o = "\"";
-  for (char c : s) {
-    const auto u = static_cast<unsigned char>(c);
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\r': o += "\\r"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (u < 0x20 || u == 0x7F) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04X", u);
-          o += buf;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
-
 const char* jb(bool b) { return b ? "true" : "false"; }
 
 std::string jbytes(const GsdBytes& b) {
@@ -221,23 +199,23 @@ std::string jbytes(const GsdBytes& b) {
 void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnings, std::ostream& out) {
   const auto& i = f.info();
   out << "{\n";
-  out << "  \"file\": " << js(f.file_name()) << ",\n";
+  out << "  \"file\": " << json_quote(f.file_name()) << ",\n";
   out << "  \"ident_number\": " << i.ident_number << ",\n";
-  out << "  \"ident_number_hex\": " << js(hex16(i.ident_number)) << ",\n";
+  out << "  \"ident_number_hex\": " << json_quote(hex16(i.ident_number)) << ",\n";
   out << "  \"station_type\": " << int(i.station_type) << ",\n";
   out << "  \"gsd_revision\": " << int(i.gsd_revision) << ",\n";
-  out << "  \"vendor_name\": " << js(i.vendor_name) << ",\n";
-  out << "  \"model_name\": " << js(i.model_name) << ",\n";
-  out << "  \"revision\": " << js(i.revision) << ",\n";
-  out << "  \"hardware_release\": " << js(i.hardware_release) << ",\n";
-  out << "  \"software_release\": " << js(i.software_release) << ",\n";
-  out << "  \"order_number\": " << js(i.order_number) << ",\n";
-  out << "  \"slave_family\": " << js(i.slave_family) << ",\n";
-  out << "  \"info_text\": " << js(i.info_text) << ",\n";
+  out << "  \"vendor_name\": " << json_quote(i.vendor_name) << ",\n";
+  out << "  \"model_name\": " << json_quote(i.model_name) << ",\n";
+  out << "  \"revision\": " << json_quote(i.revision) << ",\n";
+  out << "  \"hardware_release\": " << json_quote(i.hardware_release) << ",\n";
+  out << "  \"software_release\": " << json_quote(i.software_release) << ",\n";
+  out << "  \"order_number\": " << json_quote(i.order_number) << ",\n";
+  out << "  \"slave_family\": " << json_quote(i.slave_family) << ",\n";
+  out << "  \"info_text\": " << json_quote(i.info_text) << ",\n";
   out << "  \"baud_rates\": [";
   for (std::size_t n = 0; n < f.baud_rates().size(); ++n) {
     const auto& b = f.baud_rates()[n];
-    out << (n ? ", " : "") << "{\"baud\": " << js(bus::baud_name(b.baud))
+    out << (n ? ", " : "") << "{\"baud\": " << json_quote(bus::baud_name(b.baud))
         << ", \"bit_per_s\": " << static_cast<std::uint32_t>(b.baud) << ", \"max_tsdr\": " << b.max_tsdr << "}";
   }
   out << "],\n";
@@ -253,12 +231,12 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   out << "  \"modules\": [";
   for (std::size_t n = 0; n < f.modules().size(); ++n) {
     const auto& m = f.modules()[n];
-    out << (n ? "," : "") << "\n    {\"index\": " << n << ", \"name\": " << js(m.name) << ", \"reference\": "
+    out << (n ? "," : "") << "\n    {\"index\": " << n << ", \"name\": " << json_quote(m.name) << ", \"reference\": "
         << (m.reference ? std::to_string(*m.reference) : std::string("null")) << ", \"config\": "
-        << jbytes(m.config) << ", \"config_hex\": " << js(hex_list(m.config, ","))
+        << jbytes(m.config) << ", \"config_hex\": " << json_quote(hex_list(m.config, ","))
         << ", \"input_len\": " << m.input_len << ", \"output_len\": " << m.output_len
         << ", \"consistent\": " << jb(m.consistent) << ", \"prm_defaults\": " << jbytes(f.prm_area_defaults(m.prm))
-        << ", \"info_text\": " << js(m.info_text) << "}";
+        << ", \"info_text\": " << json_quote(m.info_text) << "}";
   }
   out << "\n  ],\n";
   const auto& g = f.global_prm();
@@ -268,8 +246,8 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
       << ", \"station_defaults\": " << jbytes(f.prm_area_defaults(g)) << ", \"ext_user_prm_data\": [";
   bool first = true;
   for (const auto& [ref, e] : f.ext_user_prm_data()) {
-    out << (first ? "" : ",") << "\n    {\"ref\": " << ref << ", \"name\": " << js(e.name)
-        << ", \"type\": " << js(devices::gsd_data_type_name(e.type)) << ", \"bit_first\": " << int(e.bit_first)
+    out << (first ? "" : ",") << "\n    {\"ref\": " << ref << ", \"name\": " << json_quote(e.name)
+        << ", \"type\": " << json_quote(devices::gsd_data_type_name(e.type)) << ", \"bit_first\": " << int(e.bit_first)
         << ", \"bit_last\": " << int(e.bit_last) << ", \"default\": " << e.default_value
         << ", \"min\": " << e.min_value << ", \"max\": " << e.max_value << ", \"allowed\": [";
     for (std::size_t k = 0; k < e.allowed.size(); ++k) out << (k ? "," : "") << e.allowed[k];
@@ -279,7 +257,7 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
       if (it != f.prm_texts().end()) {
         bool ft = true;
         for (const auto& [v, t] : it->second.texts) {
-          out << (ft ? "" : ", ") << "{\"value\": " << v << ", \"text\": " << js(t) << "}";
+          out << (ft ? "" : ", ") << "{\"value\": " << v << ", \"text\": " << json_quote(t) << "}";
           ft = false;
         }
       }
@@ -312,7 +290,7 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   auto opt = [](const auto& o) { return o ? std::to_string(*o) : std::string("null"); };
   auto per_baud = [](const std::map<bus::Baud, std::uint16_t>& mp) {
     std::string o = "{";
-    for (const auto& [b, v] : mp) o += (o.size() > 1 ? ", " : "") + js(bus::baud_name(b)) + ": " + std::to_string(v);
+    for (const auto& [b, v] : mp) o += (o.size() > 1 ? ", " : "") + json_quote(bus::baud_name(b)) + ": " + std::to_string(v);
     return o + "}";
   };
   out << "  \"master\": {\"is_master\": " << jb(f.is_master()) << ", \"max_slaves_supp\": " << opt(m.max_slaves_supp)
@@ -323,11 +301,11 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   out << "  \"unknown_keywords\": [";
   for (std::size_t n = 0; n < f.unknown_keywords().size(); ++n) {
     const auto& k = f.unknown_keywords()[n];
-    out << (n ? ", " : "") << "{\"name\": " << js(k.name) << ", \"value\": " << js(k.value) << ", \"line\": " << k.line << "}";
+    out << (n ? ", " : "") << "{\"name\": " << json_quote(k.name) << ", \"value\": " << json_quote(k.value) << ", \"line\": " << k.line << "}";
   }
   out << "],\n";
   out << "  \"warnings\": [";
-  for (std::size_t n = 0; n < warnings.size(); ++n) out << (n ? ", " : "") << js(warnings[n].to_string());
+  for (std::size_t n = 0; n < warnings.size(); ++n) out << (n ? ", " : "") << json_quote(warnings[n].to_string());
   out << "]\n}\n";
 }
 

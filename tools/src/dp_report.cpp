@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <ostream>
 
+#include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/dp_system.hpp"
 
 namespace pbvbus::tools {
@@ -17,31 +18,6 @@ std::string hex(const std::vector<std::uint8_t>& v) {
     s += buf;
   }
   return s;
-}
-
-std::string us(bus::Ticks t) {
-  const std::int64_t ns = bus::ticks_to_ns(t);
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%lld.%03lld", static_cast<long long>(ns / 1000),
-                static_cast<long long>(ns % 1000));
-  return buf;
-}
-
-std::string js(std::string_view s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-      o += buf;
-    } else {
-      o += c;
-    }
-  }
-  return o + "\"";
 }
 
 }  // namespace
@@ -67,8 +43,8 @@ void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os) {
          << "\n";
       const auto& st = s.stats;
       if (st.cycle_count > 0) {
-        os << "    DP cycle (" << st.cycle_count << "): min " << us(st.cycle_min) << " / median "
-           << us(s.cycle_median) << " / max " << us(st.cycle_max) << " us = " << st.cycle_min / bit
+        os << "    DP cycle (" << st.cycle_count << "): min " << format_us(st.cycle_min) << " / median "
+           << format_us(s.cycle_median) << " / max " << format_us(st.cycle_max) << " us = " << st.cycle_min / bit
            << " / " << s.cycle_median / bit << " / " << st.cycle_max / bit << " bit times\n";
       }
       os << "    data exchanges " << st.data_exchanges << ", start-ups " << st.startups
@@ -84,20 +60,20 @@ void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os) {
     const auto& m = r[mi];
     const auto bit = bus::ticks_per_bit(m.baud);
     os << (mi ? ",\n" : "\n") << "{\"address\":" << static_cast<int>(m.address)
-       << ",\"line\":" << js(m.line) << ",\"mode\":" << js(m.mode)
+       << ",\"line\":" << json_quote(m.line) << ",\"mode\":" << json_quote(m.mode)
        << ",\"global_controls\":" << m.global_controls
        << ",\"data_control_time_ms\":" << m.data_control_time * 10 << ",\"slaves\":[";
     for (std::size_t i = 0; i < m.slaves.size(); ++i) {
       const auto& s = m.slaves[i];
       const auto& st = s.stats;
       os << (i ? ",\n  " : "\n  ") << "{\"address\":" << static_cast<int>(s.address)
-         << ",\"model\":" << js(s.model) << ",\"modules\":[";
-      for (std::size_t k = 0; k < s.modules.size(); ++k) os << (k ? "," : "") << js(s.modules[k]);
-      os << "],\"state\":" << js(s.state) << ",\"slave_state\":" << js(s.slave_state)
-         << ",\"diag\":" << js(hex(s.diag)) << ",\"diag_bits\":[";
-      for (std::size_t k = 0; k < s.diag_bits.size(); ++k) os << (k ? "," : "") << js(s.diag_bits[k]);
+         << ",\"model\":" << json_quote(s.model) << ",\"modules\":[";
+      for (std::size_t k = 0; k < s.modules.size(); ++k) os << (k ? "," : "") << json_quote(s.modules[k]);
+      os << "],\"state\":" << json_quote(s.state) << ",\"slave_state\":" << json_quote(s.slave_state)
+         << ",\"diag\":" << json_quote(hex(s.diag)) << ",\"diag_bits\":[";
+      for (std::size_t k = 0; k < s.diag_bits.size(); ++k) os << (k ? "," : "") << json_quote(s.diag_bits[k]);
       os << "],\"input_len\":" << s.input_len << ",\"output_len\":" << s.output_len
-         << ",\"inputs\":" << js(hex(s.inputs)) << ",\"outputs\":" << js(hex(s.outputs))
+         << ",\"inputs\":" << json_quote(hex(s.inputs)) << ",\"outputs\":" << json_quote(hex(s.outputs))
          << ",\"cycle\":{\"count\":" << st.cycle_count << ",\"min_ns\":" << bus::ticks_to_ns(st.cycle_min)
          << ",\"median_ns\":" << bus::ticks_to_ns(s.cycle_median)
          << ",\"max_ns\":" << bus::ticks_to_ns(st.cycle_max) << ",\"min_bits\":" << st.cycle_min / bit

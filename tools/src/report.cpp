@@ -1,3 +1,4 @@
+#include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/report.hpp"
 
 #include <algorithm>
@@ -32,37 +33,6 @@ std::string_view live_type_key(fdl::StationType t) {
 namespace {
 
 constexpr const char* kTypeNames[LineStats::kTypes] = {"SD1", "SD2", "SD3", "SD4", "SC"};
-
-/// Microseconds with three decimals, from ticks, without floating point.
-std::string us(bus::Ticks t) {
-  const std::int64_t ns = bus::ticks_to_ns(t);
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%lld.%03lld", static_cast<long long>(ns / 1000),
-                static_cast<long long>(ns % 1000));
-  return buf;
-}
-
-std::string json_string(std::string_view s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\r': o += "\\r"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(c));
-          o += buf;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -116,8 +86,8 @@ void write_text(const Report& r, std::ostream& os) {
          << ", stations dropped " << m.stations_dropped << ", admitted " << m.admissions
          << ", duplicate tokens " << m.duplicate_tokens << ", GAP polls " << m.gap_polls << "\n";
       if (m.rotation.count > 0) {
-        os << "    token rotation (" << m.rotation.count << "): min " << us(m.rotation.min)
-           << " / median " << us(m.rotation.median) << " / max " << us(m.rotation.max)
+        os << "    token rotation (" << m.rotation.count << "): min " << format_us(m.rotation.min)
+           << " / median " << format_us(m.rotation.median) << " / max " << format_us(m.rotation.max)
            << " us = " << m.rotation.min / bit << " / " << m.rotation.median / bit << " / "
            << m.rotation.max / bit << " bit times\n";
       }
@@ -155,7 +125,7 @@ void write_text(const Report& r, std::ostream& os) {
 
 void write_json(const Report& r, std::ostream& os) {
   os << "{\"schema\":\"pbvbus.run.report/1\",\n";
-  os << "\"scenario\":{\"name\":" << json_string(r.name) << ",\"file\":" << json_string(r.file)
+  os << "\"scenario\":{\"name\":" << json_quote(r.name) << ",\"file\":" << json_quote(r.file)
      << ",\"seed\":" << r.seed << "},\n";
   os << "\"duration_ns\":" << bus::ticks_to_ns(r.duration) << ",\"wall_time_s\":"
      << fixed(r.wall_seconds, 6) << ",\"speed\":"
@@ -164,18 +134,18 @@ void write_json(const Report& r, std::ostream& os) {
   os << "\"serial\":[";
   for (std::size_t i = 0; i < r.serial.size(); ++i) {
     const auto& s = r.serial[i];
-    os << (i ? "," : "") << "{\"line\":" << json_string(s.line) << ",\"mode\":" << json_string(s.mode)
-       << ",\"path\":" << json_string(s.path) << ",\"link\":" << json_string(s.link) << "}";
+    os << (i ? "," : "") << "{\"line\":" << json_quote(s.line) << ",\"mode\":" << json_quote(s.mode)
+       << ",\"path\":" << json_quote(s.path) << ",\"link\":" << json_quote(s.link) << "}";
   }
   os << "],\n\"faults_not_reached\":[";
   for (std::size_t i = 0; i < r.faults_not_reached.size(); ++i)
-    os << (i ? "," : "") << json_string(r.faults_not_reached[i]);
+    os << (i ? "," : "") << json_quote(r.faults_not_reached[i]);
   os << "],\n\"lines\":[";
   for (std::size_t li = 0; li < r.lines.size(); ++li) {
     const auto& l = r.lines[li];
     const auto bit = bus::ticks_per_bit(l.baud);
     const auto& p = l.params;
-    os << (li ? ",\n" : "\n") << "{\"name\":" << json_string(l.name)
+    os << (li ? ",\n" : "\n") << "{\"name\":" << json_quote(l.name)
        << ",\"baud\":" << static_cast<std::uint32_t>(l.baud) << ",\n \"bus_params\":{\"tsl\":"
        << p.tsl << ",\"min_tsdr\":" << p.min_tsdr << ",\"max_tsdr\":" << p.max_tsdr
        << ",\"tqui\":" << p.tqui << ",\"tset\":" << p.tset << ",\"ttr\":" << p.ttr
@@ -191,7 +161,7 @@ void write_json(const Report& r, std::ostream& os) {
     bool first = true;
     for (std::size_t fn = 0; fn < t.requests_by_fn.size(); ++fn) {
       if (t.requests_by_fn[fn] == 0) continue;
-      os << (first ? "" : ",") << json_string(fdl::to_string(static_cast<fdl::RequestFn>(fn)))
+      os << (first ? "" : ",") << json_quote(fdl::to_string(static_cast<fdl::RequestFn>(fn)))
          << ":" << t.requests_by_fn[fn];
       first = false;
     }
@@ -201,13 +171,13 @@ void write_json(const Report& r, std::ostream& os) {
        << ",\"no_response\":" << no_response(l) << ",\"retries\":" << retries(l) << "},\n \"faults\":[";
     for (std::size_t i = 0; i < t.faults.size(); ++i)
       os << (i ? "," : "") << "{\"time_ns\":" << bus::ticks_to_ns(t.faults[i].time)
-         << ",\"text\":" << json_string(t.faults[i].text) << "}";
+         << ",\"text\":" << json_quote(t.faults[i].text) << "}";
     os << "],\n \"masters\":[";
     for (std::size_t i = 0; i < l.masters.size(); ++i) {
       const auto& m = l.masters[i];
       const auto& ro = m.rotation;
       os << (i ? ",\n  " : "\n  ") << "{\"address\":" << static_cast<int>(m.address)
-         << ",\"state\":" << json_string(m.state) << ",\"in_ring\":" << (m.in_ring ? "true" : "false")
+         << ",\"state\":" << json_quote(m.state) << ",\"in_ring\":" << (m.in_ring ? "true" : "false")
          << ",\"las\":[";
       for (std::size_t k = 0; k < m.las.size(); ++k) os << (k ? "," : "") << static_cast<int>(m.las[k]);
       os << "],\"tokens_received\":" << m.tokens_received << ",\"tokens_passed\":" << m.tokens_passed

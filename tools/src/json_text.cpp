@@ -1,0 +1,40 @@
+#include "pbvbus/tools/json_text.hpp"
+
+#include <cstdint>
+#include <cstdio>
+
+namespace pbvbus::tools {
+
+std::string json_quote(std::string_view s) {
+  std::string o = "\"";
+  o.reserve(s.size() + 2);
+  for (char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\r': o += "\\r"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (u < 0x20 || u == 0x7F) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04X", static_cast<unsigned>(u));
+          o += buf;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+std::string format_us(bus::Ticks t) {
+  const std::int64_t ns = bus::ticks_to_ns(t);
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%lld.%03lld", static_cast<long long>(ns / 1000),
+                static_cast<long long>(ns % 1000));
+  return buf;
+}
+
+}  // namespace pbvbus::tools

@@ -276,11 +276,158 @@ class DpPlanner {
       error("dp_slave", i, "modules", -1, "configuration of " + s.gsd() + ": " + why);
       return;
     }
+    if (!plan_io(i, s, sp)) return;
     sp.gsd = std::make_shared<const devices::GsdFile>(g);
     if (mi >= 0)
       m_plan.dp_masters[static_cast<std::size_t>(mi)].slaves.push_back(
           static_cast<int>(m_plan.dp_slaves.size()));
     m_plan.dp_slaves.push_back(std::move(sp));
+  }
+
+  /// Module index in the slave's list by name (first match) or position; reports errors.
+  std::optional<std::size_t> module_ref(int i, int k, const DpSlavePlan& sp, bool by_index,
+                                        std::uint32_t index, const std::string& name,
+                                        const char* what) {
+    if (by_index) {
+      if (index < sp.module_names.size()) return index;
+      error("dp_slave", i, "io", k,
+            std::string(what) + " module_index " + std::to_string(index) + " is not below the " +
+                std::to_string(sp.module_names.size()) + " modules of the slave");
+      return std::nullopt;
+    }
+    for (std::size_t m = 0; m < sp.module_names.size(); ++m)
+      if (sp.module_names[m] == name) return m;
+    error("dp_slave", i, "io", k,
+          std::string(what) + " module \"" + name + "\" is not one of the slave's modules");
+    return std::nullopt;
+  }
+
+  std::optional<bus::Ticks> io_duration(int i, int k, const std::string& text, const char* what) {
+    auto t = bus::parse_duration(text);
+    if (!t) error("dp_slave", i, "io", k, std::string("bad duration \"") + text + "\" for " + what +
+                                              " (e.g. \"100ms\")");
+    return t;
+  }
+
+  bool plan_io(int i, const scenario::DpSlave& s, DpSlavePlan& sp) {
+    bool ok = true;
+    using BC = scenario::DpSlaveIo::BehaviourCase;
+    for (int k = 0; k < s.io_size(); ++k) {
+      const auto& io = s.io(k);
+      if (io.module_ref_case() == scenario::DpSlaveIo::MODULE_REF_NOT_SET) {
+        error("dp_slave", i, "io", k, "io needs a module: module: \"name\" or module_index: n");
+        ok = false;
+        continue;
+      }
+      auto m = module_ref(i, k, sp, io.has_module_index(), io.module_index(), io.module(), "io");
+      if (!m) {
+        ok = false;
+        continue;
+      }
+      const dp::ModuleLayout& ml = m_layout.modules[*m];
+      DpIoPlan p;
+      p.module = *m;
+      if (ml.in_len == 0) {
+        error("dp_slave", i, "io", k, "module \"" + sp.module_names[*m] + "\" has no inputs");
+        ok = false;
+        continue;
+      }
+      p.whole = !io.has_offset() && !io.has_width();
+      p.offset = io.offset();
+      p.width = io.has_width() ? io.width() : (io.offset() < ml.in_len ? ml.in_len - io.offset() : 0);
+      if (p.width == 0 || p.offset + p.width > ml.in_len) {
+        error("dp_slave", i, "io", k,
+              "channel offset " + std::to_string(p.offset) + " width " + std::to_string(p.width) +
+                  " is outside the " + std::to_string(ml.in_len) + " input octets of module \"" +
+                  sp.module_names[*m] + "\"");
+        ok = false;
+        continue;
+      }
+      const std::size_t width = p.whole ? ml.in_len : p.width;
+      devices::IoBehaviour& b = p.behaviour;
+      bool good = true;
+      switch (io.behaviour_case()) {
+        case BC::kConstant: {
+          std::vector<std::uint8_t> v(width, 0);
+          devices::put_big_endian(static_cast<std::int64_t>(io.constant().value()), v.begin(), width);
+          b = devices::IoBehaviour::constant_value(std::move(v));
+          break;
+        }
+        case BC::kCounter: {
+          const auto& c = io.counter();
+          bus::Ticks period = 0;
+          if (!c.period().empty()) {
+            auto t = io_duration(i, k, c.period(), "counter period");
+            if (!t || *t == 0) {
+              if (t) error("dp_slave", i, "io", k, "counter period must be longer than 0");
+              good = false;
+            } else {
+              period = *t;
+            }
+          }
+          b = devices::IoBehaviour::counter_every(period, c.has_step() ? c.step() : 1, c.start());
+          break;
+        }
+        case BC::kRamp: {
+          const auto& r = io.ramp();
+          auto t = r.period().empty() ? std::nullopt : io_duration(i, k, r.period(), "ramp period");
+          if (r.period().empty()) error("dp_slave", i, "io", k, "ramp needs a period");
+          if (!t) good = false;
+          b = devices::IoBehaviour::ramp(r.min(), r.max(), t.value_or(0));
+          break;
+        }
+        case BC::kTable: {
+          const auto& tb = io.table();
+          std::vector<std::pair<bus::Ticks, std::int64_t>> rows;
+          for (const auto& row : tb.row()) {
+            auto t = io_duration(i, k, row.at(), "table row");
+            if (!t) good = false;
+            rows.emplace_back(t.value_or(0), row.value());
+          }
+          bus::Ticks period = 0;
+          if (!tb.period().empty()) {
+            auto t = io_duration(i, k, tb.period(), "table period");
+            if (!t) good = false;
+            period = t.value_or(0);
+          }
+          b = devices::IoBehaviour::table(std::move(rows), tb.repeat(), period);
+          break;
+        }
+        case BC::kEcho: {
+          const auto& e = io.echo();
+          std::optional<std::size_t> src;
+          if (e.source_case() != scenario::IoEcho::SOURCE_NOT_SET) {
+            src = module_ref(i, k, sp, e.has_from_module_index(), e.from_module_index(),
+                             e.from_module(), "echo from");
+            if (!src) good = false;
+          }
+          const std::size_t from = src.value_or(*m);
+          if (good && m_layout.modules[from].out_len == 0) {
+            error("dp_slave", i, "io", k,
+                  "echo source module \"" + sp.module_names[from] + "\" has no outputs");
+            good = false;
+          }
+          b = devices::IoBehaviour::echo(src ? src : std::optional<std::size_t>(*m));
+          break;
+        }
+        case BC::BEHAVIOUR_NOT_SET:
+          error("dp_slave", i, "io", k, "io needs a behaviour: constant, counter, ramp, table or echo");
+          good = false;
+          break;
+      }
+      if (good) {
+        if (std::string why = devices::check_behaviour(b, m_layout.modules.size()); !why.empty()) {
+          error("dp_slave", i, "io", k, why);
+          good = false;
+        }
+      }
+      if (!good) {
+        ok = false;
+        continue;
+      }
+      sp.io_behaviours.push_back(std::move(p));
+    }
+    return ok;
   }
 
   void derive_line_params() {

@@ -83,6 +83,13 @@ DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params) 
     if (std::string why = m_model->set_behaviour(m, beh); !why.empty())
       throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " + why);
   }
+  for (const DpIoPlan& io : plan.io_behaviours) {
+    const std::string why = io.whole ? m_model->set_behaviour(io.module, io.behaviour)
+                                     : m_model->add_channel_behaviour(io.module, io.offset, io.width,
+                                                                      io.behaviour);
+    if (!why.empty())
+      throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " + why);
+  }
 }
 
 DpSlaveNode::~DpSlaveNode() = default;

@@ -255,7 +255,45 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
     case K::PowerLoss: l.set_power(f.a, !on); break;
     case K::TransceiverFailure: l.set_transceiver_ok(f.a, !on); break;
     case K::Babble: l.set_babbling(f.a, on); break;
+    case K::SlaveMute:
+    case K::ChannelDiag:
+    case K::ModulePull:
+    case K::ProcessAlarm: apply_slave_fault(f, on); break;
   }
+}
+
+void Simulation::apply_slave_fault(const PlanFault& f, bool on) {
+  LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
+  DpSlaveNode* node = nullptr;
+  for (auto& s : ls.stations)
+    if (s.dp_slave && s.address == f.slave) node = s.dp_slave.get();
+  if (node == nullptr) return;  // the loader checked it
+  using K = PlanFault::Kind;
+  using SF = devices::SlaveFault;
+  SF sf;
+  std::string text;
+  switch (f.kind) {
+    case K::SlaveMute:
+      sf = on ? SF::mute() : SF::unmute();
+      text = on ? f.description : "un" + f.description;
+      break;
+    case K::ChannelDiag:
+      sf = SF::channel_diag(f.module, f.channel, static_cast<dp::ChannelError>(f.error_type),
+                            f.word_channel ? dp::ChannelType::Word : dp::ChannelType::Bit,
+                            f.output_channel ? dp::ChannelDirection::Output
+                                             : dp::ChannelDirection::Input,
+                            on);
+      text = f.description + (on ? " appears" : " disappears");
+      break;
+    case K::ModulePull:
+      sf = on ? SF::pulled(f.module) : SF::plugged(f.module);
+      text = on ? f.description : "plugged" + f.description.substr(6);  // "pulled ..." -> "plugged ..."
+      break;
+    default: sf = SF::process_alarm(f.module, {}); text = f.description; break;
+  }
+  // Slave faults are no line events: the report lists them with the line's faults.
+  if (std::string why = node->model().apply(sf); !why.empty()) text += " (refused: " + why + ")";
+  ls.stats.faults.push_back({m_sched.now(), std::move(text)});
 }
 
 void Simulation::run_until(Ticks t) {

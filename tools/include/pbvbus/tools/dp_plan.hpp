@@ -35,6 +35,7 @@
 #include <utility>
 #include <vector>
 
+#include "pbvbus/devices/io_behaviour.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_config.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
@@ -48,6 +49,19 @@ namespace pbvbus::tools {
 
 struct Diagnostic;
 struct ScenarioPlan;
+
+/// One `io` entry of a dp_slave: a behaviour for module `module` (0-based in the slave's module
+/// list), over all its inputs (`whole`) or input octets [offset, offset + width).
+/// Decisions: a constant's uint64 value is written big-endian over the channel width (cut to
+/// its low octets); a counter's step defaults to 1; `io` on a module without inputs, a channel
+/// outside the module, or an echo source without outputs is an error (it would show nothing).
+struct DpIoPlan {
+  std::size_t module = 0;
+  bool whole = true;
+  std::size_t offset = 0;
+  std::size_t width = 0;
+  devices::IoBehaviour behaviour;
+};
 
 struct DpSlavePlan {
   int source = 0;  ///< index into Scenario.dp_slave
@@ -66,6 +80,7 @@ struct DpSlavePlan {
   std::size_t inputs = 0;               ///< octets
   std::size_t outputs = 0;
   scenario::DpSlave::Inputs io = scenario::DpSlave::COUNTER;
+  std::vector<DpIoPlan> io_behaviours;  ///< the `io` entries, in file order
 };
 
 struct DpMasterPlan {

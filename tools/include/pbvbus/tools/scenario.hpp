@@ -70,7 +70,12 @@ struct PlanFault {
     Noise,
     PowerLoss,
     TransceiverFailure,
-    Babble
+    Babble,
+    // DP slave faults, applied through devices::SlaveModel (repair = the clearing step).
+    SlaveMute,
+    ChannelDiag,
+    ModulePull,
+    ProcessAlarm
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -80,6 +85,15 @@ struct PlanFault {
   int b = -1;                    ///< cut: the later cable position
   std::uint64_t noise_ppb = 0;   ///< noise: bit errors per 10^9 bits
   std::string description;       ///< e.g. "cable cut on line A between 3 and 10"
+  std::uint8_t slave = 0;        ///< DP slave faults: the dp_slave's address
+  std::size_t module = 0;        ///< DP slave faults: 0-based in the slave's module list
+  std::uint8_t channel = 0;      ///< channel_diag: 0..63
+  std::uint8_t error_type = 0;   ///< channel_diag: 1..31
+  /// channel_diag: the channel's type and direction, from the module's first identifier
+  /// (decision: a word-format identifier gives Word channels, any other Bit channels; input if
+  /// the identifier has inputs, else output), as a configuration tool would show them.
+  bool word_channel = false;
+  bool output_channel = false;
 };
 
 struct ScenarioPlan {

@@ -98,6 +98,7 @@ class Simulation {
   void build_line(std::size_t li);
   void schedule_faults();
   void apply_fault(const PlanFault& f, bool on);
+  void apply_slave_fault(const PlanFault& f, bool on);
   void make_link(const std::string& target, const std::string& link);
 
   ScenarioPlan m_plan;

@@ -165,3 +165,30 @@ TEST(DpSlaveIoRun, FaultsShowOnTheWireInTheMasterAndInTheReport) {
 
 }  // namespace
 }  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+namespace {
+
+// examples/dp-faults.textproto runs clean: every slave ends in Data_Exchange; slave 3's mute is
+// one failure and one return; slave 5's process alarm reaches the master once (acknowledged).
+TEST(DpFaultsExample, RunsCleanWithEachFaultSeenByTheMaster) {
+  const auto loaded = load_scenario_file(PBVBUS_SOURCE_DIR "/examples/dp-faults.textproto");
+  ASSERT_TRUE(loaded.ok()) << loaded.errors.front().str();
+  Simulation sim(*loaded.plan);
+  sim.run_until(*sim.duration());
+  const DpMasterNode* m = sim.dp_master(0, 1);
+  ASSERT_NE(m, nullptr);
+  for (std::uint8_t a : {std::uint8_t{3}, std::uint8_t{4}, std::uint8_t{5}})
+    EXPECT_EQ(m->master().slave_state(a), dp::SlaveStatusState::DataExchange) << int(a);
+  EXPECT_EQ(m->master().slave_stats(3).failures, 1u);
+  EXPECT_EQ(m->master().slave_stats(3).returns, 1u);
+  EXPECT_EQ(m->master().slave_stats(4).failures, 0u);
+  EXPECT_EQ(m->master().slave_stats(5).alarms, 1u);
+  EXPECT_EQ(m->master().slave_stats(5).alarm_acks, 1u);
+  // DH for the channel diagnosis appearing and going, the pull and the plug.
+  EXPECT_GE(m->master().slave_stats(4).dh, 4u);
+  EXPECT_EQ(sim.report(0.0).lines.at(0).traffic.faults.size(), 7u);
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

@@ -23,13 +23,11 @@
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
-namespace pbvbus::bus {
-class PacedRunner;
-}
 namespace pbvbus::captures {
 class PcapngWriter;
 }
@@ -78,9 +76,12 @@ class Simulation {
   bool has_external_attachments() const { return !m_serial.empty(); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
 
-  /// Paced driver: lets the pty attachments read their input on the runner's io_context.
-  /// Call once before runner.run_until().
-  void attach_io(bus::PacedRunner& runner);
+  /// Paced driver: creates the simulation's PacedRunner (once) and registers every pty
+  /// attachment's I/O on its io_context. The Simulation owns the runner so that the order of
+  /// tear-down is fixed: the doors (ptys) go first, then the runner and its io_context, then
+  /// the scheduler — a door never cancels I/O on a dead io_context. Anything else registered
+  /// on runner.io_context() by the caller must be gone before the Simulation.
+  bus::PacedRunner& paced_runner(bus::Speed speed);
   /// Fast driver with ptys: reads what the programs wrote so far (call between slices).
   void poll_serial();
 
@@ -106,6 +107,9 @@ class Simulation {
   std::optional<bus::Ticks> m_duration;
   std::uint64_t m_seed = 0;
   bus::Scheduler m_sched;
+  // Declared after the scheduler and before the lines: destroyed after every door, before the
+  // scheduler it drives.
+  std::unique_ptr<bus::PacedRunner> m_runner;
   std::vector<std::unique_ptr<LineState>> m_lines;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;

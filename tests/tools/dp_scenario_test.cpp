@@ -90,7 +90,8 @@ TEST(DpScenario, ErrorsNameFileLineAndColumn) {
 
   const auto modular = errors_of(head() + "dp_slave { address: 3 line: \"A\" gsd: \"gsd/PBVB0A02.gsd\" master: 1 }\n");
   ASSERT_EQ(modular.size(), 1u);
-  EXPECT_EQ(modular[0], kFile + ":5:1: dp_slave with the modular GSD \"gsd/PBVB0A02.gsd\" needs a module list");
+  EXPECT_EQ(modular[0], kFile + ":5:1: dp_slave with the modular GSD \"gsd/PBVB0A02.gsd\" needs a module "
+                                "list (modules: [\"...\"], at most Max_Module = 8)");
 
   const auto wd = errors_of("line { name: \"A\" }\ndp_master { address: 1 line: \"A\" watchdog: \"15ms\" }\n");
   ASSERT_EQ(wd.size(), 1u);

@@ -215,8 +215,16 @@ class DpPlanner {
     if (s.modules_size() == 0 && !g.slave_features().modular_station && g.modules().size() == 1) {
       mods.push_back(0);
     } else if (s.modules_size() == 0) {
+      // Name the station kind the GSD declares: a compact station whose GSD offers several
+      // variants needs its one module chosen, it is not "modular".
+      const bool modular = g.slave_features().modular_station;
       error("dp_slave", i, nullptr, -1,
-            "dp_slave with the modular GSD \"" + s.gsd() + "\" needs a module list");
+            modular ? "dp_slave with the modular GSD \"" + s.gsd() +
+                          "\" needs a module list (modules: [\"...\"], at most Max_Module = " +
+                          std::to_string(g.slave_features().max_module) + ")"
+                    : "dp_slave with the compact GSD \"" + s.gsd() + "\" offers " +
+                          std::to_string(g.modules().size()) +
+                          " modules: choose one (modules: \"name\")");
       ok = false;
     }
     for (int k = 0; k < s.modules_size(); ++k) {

@@ -76,8 +76,17 @@ const pb::FieldDescriptor* field_of(const pb::Descriptor* d, const char* name) {
   return f;
 }
 
+/// protobuf's ParseInfoTree aborts (DFATAL) when a repeated field is asked for without an
+/// index or a singular one with an index: the index is made to fit the field, so an error
+/// about "the list as a whole" points at its first element.
+int fit_index(const pb::FieldDescriptor* f, int index) {
+  if (!f->is_repeated()) return -1;
+  return index < 0 ? 0 : index;
+}
+
 Where nested(const Where& w, const pb::Descriptor* d, const char* name, int index = -1) {
   const pb::FieldDescriptor* f = field_of(d, name);
+  index = fit_index(f, index);
   Where r;
   if (w.tree != nullptr) {
     r.tree = w.tree->GetTreeForNested(f, index);
@@ -97,6 +106,7 @@ Where at_field(const Where& w, const pb::Descriptor* d, const char* name, int in
   Where r = w;
   if (w.tree != nullptr) {
     const pb::FieldDescriptor* f = field_of(d, name);
+    index = fit_index(f, index);
     auto loc = w.tree->GetLocation(f, index);
     // A list value `address: [2, 1]` is recorded once, at its field name.
     if (loc.line < 0 && index > 0) loc = w.tree->GetLocation(f, 0);

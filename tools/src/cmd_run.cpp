@@ -10,7 +10,8 @@
 //  - --quiet prints nothing but errors and the --json report.
 //  - A paced run without a duration (none in the scenario, no --duration) runs until SIGINT or
 //    SIGTERM; either signal ends any run early, and the report covers the time run so far.
-//  - Progress (virtual time, speed) goes to stderr only when stderr is a terminal and the run
+//  - Progress (virtual time, speed ratio, frames, error frames) goes to stderr only when stderr
+//    is a terminal, --quiet is not given, and the run
 //    has taken more than a second of wall time; it is erased before the report.
 //  - Exit codes: 0 done, 1 the run failed (capture could not be written), 2 bad usage or a bad
 //    scenario.
@@ -21,6 +22,8 @@
 #include <charconv>
 #include <chrono>
 #include <csignal>
+#include <cstring>
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -157,10 +160,13 @@ std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
   return std::nullopt;
 }
 
+/// The progress line on a terminal: virtual time, speed ratio, frames and error frames so far
+/// (all lines). Redrawn in place at most five times a second, erased before the report.
 class Progress {
  public:
-  Progress(std::ostream& err, bool enabled, bus::Ticks total)
-      : m_err(err), m_enabled(enabled), m_total(total), m_t0(std::chrono::steady_clock::now()) {}
+  Progress(std::ostream& err, bool enabled, bus::Ticks total, const Simulation& sim)
+      : m_err(err), m_enabled(enabled), m_total(total), m_sim(sim),
+        m_t0(std::chrono::steady_clock::now()) {}
 
   void update(bus::Ticks now) {
     if (!m_enabled) return;
@@ -169,18 +175,22 @@ class Progress {
     m_last = wall;
     const double w = std::chrono::duration<double>(wall).count();
     const double v = static_cast<double>(now) / bus::kTicksPerSecond;
-    char buf[160];
-    if (m_total > 0)
-      std::snprintf(buf, sizeof buf, "\r%s / %s virtual, %.1fx real time   ",
-                    bus::format_duration(now).c_str(), bus::format_duration(m_total).c_str(), v / w);
-    else
-      std::snprintf(buf, sizeof buf, "\r%s virtual, %.3fx real time   ",
-                    bus::format_duration(now).c_str(), v / w);
+    std::uint64_t frames = 0, errors = 0;
+    for (std::size_t i = 0; i < m_sim.line_count(); ++i) {
+      frames += m_sim.stats(i).frames;
+      errors += m_sim.stats(i).error_frames();
+    }
+    char buf[200];
+    const std::string total = m_total > 0 ? " / " + bus::format_duration(m_total) : std::string();
+    std::snprintf(buf, sizeof buf, "\r%s%s virtual, %.3gx real time, %llu frames, %llu errors   ",
+                  bus::format_duration(now).c_str(), total.c_str(), v / w,
+                  static_cast<unsigned long long>(frames), static_cast<unsigned long long>(errors));
+    m_width = std::max(m_width, std::strlen(buf));
     m_err << buf << std::flush;
     m_shown = true;
   }
   void clear() {
-    if (m_shown) m_err << "\r" << std::string(70, ' ') << "\r" << std::flush;
+    if (m_shown) m_err << "\r" << std::string(m_width, ' ') << "\r" << std::flush;
   }
   double elapsed() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - m_t0).count();
@@ -190,6 +200,8 @@ class Progress {
   std::ostream& m_err;
   bool m_enabled;
   bus::Ticks m_total;
+  const Simulation& m_sim;
+  std::size_t m_width = 0;
   std::chrono::steady_clock::time_point m_t0;
   std::chrono::steady_clock::duration m_last{};
   bool m_shown = false;
@@ -297,16 +309,16 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     if (ra.fast && has_serial)
       err << "pbvbus run: warning: --fast with serial attachments: the bus runs faster than real "
              "time\n";
-    if (paced && !duration) err << "pbvbus run: running until interrupted (Ctrl-C)\n";
   }
 
   const bool show_progress = !ra.quiet && &err == &std::cerr && ::isatty(STDERR_FILENO) == 1;
-  Progress progress(err, show_progress, duration.value_or(0));
+  Progress progress(err, show_progress, duration.value_or(0), *sim);
   g_interrupted = 0;
   sim->start();
   if (paced) {
-    bus::PacedRunner runner(sim->scheduler(), ra.speed.value_or(bus::Speed{}));
-    sim->attach_io(runner);
+    // The runner belongs to the simulation (torn down after its doors); the signal set below
+    // is the only other user of its io_context and goes at the end of this block.
+    bus::PacedRunner& runner = sim->paced_runner(ra.speed.value_or(bus::Speed{}));
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {
       if (!ec) {
@@ -314,6 +326,8 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
         runner.stop();
       }
     });
+    // Said only once SIGINT is handled, so that whoever waits for it may send one.
+    if (!duration && !ra.quiet) err << "pbvbus run: running until interrupted (Ctrl-C)\n";
     ProgressTick tick(sim->scheduler(), progress);
     tick.arm();
     runner.run_until(end);

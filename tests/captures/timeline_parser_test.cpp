@@ -15,6 +15,7 @@
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/captures/timeline.hpp"
+#include "pbvbus/captures/timeline_render.hpp"
 
 namespace pbvbus::captures {
 namespace {
@@ -425,6 +426,9 @@ TEST(TimelineErrors, ExtremeTimestampsStayDefined) {
     EXPECT_EQ(f.start_ns, kMax);
     EXPECT_EQ(f.end_ns, kMax);
   }
+  // Drawing it must not fail either.
+  EXPECT_NE(to_html(*tl).find("pbvbus-data"), std::string::npos);
+  EXPECT_NE(to_svg(*tl).find("</svg>"), std::string::npos);
 }
 
 TEST(TimelineErrors, SeededMutationsNeverCrash) {
@@ -461,11 +465,51 @@ TEST(TimelineErrors, SeededMutationsNeverCrash) {
     auto tl = build_timeline(b, o, error);
     if (tl) {
       ++built;
+      // The drawings of whatever survived must be produced without trouble.
+      const std::string svg = to_svg(*tl);
+      EXPECT_NE(svg.find("</svg>"), std::string::npos);
+      if (round % 10 == 0) {
+        const std::string html = to_html(*tl);
+        EXPECT_EQ(html.find("</script>", html.find("pbvbus-data\">")),
+                  html.find("</script>\n<script>"));
+      }
     } else {
       EXPECT_FALSE(error.empty());
     }
   }
   EXPECT_GT(built, 50);
+}
+
+TEST(TimelineRender, Utf8AndEscaping) {
+  EXPECT_EQ(sanitize_utf8("ok \u00b5s \u2192"), "ok \u00b5s \u2192");
+  EXPECT_EQ(sanitize_utf8(std::string("a\xFF" "b", 3)), "a\uFFFDb");
+  EXPECT_EQ(sanitize_utf8(std::string("\xC0\xAF", 2)), "\uFFFD\uFFFD");  // overlong '/'
+  EXPECT_EQ(sanitize_utf8(std::string("\xED\xA0\x80", 3)), "\uFFFD\uFFFD\uFFFD");  // surrogate
+  EXPECT_EQ(sanitize_utf8(std::string("x\x01y\n", 4)), "x\uFFFDy\n");
+  EXPECT_EQ(sanitize_utf8(std::string("\xE2\x82", 2)), "\uFFFD\uFFFD");  // cut short
+
+  // Hostile interface names and event texts stay text.
+  bus::Scheduler sched;
+  bus::Line line(sched, "</script><b>&\"'", bus::Baud::k500);
+  test::MemorySink mem;
+  PcapngWriter w(mem.sink());
+  w.on_frame(test::tap_frame(line, kTok1to2, bus::kTicksPerMs));
+  EventRecord e;
+  e.text = std::string("</script><script>alert(1)</script>\xFF");
+  w.write_event(bus::kTicksPerMs, e);
+  w.flush();
+  const Timeline tl = build(mem.data);
+  const std::string html = to_html(tl);
+  EXPECT_EQ(html.find("<b>&"), std::string::npos);
+  EXPECT_EQ(html.find("alert(1)</script>"), std::string::npos);
+  // Exactly the two script blocks of the page close.
+  std::size_t closes = 0;
+  for (std::size_t p = html.find("</script>"); p != std::string::npos; p = html.find("</script>", p + 1))
+    ++closes;
+  EXPECT_EQ(closes, 2u);
+  const std::string svg = to_svg(tl);
+  EXPECT_NE(svg.find("&lt;/script&gt;&lt;b&gt;&amp;&quot;&#39;"), std::string::npos);
+  EXPECT_EQ(svg.find("<b>"), std::string::npos);
 }
 
 }  // namespace

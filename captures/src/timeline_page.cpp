@@ -303,12 +303,17 @@ function drawToken(s, L) {
 }
 
 function drawRuler(s, L) {
-  const y = L.yR;
   if (!L.speed) return;
+  s.push(`<g class="bit-axis" data-speed="${L.speed}">`);
+  drawRulerTicks(s, L);
+  s.push('</g>');
+}
+function drawRulerTicks(s, L) {
+  const y = L.yR;
   const bitNs = 1e9 / L.speed;
   const spanBits = (v1 - v0) / bitNs;
   if (spanBits > 6000) {
-    s.push(`<text x="${plotX + 4}" y="${y + 13}" font-size="10" fill="#9aa3ad">zoom in below ${fmtDur(6000 * bitNs)} for a bit-time axis</text>`);
+    s.push(`<text class="bit-axis-hint" x="${plotX + 4}" y="${y + 13}" font-size="10" fill="#9aa3ad">zoom in below ${fmtDur(6000 * bitNs)} for a bit-time axis</text>`);
     return;
   }
   const o = ref && ref.lane === L ? ref.t : 0;
@@ -318,7 +323,7 @@ function drawRuler(s, L) {
   for (let b = firstBit, k = 0; o + b * bitNs <= v1 && k < 400; b += step, k++) {
     const x = X(o + b * bitNs);
     s.push(`<line x1="${x.toFixed(2)}" y1="${y + 3}" x2="${x.toFixed(2)}" y2="${y + 8}" stroke="#495057"/>`);
-    s.push(`<text x="${x.toFixed(2)}" y="${y + 18}" text-anchor="middle" font-size="10" fill="#343a40">${group3(String(b))}</text>`);
+    s.push(`<text class="bit-tick" x="${x.toFixed(2)}" y="${y + 18}" text-anchor="middle" font-size="10" fill="#343a40">${group3(String(b))}</text>`);
   }
   if (spanBits <= 600) {
     const minor = step >= 10 ? step / 5 : (step >= 2 ? 1 : 0);

@@ -291,7 +291,7 @@ function drawToken(s, L) {
     if (w >= 1) {
       flush();
       s.push(`<rect x="${xa.toFixed(2)}" y="${y + 2}" width="${w.toFixed(2)}" height="${h - 4}" fill="${holderColour[hd]}"/>`);
-      const label = w >= 34 ? L.tp[i] + '\u2192' + hd : (w >= 12 ? String(hd) : '');
+      const label = w >= 26 ? L.tp[i] + '\u2192' + hd : (w >= 12 ? String(hd) : '');
       if (label) s.push(`<text x="${((xa + xb) / 2).toFixed(1)}" y="${y + h / 2 + 4}" text-anchor="middle" font-size="11" fill="#1d2126">${label}</text>`);
     } else {
       const p = Math.floor(xa - plotX);

@@ -527,7 +527,7 @@ void svg_token(SvgCtx& c, const TimelineLane& L, int y, const std::map<int, std:
              "\"><title>token holder " + std::to_string(s.holder) + " (passed by " +
              std::to_string(s.passed_by) + "), " + xml(fmt_dur(diff(s.start_ns, s.end_ns))) +
              "</title></rect>\n";
-      const std::string label = w >= 34 ? std::to_string(s.passed_by) + "\u2192" + std::to_string(s.holder)
+      const std::string label = w >= 26 ? std::to_string(s.passed_by) + "\u2192" + std::to_string(s.holder)
                                 : w >= 12 ? std::to_string(s.holder)
                                           : std::string();
       if (!label.empty())

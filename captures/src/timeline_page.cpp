@@ -366,7 +366,7 @@ function drawDx(s, L) {
 }
 
 function drawLabels(s, L) {
-  s.push(`<rect x="0" y="${L.y - 6}" width="${LABEL_W - 8}" height="${L.h + 12}" fill="#f7f8fa"/>`);
+  s.push(`<rect x="0" y="${L.y - 6}" width="${LABEL_W - 8}" height="${L.h + 12}" fill="#f7f8fa"><title>${esc(`interface ${L.iface}: ${L.name} \u2014 ${L.desc || 'no description'}, ${speedText(L.speed)}`)}</title></rect>`);
   s.push(`<text x="12" y="${L.yF + 13}" font-size="14" font-weight="600" fill="#1d2126">${esc(L.name || '(no name)')}</text>`);
   s.push(`<text x="12" y="${L.yF + 27}" font-size="11" fill="#68717d">${esc(speedText(L.speed))} \u00b7 if ${L.iface}</text>`);
   const r = (y, t) => s.push(`<text x="${LABEL_W - 12}" y="${y}" text-anchor="end" font-size="11" fill="#495057">${esc(t)}</text>`);
@@ -574,8 +574,9 @@ window.addEventListener('mouseup', ev => {
 });
 svg.addEventListener('dblclick', ev => { const [x] = localXY(ev); zoom(0.25, T(x)); });
 svg.addEventListener('wheel', ev => {
-  ev.preventDefault();
   const [x] = localXY(ev);
+  if (x < plotX) return;  // over the labels the wheel scrolls the page
+  ev.preventDefault();
   if (ev.shiftKey || Math.abs(ev.deltaX) > Math.abs(ev.deltaY)) {
     pan((ev.deltaX || ev.deltaY) / plotW);
   } else {

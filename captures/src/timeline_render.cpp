@@ -773,7 +773,7 @@ std::string to_html(const Timeline& tl, const TimelineHtmlOptions& opts) {
        "<th>lane / slave</th><th>masters</th><th>polls</th><th>no answer</th>"
        "<th>cycle min</th><th>median</th><th>max (bit times)</th></tr></thead>"
        "<tbody id=\"dxbody\"></tbody></table></section>\n"
-       "<p class=\"help\">Mouse wheel: zoom at the pointer \u00b7 drag or shift+wheel: pan \u00b7 "
+       "<p class=\"help\">Mouse wheel over the lanes: zoom at the pointer \u00b7 drag or shift+wheel: pan \u00b7 "
        "double click: zoom in \u00b7 keys + / \u2212 zoom, \u2190 / \u2192 pan, Home whole capture, "
        "r first view \u00b7 click a frame: count bit times from its end (Esc: back to 0 s) \u00b7 "
        "hover for details. Times are the capture's (virtual time of the run); a frame lasts 11 "
@@ -908,7 +908,11 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     c.o += "<g class=\"lane\" data-lane=\"" + xml(L.name) + "\">\n";
     c.o += "<rect x=\"0\" y=\"" + std::to_string(ly - 6) + "\" width=\"" +
            std::to_string(kLabelW - 8) + "\" height=\"" + std::to_string(lh + 12) +
-           "\" fill=\"#f7f8fa\"/>\n";
+           "\" fill=\"#f7f8fa\"><title>" +
+           xml("interface " + std::to_string(L.interface) + ": " + L.name + " \u2014 " +
+               (L.description.empty() ? std::string("no description") : L.description) + ", " +
+               speed_text(L.speed)) +
+           "</title></rect>\n";
     c.o += "<text x=\"12\" y=\"" + std::to_string(ly + 13) +
            "\" font-size=\"14\" font-weight=\"600\" fill=\"#1d2126\">" +
            xml(L.name.empty() ? std::string("(no name)") : L.name) + "</text>\n";

@@ -18,6 +18,7 @@ const Command kCommands[] = {
     {"run", pbvbus::tools::cmd_run, "run a scenario (built-in default without a file)"},
     {"gsd", pbvbus::tools::cmd_gsd, "read a GSD file and print what it describes"},
     {"inspect", pbvbus::tools::cmd_inspect, "summarise a pcapng capture (frames, errors, gaps, events)"},
+    {"timeline", pbvbus::tools::cmd_timeline, "draw a capture as an interactive HTML page or an SVG"},
 };
 
 void usage(std::ostream& os) {

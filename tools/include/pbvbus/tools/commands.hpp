@@ -14,5 +14,6 @@ using Args = std::vector<std::string>;
 int cmd_run(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err);
+int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace pbvbus::tools

@@ -1,0 +1,195 @@
+#pragma once
+// The model behind `pbvbus timeline CAPTURE` (issue 6, "a picture of the bus"): a capture read
+// into lanes of frames with their times on the wire, who held the token when, the DP cycle of
+// every slave, and the events. timeline_render.hpp draws it as HTML or SVG.
+//
+// Decisions:
+//  - One lane per interface with link type USER0 (147) or PROFIBUS_DL (257), in interface
+//    order, whether or not it has frames: a line, or one probe of a line when a capture has
+//    several interfaces on one line. The model draws what the file holds; it does not merge or
+//    split lanes. Interfaces of other link types except the events interface (USER1, 148) are
+//    counted in `skipped_interfaces` and otherwise ignored.
+//  - A frame lasts from its timestamp (the start bit of its first character) for 11 bit times
+//    per octet captured at the interface's if_speed: end_ns = start_ns +
+//    floor(octets * 11 * 10^9 / if_speed), in integer arithmetic. Without if_speed (or with an
+//    absurd one above 10^12 bit/s) a frame has no length (end_ns = start_ns) and nothing is
+//    given in bit times.
+//  - Frames of a lane are sorted by start time (stable: file order for equal starts). The file
+//    is in order of frame ends, and during a cut or a collision frames on one interface overlap.
+//  - Kind: Bad if epb_flags has a link-layer error bit (collision, CRC, partial, ...) or the FDL
+//    codec rejects the octets (also an intact frame that breaks an FDL rule); otherwise Token
+//    (SD4), SC (0xE5), or Request / Response by the FC octet's request bit (0x40).
+//  - idle_ns / idle_bits: from the end of the previous frame of the lane (in start order) to this
+//    frame's start; negative when the frames overlap. Bit times round to the nearest whole bit
+//    (ns timestamps are rounded down, a bit time at 1.5 Mbit/s is 666.67 ns).
+//  - Token holder: every Token frame hands the token to its DA, who holds it from the end of
+//    that frame to the start of the next Token frame of the lane (the last one to the end of the
+//    lane's last frame). A token that was not taken up (a retried pass) still makes a span: the
+//    model shows what the wire says, not what the stations believed.
+//  - DP cycle: a Data_Exchange request is an SRD (high or low) without a DSAP (the default SAP;
+//    as in inspect.hpp and the Lua dissector). Its answer is the first later frame of the lane
+//    (start order) that starts at least 10 bit times after the request's end (TSDR >= 11,
+//    less one for ns rounding) and is a Response from the request's DA to its SA, or an SC
+//    with no other station's request in between; unless the requester sends again first (a
+//    retry, its next request or its token pass). Frames of other stations in between are
+//    passed over because during a cable cut one interface carries both halves of the line (an
+//    SC of the other half can still be taken for the answer: SC carries no addresses). The
+//    search stops after 32 frames or 65536 bit times (more than the longest slot time). A slave address gets a row if it answered a
+//    Data_Exchange at least once in the capture; its polls are all the Data_Exchange requests
+//    to it, answered or not, and a poll's cycle time is the time since
+//    the previous Data_Exchange request to the same address on that lane (from start to start,
+//    whoever sent it; a retry after a missing answer therefore shows as a short cycle).
+//  - Events: every record of every USER1 interface, decoded with decode_event(); records that
+//    do not decode are counted in `bad_event_records`. Line events that inject a fault (cable cut,
+//    short circuit, noise on, power off, transceiver failure, babbling on) are faults; their
+//    opposites are repairs; everything else is a plain event.
+//  - Window [from_ns, to_ns): frames and token spans that overlap it, polls and events that
+//    start in it. Without a window: from the earliest record to 1 ns after the end of the
+//    latest frame or event (so that what happens last is inside; to_ns saturates at the int64
+//    limit, and a window ending there includes it). Token spans and cycle times are worked
+//    out on the whole capture first, so a window does not change them; the per-slave summary
+//    covers the polls in the window. Times are the capture's own (virtual time since the start
+//    of the run for pbvbus captures).
+//  - Errors: anything the reader rejects (not pcapng, truncated or malformed block) fails the
+//    whole build with the reader's message and offset: a partial picture of a broken file would
+//    look complete. So do an empty file, a capture without records, a capture without a line
+//    interface, and a window whose start is not before its end. Nothing here throws or reads
+//    outside a buffer on bad input.
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pbvbus/captures/event_record.hpp"
+#include "pbvbus/captures/pcapng_reader.hpp"
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::captures {
+
+enum class FrameKind : std::uint8_t { Token, Request, Response, Sc, Bad };
+/// "token", "request", "response", "SC", "bad"
+std::string_view to_string(FrameKind k);
+
+struct TimelineFrame {
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  FrameKind kind = FrameKind::Bad;
+  std::vector<std::uint8_t> bytes;
+  std::uint32_t flags = 0;  ///< epb_flags
+  std::string comment;      ///< opt_comment
+  /// Decoded by the FDL codec (then the fields below are valid; a frame with error flags may
+  /// still decode).
+  bool decoded = false;
+  fdl::FrameType type = fdl::FrameType::SC;
+  std::uint8_t da = 0;
+  std::uint8_t sa = 0;
+  std::uint8_t fc = 0;
+  std::optional<std::uint8_t> dsap;
+  std::optional<std::uint8_t> ssap;
+  std::size_t data_len = 0;  ///< DU octets after the extension octets
+  /// Why the frame is bad ("" if it is not): the writer's comment, else the epb_flags error
+  /// bits in words, plus the decoder's reason.
+  std::string problem;
+  std::optional<std::int64_t> idle_ns;    ///< since the end of the previous frame of the lane
+  std::optional<std::int64_t> idle_bits;  ///< idle_ns in bit times (needs if_speed)
+};
+
+struct TokenSpan {
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  std::uint8_t holder = 0;     ///< DA of the token frame
+  std::uint8_t passed_by = 0;  ///< SA of the token frame
+};
+
+struct DxPoll {
+  std::int64_t start_ns = 0;   ///< start of the Data_Exchange request
+  std::uint8_t master = 0;     ///< its SA
+  bool answered = false;
+  std::optional<std::int64_t> cycle_ns;  ///< since the previous Data_Exchange request to the slave
+};
+
+struct CycleStats {
+  std::uint64_t count = 0;  ///< polls in the window with a cycle time
+  std::int64_t min_ns = 0;
+  std::int64_t median_ns = 0;  ///< lower median
+  std::int64_t max_ns = 0;
+};
+
+struct SlaveCycles {
+  std::uint8_t address = 0;
+  std::vector<DxPoll> polls;  ///< in the window, in time order
+  std::uint64_t unanswered = 0;  ///< polls in the window without an answer
+  CycleStats cycle;
+};
+
+struct TimelineLane {
+  std::uint32_t interface = 0;  ///< pcapng interface index
+  std::string name;             ///< if_name
+  std::string description;      ///< if_description
+  std::uint16_t link_type = 0;
+  std::uint64_t speed = 0;  ///< if_speed in bit/s; 0 = unknown (also for absurd values)
+  std::vector<TimelineFrame> frames;  ///< in the window, by start time
+  std::vector<TokenSpan> token;       ///< in the window, by start time
+  std::vector<SlaveCycles> slaves;    ///< by address
+  std::uint64_t bad_frames = 0;       ///< in the window
+};
+
+enum class EventStyle : std::uint8_t { Fault, Repair, Event };
+std::string_view to_string(EventStyle s);  ///< "fault", "repair", "event"
+
+struct TimelineEvent {
+  std::int64_t ts_ns = 0;
+  std::uint32_t interface = 0;
+  EventRecord record;
+  EventStyle style = EventStyle::Event;
+};
+
+struct Timeline {
+  std::int64_t from_ns = 0;  ///< the window
+  std::int64_t to_ns = 0;
+  std::int64_t first_ns = 0;  ///< the whole capture: earliest record
+  std::int64_t last_ns = 0;   ///< end of the latest frame, or the latest event
+  std::vector<TimelineLane> lanes;
+  std::vector<TimelineEvent> events;  ///< in the window, by time
+  std::uint64_t records = 0;
+  std::uint64_t bad_event_records = 0;
+  std::uint64_t skipped_interfaces = 0;
+};
+
+struct TimelineOptions {
+  std::optional<std::int64_t> from_ns;
+  std::optional<std::int64_t> to_ns;
+};
+
+/// Reads everything `reader` still has. nullopt with a one-line reason in `error` on failure.
+std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptions& opts,
+                                       std::string& error);
+/// The same from a buffer (a copy is taken) or a file.
+std::optional<Timeline> build_timeline(std::span<const std::uint8_t> data,
+                                       const TimelineOptions& opts, std::string& error);
+std::optional<Timeline> read_timeline_file(const std::string& path, const TimelineOptions& opts,
+                                           std::string& error);
+
+/// Duration `ns` in bit times at `speed` bit/s, rounded to the nearest (halves away from zero).
+/// nullopt without a speed.
+std::optional<std::int64_t> ns_to_bits(std::int64_t ns, std::uint64_t speed);
+
+/// Length of `octets` characters on the wire in ns (rounded down); 0 without a speed.
+std::int64_t frame_duration_ns(std::size_t octets, std::uint64_t speed);
+
+/// Several lines of text describing a frame: frame type and direction, addresses, FC in words,
+/// SAPs and DP service, lengths, and for a bad frame why. No hex dump.
+std::string describe(const TimelineFrame& f);
+
+/// Parses "2s", "1500ms", "250us" (or "250µs"), "100ns", "1.25s" into ns, exactly. nullopt for
+/// anything else: no number, no or an unknown unit, a sign, more than 9 decimals of a second,
+/// overflow.
+std::optional<std::int64_t> parse_time_ns(std::string_view s);
+
+/// "2.000000000 s" style, for messages.
+std::string format_time_ns(std::int64_t ns);
+
+}  // namespace pbvbus::captures

@@ -1,0 +1,627 @@
+// Style sheet and script of the `pbvbus timeline` HTML page (see timeline_render.hpp for the
+// data the page reads).
+#include "timeline_page.hpp"
+
+namespace pbvbus::captures::detail {
+
+const char* const kTimelineCss = R"CSS(
+:root { --fg: #1d2126; --muted: #68717d; --line: #d5dae0; --bg: #ffffff; }
+* { box-sizing: border-box; }
+body { margin: 0; font: 13px/1.35 system-ui, "DejaVu Sans", Arial, sans-serif; color: var(--fg); background: var(--bg); }
+header { padding: 8px 14px 6px; border-bottom: 1px solid var(--line); background: #f7f8fa; }
+h1 { font-size: 16px; margin: 0 0 2px; font-weight: 600; }
+h1 .file { font-weight: 400; color: var(--muted); }
+#info { color: var(--muted); font-size: 12px; }
+.bar { display: flex; flex-wrap: wrap; align-items: center; gap: 6px 14px; margin-top: 6px; }
+.controls button { font: inherit; padding: 1px 9px; margin-right: 2px; border: 1px solid #b9c0c8; border-radius: 4px; background: #fff; cursor: pointer; }
+.controls button:hover { background: #eef3fb; }
+#status { font-variant-numeric: tabular-nums; color: var(--fg); }
+.legend { display: flex; flex-wrap: wrap; gap: 4px 12px; font-size: 12px; align-items: center; }
+.legend .sw { display: inline-block; width: 14px; height: 10px; margin-right: 4px; vertical-align: -1px; border-radius: 2px; }
+.legend .vl { display: inline-block; width: 3px; height: 12px; margin-right: 4px; vertical-align: -2px; }
+.legend b { font-weight: 600; margin-right: 2px; }
+#chart { position: relative; user-select: none; cursor: grab; }
+#chart.drag { cursor: grabbing; }
+#chart svg { display: block; }
+#chart text { font-family: system-ui, "DejaVu Sans", Arial, sans-serif; }
+#tip { position: fixed; z-index: 10; pointer-events: none; background: rgba(255,255,255,0.97); border: 1px solid #9aa3ad;
+       border-radius: 4px; padding: 6px 8px; font: 12px/1.35 ui-monospace, "DejaVu Sans Mono", monospace;
+       white-space: pre; max-width: 720px; box-shadow: 0 2px 8px rgba(0,0,0,0.18); }
+#tip[hidden] { display: none; }
+section { padding: 6px 14px 10px; }
+h2 { font-size: 14px; margin: 6px 0; font-weight: 600; }
+table { border-collapse: collapse; font-variant-numeric: tabular-nums; }
+th, td { border-bottom: 1px solid var(--line); padding: 2px 10px 2px 0; text-align: right; white-space: nowrap; }
+th { color: var(--muted); font-weight: 600; }
+td:first-child, th:first-child { text-align: left; }
+.help { color: var(--muted); font-size: 12px; margin: 4px 14px 14px; }
+)CSS";
+
+const char* const kTimelineJs = R"JS(
+(function () {
+'use strict';
+const D = JSON.parse(document.getElementById('pbvbus-data').textContent);
+const KIND_NAMES = ['token', 'request', 'response', 'SC', 'bad'];
+const KIND_COLOURS = ['#8446c2', '#2468c9', '#2f9e48', '#13a3b4', '#e03131'];
+const HOLDER_COLOURS = ['#f6bd60', '#90caf9', '#b8e0a0', '#f7a8c4', '#cdb4f0', '#ffe08a', '#9fd8cb',
+  '#f4a582', '#c7d2fe', '#d9ed92', '#e5c3a6', '#a5d8ff'];
+const EVENT_COLOURS = { fault: '#e8590c', repair: '#2b8a3e', event: '#5f3dc4' };
+const DX_OK = '#3f9b57', DX_MISS = '#e03131';
+const LABEL_W = 210, AXIS_H = 34, EV_H = 46, PAD_R = 18;
+const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18;
+const MIN_SPAN = 100;  // ns: a few bit times even at 12 Mbit/s
+
+const chart = document.getElementById('chart');
+const svg = document.getElementById('svg');
+const tip = document.getElementById('tip');
+const status = document.getElementById('status');
+const origin = Number(D.origin);
+const ents = D.ent;
+const entLen = ents.map(e => e[0].length / 2);
+
+function esc(s) {
+  return String(s).replace(/[&<>"']/g, c => ({ '&': '&amp;', '<': '&lt;', '>': '&gt;', '"': '&quot;', "'": '&#39;' }[c]));
+}
+function lowerBound(a, x, lo, hi) {
+  lo = lo || 0; hi = hi === undefined ? a.length : hi;
+  while (lo < hi) { const m = (lo + hi) >>> 1; if (a[m] < x) lo = m + 1; else hi = m; }
+  return lo;
+}
+function bitsOf(ns, speed) {
+  if (!speed) return null;
+  const v = ns * speed / 1e9;
+  return v < 0 ? -Math.round(-v) : Math.round(v);
+}
+function speedText(s) {
+  if (!s) return 'speed unknown';
+  if (s >= 1e6) return (s / 1e6).toString() + ' Mbit/s';
+  if (s >= 1e3) return (s / 1e3).toString() + ' kbit/s';
+  return s + ' bit/s';
+}
+function group3(digits) { return digits.replace(/(\d{3})(?=\d)/g, '$1\u2009'); }
+// Absolute time of a relative time, as seconds with `dec` decimals (0..9), digits grouped.
+function fmtAbs(t, dec) {
+  let ns = Math.round(origin + t);
+  const neg = ns < 0; if (neg) ns = -ns;
+  const s = Math.floor(ns / 1e9);
+  let frac = String(ns - s * 1e9).padStart(9, '0').slice(0, dec);
+  return (neg ? '-' : '') + s + (dec > 0 ? '.' + group3(frac) : '') + ' s';
+}
+function fmtDur(ns) {
+  const a = Math.abs(ns);
+  if (a < 1e3) return ns.toFixed(0) + ' ns';
+  if (a < 1e6) return (ns / 1e3).toFixed(3) + ' \u00b5s';
+  if (a < 1e9) return (ns / 1e6).toFixed(3) + ' ms';
+  return (ns / 1e9).toFixed(6) + ' s';
+}
+function fmtBits(ns, speed) {
+  const b = bitsOf(ns, speed);
+  return b === null ? '' : ' = ' + b + ' bit times';
+}
+function niceStep(raw) {
+  const p = Math.pow(10, Math.floor(Math.log10(raw)));
+  const m = raw / p;
+  return (m <= 1 ? 1 : m <= 2 ? 2 : m <= 5 ? 5 : 10) * p;
+}
+function hexSpaced(h) { return h.replace(/(..)(?!$)/g, '$1 '); }
+
+// ---- data -------------------------------------------------------------------------------
+const holderSet = new Set();
+const lanes = D.lanes.map(L => {
+  const n = L.t.length;
+  const start = new Float64Array(n), end = new Float64Array(n), kind = new Uint8Array(n);
+  let t = 0, maxDur = 0;
+  for (let i = 0; i < n; i++) {
+    t += L.t[i]; start[i] = t;
+    const e = L.e[i];
+    const dur = L.speed > 0 ? Math.floor(entLen[e] * 11e9 / L.speed) : 0;
+    end[i] = t + dur; kind[i] = ents[e][1];
+    if (dur > maxDur) maxDur = dur;
+  }
+  const m = L.tk.length;
+  const ts = new Float64Array(m), te = new Float64Array(m);
+  t = 0;
+  for (let i = 0; i < m; i++) { t += L.tk[i]; ts[i] = t; te[i] = t + L.tl[i]; holderSet.add(L.th[i]); }
+  const dx = L.dx.map(S => {
+    const k = S.t.length, tt = new Float64Array(k);
+    let u = 0;
+    for (let i = 0; i < k; i++) { u += S.t[i]; tt[i] = u; }
+    return { a: S.a, t: tt, c0: S.c0, m: S.m, un: S.un, unSet: new Set(S.un) };
+  });
+  return { name: L.name, desc: L.desc, speed: L.speed, iface: L['if'], start, end, kind, maxDur,
+           e: L.e, ts, te, th: L.th, tp: L.tp, dx };
+});
+const holders = Array.from(holderSet).sort((a, b) => a - b);
+const holderColour = {};
+holders.forEach((h, i) => { holderColour[h] = HOLDER_COLOURS[i % HOLDER_COLOURS.length]; });
+const events = D.ev.map(e => ({ t: e[0], style: e[1], cat: e[2], text: e[3] }));
+const evTimes = Float64Array.from(events.map(e => e.t));
+
+// ---- view -------------------------------------------------------------------------------
+const full = [D.span[0], D.span[1]];
+if (!(full[1] > full[0])) full[1] = full[0] + 1000;
+const initial = [D.view[0], D.view[1]];
+let v0 = initial[0], v1 = initial[1];
+let ref = null;  // bit ruler origin: {lane, t, what}
+(function fromHash() {
+  const m = /^#v=(-?[\d.e+]+),(-?[\d.e+]+)$/.exec(location.hash);
+  if (m) { const a = Number(m[1]), b = Number(m[2]); if (b > a) { v0 = a; v1 = b; } }
+})();
+
+let plotX = LABEL_W, plotW = 800, scale = 1, totalH = 0;
+function X(t) { return plotX + (t - v0) * scale; }
+function T(x) { return v0 + (x - plotX) / scale; }
+
+function setView(a, b) {
+  let span = b - a;
+  const maxSpan = (full[1] - full[0]) * 1.5 + MIN_SPAN;
+  if (span < MIN_SPAN) { const c = (a + b) / 2; a = c - MIN_SPAN / 2; b = c + MIN_SPAN / 2; span = MIN_SPAN; }
+  if (span > maxSpan) { const c = (a + b) / 2; a = c - maxSpan / 2; b = c + maxSpan / 2; span = maxSpan; }
+  const lo = full[0] - span * 0.5, hi = full[1] + span * 0.5;
+  if (a < lo) { a = lo; b = lo + span; }
+  if (b > hi) { b = hi; a = hi - span; }
+  v0 = a; v1 = b;
+  schedule();
+}
+function zoom(f, at) {
+  if (at === undefined) at = (v0 + v1) / 2;
+  setView(at - (at - v0) * f, at + (v1 - at) * f);
+}
+function pan(frac) { const d = (v1 - v0) * frac; setView(v0 + d, v1 + d); }
+
+let pending = false;
+function schedule() {
+  if (pending) return;
+  pending = true;
+  requestAnimationFrame(() => { pending = false; render(); });
+}
+
+// ---- layout -----------------------------------------------------------------------------
+function layout() {
+  let y = AXIS_H + EV_H;
+  for (const L of lanes) {
+    L.y = y;
+    L.yF = y; L.yT = L.yF + ROW_FRAMES + 3; L.yR = L.yT + ROW_TOKEN + 2; L.yD = L.yR + ROW_RULER;
+    L.h = L.yD + L.dx.length * ROW_DX - y;
+    y += L.h + LANE_GAP;
+  }
+  totalH = y;
+}
+layout();
+
+// ---- drawing ----------------------------------------------------------------------------
+function drawAxis(s) {
+  const span = v1 - v0;
+  const step = niceStep(span / Math.max(2, plotW / 130));
+  const dec = Math.max(0, Math.min(9, Math.ceil(-Math.log10(step / 1e9) - 1e-9)));
+  s.push('<g class="axis">');
+  s.push(`<rect x="0" y="0" width="${plotX + plotW + PAD_R}" height="${AXIS_H}" fill="#f7f8fa"/>`);
+  s.push(`<text x="${LABEL_W - 10}" y="21" text-anchor="end" font-size="12" fill="#68717d">time</text>`);
+  const first = Math.ceil((origin + v0) / step) * step - origin;
+  for (let t = first, k = 0; t <= v1 && k < 200; t += step, k++) {
+    const x = X(t);
+    s.push(`<line x1="${x.toFixed(1)}" y1="${AXIS_H - 8}" x2="${x.toFixed(1)}" y2="${totalH}" stroke="#e6e9ed"/>`);
+    s.push(`<line x1="${x.toFixed(1)}" y1="${AXIS_H - 8}" x2="${x.toFixed(1)}" y2="${AXIS_H}" stroke="#68717d"/>`);
+    const anchor = x < plotX + 40 ? 'start' : (x > plotX + plotW - 40 ? 'end' : 'middle');
+    s.push(`<text x="${x.toFixed(1)}" y="${AXIS_H - 12}" text-anchor="${anchor}" font-size="11" fill="#1d2126">${esc(fmtAbs(t, dec))}</text>`);
+  }
+  s.push(`<line x1="${plotX}" y1="${AXIS_H}" x2="${plotX + plotW}" y2="${AXIS_H}" stroke="#68717d"/>`);
+  s.push('</g>');
+}
+
+function frameRange(L) {
+  return [lowerBound(L.start, v0 - L.maxDur), lowerBound(L.start, v1)];
+}
+
+let drawnFrames = 0;
+function drawFrames(s, L) {
+  const [i0, i1] = frameRange(L);
+  const y = L.yF, h = ROW_FRAMES;
+  s.push(`<rect x="${plotX}" y="${y}" width="${plotW}" height="${h}" fill="#fbfbfc" stroke="#e2e5e9"/>`);
+  let n = 0;
+  for (let i = i0; i < i1; i++) if (L.end[i] > v0 || L.end[i] === L.start[i]) n++;
+  if (n <= 2500) {
+    for (let i = i0; i < i1; i++) {
+      if (!(L.end[i] > v0 || L.end[i] === L.start[i])) continue;
+      const xa = Math.max(plotX, X(L.start[i])), xb = Math.min(plotX + plotW, X(L.end[i]));
+      const w = Math.max(1, xb - xa);
+      const k = L.kind[i];
+      s.push(`<rect x="${xa.toFixed(2)}" y="${y + 3}" width="${w.toFixed(2)}" height="${h - 6}" fill="${KIND_COLOURS[k]}"/>`);
+      if (w > 34) {
+        const label = D.desc[ents[L.e[i]][3]];
+        const fit = Math.floor((w - 6) / 6.4);
+        if (fit >= 3) {
+          const txt = label.length > fit ? label.slice(0, fit - 1) + '\u2026' : label;
+          s.push(`<text x="${(xa + 3).toFixed(2)}" y="${y + h / 2 + 4}" font-size="11" fill="#fff">${esc(txt)}</text>`);
+        }
+      }
+      drawnFrames++;
+    }
+    return;
+  }
+  // Aggregated: per pixel the time share of each kind; colour of the largest share (bad wins),
+  // opacity by how busy the pixel is.
+  const W = Math.ceil(plotW), occ = new Float32Array(W * 5);
+  for (let i = i0; i < i1; i++) {
+    const a = (L.start[i] - v0) * scale, b = (L.end[i] - v0) * scale;
+    if (b <= 0 && b !== a) continue;
+    const k = L.kind[i];
+    let p = Math.max(0, Math.floor(a));
+    const pe = Math.min(W - 1, Math.floor(b));
+    if (a === b) { if (p < W) occ[p * 5 + k] += 0.15; continue; }
+    for (; p <= pe; p++) {
+      const ov = Math.min(b, p + 1) - Math.max(a, p);
+      if (ov > 0) occ[p * 5 + k] += ov;
+    }
+    drawnFrames++;
+  }
+  let runStart = -1, runKey = '';
+  const flush = (end) => {
+    if (runStart < 0) return;
+    const [k, o] = runKey.split('/');
+    s.push(`<rect x="${plotX + runStart}" y="${y + 3}" width="${end - runStart}" height="${h - 6}" fill="${KIND_COLOURS[k]}" fill-opacity="${o}"/>`);
+    runStart = -1;
+  };
+  for (let p = 0; p < W; p++) {
+    let tot = 0, best = -1, bv = 0;
+    for (let k = 0; k < 5; k++) { const v = occ[p * 5 + k]; tot += v; if (v > bv) { bv = v; best = k; } }
+    if (occ[p * 5 + 4] > 0) best = 4;
+    const key = best < 0 ? '' : best + '/' + (0.3 + 0.7 * Math.min(1, tot)).toFixed(1);
+    if (key !== runKey) { flush(p); if (key) runStart = p; runKey = key; }
+  }
+  flush(W);
+}
+
+function drawToken(s, L) {
+  const y = L.yT, h = ROW_TOKEN;
+  s.push(`<rect x="${plotX}" y="${y}" width="${plotW}" height="${h}" fill="#fbfbfc" stroke="#e2e5e9"/>`);
+  const i0 = Math.max(0, lowerBound(L.te, v0)), i1 = lowerBound(L.ts, v1);
+  let bucket = -1, acc = {};
+  const flush = () => {
+    if (bucket < 0) return;
+    let best = null, bv = -1;
+    for (const k in acc) if (acc[k] > bv) { bv = acc[k]; best = k; }
+    s.push(`<rect x="${plotX + bucket}" y="${y + 2}" width="1" height="${h - 4}" fill="${holderColour[best]}"/>`);
+    bucket = -1; acc = {};
+  };
+  for (let i = i0; i < i1; i++) {
+    const xa = Math.max(plotX, X(L.ts[i])), xb = Math.min(plotX + plotW, X(L.te[i]));
+    if (xb < plotX) continue;
+    const w = xb - xa, hd = L.th[i];
+    if (w >= 1) {
+      flush();
+      s.push(`<rect x="${xa.toFixed(2)}" y="${y + 2}" width="${w.toFixed(2)}" height="${h - 4}" fill="${holderColour[hd]}"/>`);
+      const label = w >= 26 ? L.tp[i] + '\u2192' + hd : (w >= 12 ? String(hd) : '');
+      if (label) s.push(`<text x="${((xa + xb) / 2).toFixed(1)}" y="${y + h / 2 + 4}" text-anchor="middle" font-size="11" fill="#1d2126">${label}</text>`);
+    } else {
+      const p = Math.floor(xa - plotX);
+      if (p !== bucket) { flush(); bucket = p; }
+      acc[hd] = (acc[hd] || 0) + w;
+    }
+  }
+  flush();
+}
+
+function drawRuler(s, L) {
+  if (!L.speed) return;
+  s.push(`<g class="bit-axis" data-speed="${L.speed}">`);
+  drawRulerTicks(s, L);
+  s.push('</g>');
+}
+function drawRulerTicks(s, L) {
+  const y = L.yR;
+  const bitNs = 1e9 / L.speed;
+  const spanBits = (v1 - v0) / bitNs;
+  if (spanBits > 6000) {
+    s.push(`<text class="bit-axis-hint" x="${plotX + 4}" y="${y + 13}" font-size="10" fill="#9aa3ad">zoom in below ${fmtDur(6000 * bitNs)} for a bit-time axis</text>`);
+    return;
+  }
+  const o = ref && ref.lane === L ? ref.t : 0;
+  const step = Math.max(1, niceStep(spanBits / Math.max(2, plotW / 90)));
+  s.push(`<line x1="${plotX}" y1="${y + 3}" x2="${plotX + plotW}" y2="${y + 3}" stroke="#495057"/>`);
+  const firstBit = Math.ceil((v0 - o) / bitNs / step) * step;
+  for (let b = firstBit, k = 0; o + b * bitNs <= v1 && k < 400; b += step, k++) {
+    const x = X(o + b * bitNs);
+    s.push(`<line x1="${x.toFixed(2)}" y1="${y + 3}" x2="${x.toFixed(2)}" y2="${y + 8}" stroke="#495057"/>`);
+    s.push(`<text class="bit-tick" x="${x.toFixed(2)}" y="${y + 18}" text-anchor="middle" font-size="10" fill="#343a40">${group3(String(b))}</text>`);
+  }
+  if (spanBits <= 600) {
+    const minor = step >= 10 ? step / 5 : (step >= 2 ? 1 : 0);
+    if (minor) {
+      const fb = Math.ceil((v0 - o) / bitNs / minor) * minor;
+      for (let b = fb, k = 0; o + b * bitNs <= v1 && k < 1000; b += minor, k++) {
+        const x = X(o + b * bitNs);
+        s.push(`<line x1="${x.toFixed(2)}" y1="${y + 3}" x2="${x.toFixed(2)}" y2="${y + 5}" stroke="#868e96"/>`);
+      }
+    }
+  }
+  if (ref && ref.lane === L && ref.t >= v0 && ref.t <= v1) {
+    const x = X(ref.t);
+    s.push(`<line x1="${x.toFixed(2)}" y1="${L.yF}" x2="${x.toFixed(2)}" y2="${y + 8}" stroke="#212529" stroke-dasharray="3,2"/>`);
+  }
+}
+
+function drawDx(s, L) {
+  L.dx.forEach((S, j) => {
+    const y = L.yD + j * ROW_DX;
+    s.push(`<rect x="${plotX}" y="${y}" width="${plotW}" height="${ROW_DX - 1}" fill="${j % 2 ? '#fbfbfc' : '#f4f6f8'}"/>`);
+    const i0 = lowerBound(S.t, v0), i1 = lowerBound(S.t, v1);
+    const dense = (i1 - i0) > plotW / 3;
+    let last = -1e9;
+    for (let i = i0; i < i1; i++) {
+      const x = X(S.t[i]);
+      const miss = S.unSet.has(i);
+      if (dense && !miss && x - last < 1) continue;
+      last = x;
+      s.push(`<rect x="${(x - 0.5).toFixed(2)}" y="${y + 2}" width="${dense ? 1 : 2}" height="${ROW_DX - 5}" fill="${miss ? DX_MISS : DX_OK}"/>`);
+      if (!dense && i + 1 < S.t.length) {
+        const x2 = X(S.t[i + 1]);
+        if (x2 - x > 70) {
+          const c = S.t[i + 1] - S.t[i];
+          s.push(`<text x="${((x + Math.min(x2, plotX + plotW)) / 2).toFixed(1)}" y="${y + ROW_DX - 4}" text-anchor="middle" font-size="10" fill="#495057">${esc(fmtDur(c))}</text>`);
+        }
+      }
+    }
+  });
+}
+
+function drawLabels(s, L) {
+  s.push(`<rect x="0" y="${L.y - 6}" width="${LABEL_W - 8}" height="${L.h + 12}" fill="#f7f8fa"><title>${esc(`interface ${L.iface}: ${L.name} \u2014 ${L.desc || 'no description'}, ${speedText(L.speed)}`)}</title></rect>`);
+  s.push(`<text x="12" y="${L.yF + 13}" font-size="14" font-weight="600" fill="#1d2126">${esc(L.name || '(no name)')}</text>`);
+  s.push(`<text x="12" y="${L.yF + 27}" font-size="11" fill="#68717d">${esc(speedText(L.speed))} \u00b7 if ${L.iface}</text>`);
+  const r = (y, t) => s.push(`<text x="${LABEL_W - 12}" y="${y}" text-anchor="end" font-size="11" fill="#495057">${esc(t)}</text>`);
+  r(L.yT + 13, 'token holder');
+  r(L.yR + 14, ref && ref.lane === L ? 'bit times from ref' : 'bit times');
+  L.dx.forEach((S, j) => r(L.yD + j * ROW_DX + 11, 'DX slave ' + S.a));
+}
+
+function drawEvents(s) {
+  const i0 = lowerBound(evTimes, v0), i1 = lowerBound(evTimes, v1 + 1e-9);
+  // Group events closer than 4 px; stagger the labels over three rows.
+  const groups = [];
+  for (let i = i0; i < i1; i++) {
+    const x = X(events[i].t);
+    const g = groups[groups.length - 1];
+    if (g && x - g.x < 4) g.items.push(events[i]); else groups.push({ x, items: [events[i]] });
+  }
+  const rowEnd = [-1e9, -1e9, -1e9];
+  for (const g of groups) {
+    const style = g.items.some(e => e.style === 'fault') ? 'fault' : g.items[0].style;
+    const col = EVENT_COLOURS[style] || EVENT_COLOURS.event;
+    s.push(`<line x1="${g.x.toFixed(2)}" y1="${AXIS_H + 2}" x2="${g.x.toFixed(2)}" y2="${totalH - LANE_GAP + 4}" stroke="${col}" stroke-width="2" stroke-opacity="0.85"${style === 'fault' ? '' : ' stroke-dasharray="5,3"'}/>`);
+    let label = g.items[0].text;
+    if (label.length > 60) label = label.slice(0, 59) + '\u2026';
+    if (g.items.length > 1) label += ` (+${g.items.length - 1})`;
+    const w = label.length * 6.2 + 8;
+    let row = rowEnd.findIndex(e => g.x + 4 > e);
+    if (row < 0) continue;
+    rowEnd[row] = g.x + 4 + w;
+    const ty = AXIS_H + 13 + row * 14;
+    s.push(`<text x="${(g.x + 4).toFixed(1)}" y="${ty}" font-size="11" fill="${col}" font-weight="600">${esc(label)}</text>`);
+  }
+}
+
+function render() {
+  const W = Math.max(600, chart.clientWidth || 1200);
+  plotX = LABEL_W; plotW = W - LABEL_W - PAD_R; scale = plotW / (v1 - v0);
+  drawnFrames = 0;
+  const s = [];
+  s.push(`<defs><clipPath id="plotclip"><rect x="${plotX}" y="0" width="${plotW}" height="${totalH}"/></clipPath></defs>`);
+  drawAxis(s);
+  for (const L of lanes) {
+    s.push(`<g class="lane" data-lane="${esc(L.name)}" data-interface="${L.iface}" data-frames="${L.start.length}">`);
+    drawLabels(s, L);
+    s.push('<g clip-path="url(#plotclip)">');
+    drawFrames(s, L); drawToken(s, L); drawRuler(s, L); drawDx(s, L);
+    s.push('</g></g>');
+  }
+  s.push('<g class="events" clip-path="url(#plotclip)">');
+  drawEvents(s);
+  s.push('</g>');
+  svg.setAttribute('width', W);
+  svg.setAttribute('height', totalH);
+  svg.setAttribute('viewBox', `0 0 ${W} ${totalH}`);
+  svg.innerHTML = s.join('');
+  status.textContent = `view ${fmtAbs(v0, 6)} \u2013 ${fmtAbs(v1, 6)}  (${fmtDur(v1 - v0)})`;
+  updateSummary();
+  document.body.dataset.rendered = '1';
+  document.body.dataset.framesDrawn = String(drawnFrames);
+  document.body.dataset.lanes = String(lanes.length);
+  if (history.replaceState) history.replaceState(null, '', '#v=' + Math.round(v0) + ',' + Math.round(v1));
+}
+
+// ---- DP cycle table ---------------------------------------------------------------------
+function updateSummary() {
+  const rows = [];
+  for (const L of lanes) {
+    const [i0, i1] = frameRange(L);
+    const counts = [0, 0, 0, 0, 0];
+    for (let i = i0; i < i1; i++) if (L.end[i] > v0) counts[L.kind[i]]++;
+    rows.push(`<tr class="lane-row" data-lane="${esc(L.name)}"><td><b>${esc(L.name)}</b> (${esc(speedText(L.speed))})</td><td colspan="6" style="text-align:left">frames in view: ${counts.map((c, k) => KIND_NAMES[k] + ' ' + c).join(', ')}</td></tr>`);
+    for (const S of L.dx) {
+      const a = lowerBound(S.t, v0), b = lowerBound(S.t, v1);
+      const cyc = [];
+      let miss = 0;
+      for (let i = a; i < b; i++) {
+        if (S.unSet.has(i)) miss++;
+        if (i > 0) cyc.push(S.t[i] - S.t[i - 1]); else if (S.c0 >= 0) cyc.push(S.c0);
+      }
+      cyc.sort((x, y) => x - y);
+      const f = v => cyc.length ? `${(v / 1e3).toFixed(1)} \u00b5s` + (L.speed ? ` (${bitsOf(v, L.speed)})` : '') : '\u2013';
+      const masters = S.m.join(', ');
+      rows.push(`<tr data-slave="${S.a}"><td>slave ${S.a}</td><td>${esc(masters)}</td><td>${b - a}</td><td>${miss}</td>` +
+        `<td>${f(cyc[0])}</td><td>${f(cyc[(cyc.length - 1) >> 1])}</td><td>${f(cyc[cyc.length - 1])}</td></tr>`);
+    }
+  }
+  document.getElementById('dxbody').innerHTML = rows.join('');
+}
+
+// ---- tooltips ---------------------------------------------------------------------------
+function frameText(L, i, inPixel) {
+  const e = ents[L.e[i]];
+  const lines = [];
+  lines.push(`${KIND_NAMES[L.kind[i]].toUpperCase()}   lane ${L.name}, frame ${i + 1} of ${L.start.length}`);
+  if (inPixel > 1) lines.push(`(${inPixel} frames under the pointer: zoom in)`);
+  lines.push(`start ${fmtAbs(L.start[i], 9)}   length ${fmtDur(L.end[i] - L.start[i])}${fmtBits(L.end[i] - L.start[i], L.speed)}`);
+  if (i > 0) {
+    const gap = L.start[i] - L.end[i - 1], d = L.start[i] - L.start[i - 1];
+    lines.push(gap >= 0 ? `idle before: ${fmtDur(gap)}${fmtBits(gap, L.speed)} (since the end of the previous frame)`
+                        : `overlaps the previous frame by ${fmtDur(-gap)}${fmtBits(-gap, L.speed)}`);
+    lines.push(`since the previous start: ${fmtDur(d)}${fmtBits(d, L.speed)}`);
+  }
+  lines.push('');
+  lines.push(D.desc[e[2]]);
+  lines.push('');
+  const hx = hexSpaced(e[0]);
+  for (let k = 0; k < hx.length; k += 48) lines.push((k === 0 ? 'hex  ' : '     ') + hx.slice(k, k + 48));
+  return lines.join('\n');
+}
+
+function hitTest(x, y) {
+  if (x < plotX || x > plotX + plotW) return null;
+  const t = T(x), tol = 3 / scale;
+  if (y >= AXIS_H && y < AXIS_H + EV_H) return eventText(t, tol);
+  for (const L of lanes) {
+    if (y < L.y || y >= L.y + L.h) continue;
+    if (y < L.yF + ROW_FRAMES) {
+      let i = lowerBound(L.start, t - L.maxDur - tol), best = -1, bd = Infinity, cnt = 0;
+      const i1 = lowerBound(L.start, t + tol);
+      for (; i < i1; i++) {
+        if (L.end[i] < t - tol) continue;
+        cnt++;
+        const d = t < L.start[i] ? L.start[i] - t : (t > L.end[i] ? t - L.end[i] : 0);
+        if (d < bd || (d === 0 && bd === 0)) { bd = d; best = i; }
+      }
+      return best >= 0 ? frameText(L, best, cnt) : null;
+    }
+    if (y >= L.yT && y < L.yT + ROW_TOKEN) {
+      const i = lowerBound(L.ts, t + 1e-9) - 1;
+      if (i < 0 || L.te[i] < t - tol) return null;
+      const d = L.te[i] - L.ts[i];
+      return `TOKEN HOLDER ${L.th[i]}   lane ${L.name}\npassed by ${L.tp[i]} at ${fmtAbs(L.ts[i], 9)}\nheld for ${fmtDur(d)}${fmtBits(d, L.speed)}\n(until the next token frame starts)`;
+    }
+    if (y >= L.yD) {
+      const S = L.dx[Math.floor((y - L.yD) / ROW_DX)];
+      if (!S) return null;
+      const j = lowerBound(S.t, t - tol);
+      if (j >= S.t.length || S.t[j] > t + tol) return null;
+      const c = j > 0 ? S.t[j] - S.t[j - 1] : (S.c0 >= 0 ? S.c0 : null);
+      const m = S.m;
+      return `DATA_EXCHANGE to slave ${S.a}   lane ${L.name}\nrequest at ${fmtAbs(S.t[j], 9)}` +
+        (m.length === 1 ? ` from master ${m[0]}` : '') + `\n` +
+        (S.unSet.has(j) ? 'NOT ANSWERED\n' : 'answered\n') +
+        (c === null ? 'first poll: no cycle time' : `DP cycle (since the previous request): ${fmtDur(c)}${fmtBits(c, L.speed)}`);
+    }
+    return null;
+  }
+  return eventText(t, tol);
+}
+
+function eventText(t, tol) {
+  const i0 = lowerBound(evTimes, t - tol), i1 = lowerBound(evTimes, t + tol + 1e-9);
+  if (i0 >= i1) return null;
+  const lines = [];
+  for (let i = i0; i < i1 && lines.length < 20; i++) {
+    const e = events[i];
+    lines.push(`${fmtAbs(e.t, 9)}  [${e.style}, ${e.cat}] ${e.text}`);
+  }
+  if (i1 - i0 > 20) lines.push(`\u2026 and ${i1 - i0 - 20} more`);
+  return lines.join('\n');
+}
+
+// ---- input ------------------------------------------------------------------------------
+let drag = null;
+function localXY(ev) { const r = svg.getBoundingClientRect(); return [ev.clientX - r.left, ev.clientY - r.top]; }
+svg.addEventListener('mousemove', ev => {
+  const [x, y] = localXY(ev);
+  if (drag) {
+    const dx = x - drag.x;
+    if (Math.abs(dx) > 2) drag.moved = true;
+    if (drag.moved) { const d = dx / scale; v0 = drag.v0 - d; v1 = drag.v1 - d; setView(v0, v1); }
+    tip.hidden = true;
+    return;
+  }
+  const text = hitTest(x, y);
+  if (!text) { tip.hidden = true; return; }
+  tip.textContent = text;
+  tip.hidden = false;
+  const w = tip.offsetWidth, h = tip.offsetHeight;
+  let left = ev.clientX + 14, top = ev.clientY + 14;
+  if (left + w > window.innerWidth - 4) left = Math.max(4, ev.clientX - w - 14);
+  if (top + h > window.innerHeight - 4) top = Math.max(4, ev.clientY - h - 14);
+  tip.style.left = left + 'px'; tip.style.top = top + 'px';
+});
+svg.addEventListener('mouseleave', () => { tip.hidden = true; });
+svg.addEventListener('mousedown', ev => {
+  const [x] = localXY(ev);
+  drag = { x, v0, v1, moved: false };
+  chart.classList.add('drag');
+});
+window.addEventListener('mouseup', ev => {
+  if (!drag) return;
+  const moved = drag.moved;
+  drag = null;
+  chart.classList.remove('drag');
+  if (moved) return;
+  // A click on a frame makes its end the origin of that lane's bit-time axis.
+  const [x, y] = localXY(ev);
+  for (const L of lanes) {
+    if (y < L.yF || y >= L.yF + ROW_FRAMES || x < plotX) continue;
+    const t = T(x);
+    const i = lowerBound(L.start, t + 1e-9) - 1;
+    if (i >= 0 && L.end[i] >= t - 3 / scale) { ref = { lane: L, t: L.end[i] }; schedule(); }
+  }
+});
+svg.addEventListener('dblclick', ev => { const [x] = localXY(ev); zoom(0.25, T(x)); });
+svg.addEventListener('wheel', ev => {
+  const [x] = localXY(ev);
+  if (x < plotX) return;  // over the labels the wheel scrolls the page
+  ev.preventDefault();
+  if (ev.shiftKey || Math.abs(ev.deltaX) > Math.abs(ev.deltaY)) {
+    pan((ev.deltaX || ev.deltaY) / plotW);
+  } else {
+    zoom(Math.exp(ev.deltaY * 0.0015), Math.max(v0, Math.min(v1, T(x))));
+  }
+}, { passive: false });
+document.addEventListener('keydown', ev => {
+  if (ev.ctrlKey || ev.metaKey || ev.altKey) return;
+  const k = ev.key;
+  if (k === '+' || k === '=') zoom(0.5);
+  else if (k === '-' || k === '_') zoom(2);
+  else if (k === 'ArrowLeft') pan(-0.2);
+  else if (k === 'ArrowRight') pan(0.2);
+  else if (k === 'Home' || k === '0') setView(full[0], full[1]);
+  else if (k === 'r' || k === 'R') setView(initial[0], initial[1]);
+  else if (k === 'Escape') { ref = null; schedule(); }
+  else return;
+  ev.preventDefault();
+});
+document.querySelectorAll('.controls button').forEach(b => b.addEventListener('click', () => {
+  const a = b.dataset.act;
+  if (a === 'in') zoom(0.5); else if (a === 'out') zoom(2);
+  else if (a === 'left') pan(-0.2); else if (a === 'right') pan(0.2);
+  else if (a === 'all') setView(full[0], full[1]); else if (a === 'reset') setView(initial[0], initial[1]);
+}));
+window.addEventListener('resize', schedule);
+
+// ---- legend -----------------------------------------------------------------------------
+(function legend() {
+  const parts = [];
+  parts.push('<span><b>frames</b></span>');
+  KIND_NAMES.forEach((k, i) => parts.push(`<span><span class="sw" style="background:${KIND_COLOURS[i]}"></span>${k}</span>`));
+  parts.push('<span><b>token holder</b></span>');
+  holders.forEach(h => parts.push(`<span><span class="sw" style="background:${holderColour[h]}"></span>${h}</span>`));
+  parts.push('<span><b>DP cycle</b></span>');
+  parts.push(`<span><span class="vl" style="background:${DX_OK}"></span>answered</span>`);
+  parts.push(`<span><span class="vl" style="background:${DX_MISS}"></span>no answer</span>`);
+  parts.push('<span><b>events</b></span>');
+  for (const k of ['fault', 'repair', 'event']) parts.push(`<span><span class="vl" style="background:${EVENT_COLOURS[k]}"></span>${k}</span>`);
+  document.getElementById('legend').innerHTML = parts.join('');
+})();
+
+setView(v0, v1);
+render();
+})();
+)JS";
+
+}  // namespace pbvbus::captures::detail

@@ -162,6 +162,10 @@ TEST_F(TimelineBrowser, ScreenshotIsAPicture) {
   // A blank or unstyled page has a handful of colours; lanes, legend and anti-aliased text
   // give hundreds.
   EXPECT_GT(colours, 200) << out;
+  // The README's picture is this screenshot: PBVBUS_UPDATE_DOCS=1 writes it there.
+  if (const char* u = std::getenv("PBVBUS_UPDATE_DOCS"); u && std::string(u) == "1")
+    fs::copy_file(png, PBVBUS_SOURCE_DIR "/docs/img/timeline-multimaster.png",
+                  fs::copy_options::overwrite_existing);
 }
 
 TEST_F(TimelineBrowser, ScriptDrawsTheLanes) {

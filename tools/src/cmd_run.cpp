@@ -305,8 +305,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   g_interrupted = 0;
   sim->start();
   if (paced) {
-    bus::PacedRunner runner(sim->scheduler(), ra.speed.value_or(bus::Speed{}));
-    sim->attach_io(runner);
+    bus::PacedRunner& runner = sim->paced_runner(ra.speed.value_or(bus::Speed{}));
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {
       if (!ec) {

@@ -86,10 +86,16 @@ void Simulation::make_link(const std::string& target, const std::string& link) {
   m_links.push_back(link);
 }
 
-void Simulation::attach_io(bus::PacedRunner& runner) {
+bus::PacedRunner& Simulation::paced_runner(bus::Speed speed) {
+  if (m_runner) {
+    m_runner->set_speed(speed);
+    return *m_runner;
+  }
+  m_runner = std::make_unique<bus::PacedRunner>(m_sched, speed);
   for (auto& ls : m_lines)
     for (auto& s : ls->stations)
-      if (s.pty) s.pty->attach_io(runner);
+      if (s.pty) s.pty->attach_io(*m_runner);
+  return *m_runner;
 }
 
 void Simulation::poll_serial() {

@@ -15,6 +15,8 @@
 //    removed when the Simulation ends.
 //  - Faults scheduled after the end of the run (possible with a shorter --duration) are not
 //    applied and are listed in the report.
+//  - The paced driver belongs to the Simulation (paced_runner()): the ptys register their I/O
+//    on its io_context, so it must live as long as they do. It is destroyed after them.
 
 #include <cstdint>
 #include <memory>
@@ -29,6 +31,7 @@
 
 namespace pbvbus::bus {
 class PacedRunner;
+struct Speed;
 }
 namespace pbvbus::captures {
 class PcapngWriter;
@@ -78,9 +81,9 @@ class Simulation {
   bool has_external_attachments() const { return !m_serial.empty(); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
 
-  /// Paced driver: lets the pty attachments read their input on the runner's io_context.
-  /// Call once before runner.run_until().
-  void attach_io(bus::PacedRunner& runner);
+  /// The paced driver (created on the first call, at `speed`; later calls change its speed),
+  /// with every pty attachment reading its input on the runner's io_context.
+  bus::PacedRunner& paced_runner(bus::Speed speed);
   /// Fast driver with ptys: reads what the programs wrote so far (call between slices).
   void poll_serial();
 
@@ -106,6 +109,7 @@ class Simulation {
   std::optional<bus::Ticks> m_duration;
   std::uint64_t m_seed = 0;
   bus::Scheduler m_sched;
+  std::unique_ptr<bus::PacedRunner> m_runner;  // before m_lines: the ptys use its io_context
   std::vector<std::unique_ptr<LineState>> m_lines;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;

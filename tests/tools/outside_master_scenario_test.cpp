@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
@@ -79,6 +81,39 @@ TEST(OutsideMasterScenario, SerialTimingIsInterfaceUnlessRawIsAsked) {
   EXPECT_EQ(a.report(0).serial.at(0).timing, "interface");
   EXPECT_EQ(b.report(0).serial.at(0).timing, "raw");
   EXPECT_EQ(a.report(0).serial.at(0).address, std::optional<std::uint8_t>(2));
+}
+
+std::string hex(const std::vector<std::uint8_t>& b) {
+  std::string s;
+  char buf[4];
+  for (std::uint8_t x : b) {
+    std::snprintf(buf, sizeof buf, "%02X", x);
+    s += buf;
+  }
+  return s;
+}
+
+// examples/outside-master.textproto loads, and the --slave arguments its comment gives for the
+// test master are what the plan says a configuration tool would put into a master.
+TEST(OutsideMasterScenario, ExampleLoadsAndItsCommentIsRight) {
+  const std::string file = PBVBUS_SOURCE_DIR "/examples/outside-master.textproto";
+  const auto r = load_scenario_file(file);
+  ASSERT_TRUE(r.ok()) << r.errors.front().str();
+  EXPECT_TRUE(r.plan->dp_masters.empty());
+  ASSERT_EQ(r.plan->dp_slaves.size(), 2u);
+  EXPECT_EQ(r.plan->proto.serial(0).timing(), scenario::Serial::INTERFACE);
+  EXPECT_EQ(r.plan->proto.serial(0).link(), "/tmp/pbvbus-dp");
+  std::ifstream in(file);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  for (const auto& sp : r.plan->dp_slaves) {
+    char ident[8];
+    std::snprintf(ident, sizeof ident, "0x%04X", sp.params.ident);
+    const std::string arg = "--slave " + std::to_string(sp.address) + ":" + ident + ":" +
+                            hex(sp.params.user_prm) + ":" + hex(sp.params.chk_cfg_du()) + ":" +
+                            std::to_string(sp.inputs) + ":" + std::to_string(sp.outputs);
+    EXPECT_NE(text.find(arg), std::string::npos) << arg;
+    EXPECT_EQ(sp.master, dp::kNoMaster);
+  }
 }
 
 // --- a scripted program behind the pty --------------------------------------------------------

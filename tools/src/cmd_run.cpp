@@ -305,6 +305,8 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   g_interrupted = 0;
   sim->start();
   if (paced) {
+    // The runner belongs to the simulation (torn down after its doors); the signal set below
+    // is the only other user of its io_context and goes at the end of this block.
     bus::PacedRunner& runner = sim->paced_runner(ra.speed.value_or(bus::Speed{}));
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {

@@ -17,8 +17,6 @@
 //    applied and are listed in the report.
 //  - A serial attachment's slot time (bus::PtyStation reply window and Interface timing) is
 //    the line's TSL, so it waits as long for a reply as the line's masters would.
-//  - The paced driver belongs to the Simulation (paced_runner()): the ptys register their I/O
-//    on its io_context, so it must live as long as they do. It is destroyed after them.
 
 #include <cstdint>
 #include <memory>
@@ -27,14 +25,11 @@
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
-namespace pbvbus::bus {
-class PacedRunner;
-struct Speed;
-}
 namespace pbvbus::captures {
 class PcapngWriter;
 }
@@ -83,8 +78,11 @@ class Simulation {
   bool has_external_attachments() const { return !m_serial.empty(); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
 
-  /// The paced driver (created on the first call, at `speed`; later calls change its speed),
-  /// with every pty attachment reading its input on the runner's io_context.
+  /// Paced driver: creates the simulation's PacedRunner (once) and registers every pty
+  /// attachment's I/O on its io_context. The Simulation owns the runner so that the order of
+  /// tear-down is fixed: the doors (ptys) go first, then the runner and its io_context, then
+  /// the scheduler — a door never cancels I/O on a dead io_context. Anything else registered
+  /// on runner.io_context() by the caller must be gone before the Simulation.
   bus::PacedRunner& paced_runner(bus::Speed speed);
   /// Fast driver with ptys: reads what the programs wrote so far (call between slices).
   void poll_serial();
@@ -111,7 +109,9 @@ class Simulation {
   std::optional<bus::Ticks> m_duration;
   std::uint64_t m_seed = 0;
   bus::Scheduler m_sched;
-  std::unique_ptr<bus::PacedRunner> m_runner;  // before m_lines: the ptys use its io_context
+  // Declared after the scheduler and before the lines: destroyed after every door, before the
+  // scheduler it drives.
+  std::unique_ptr<bus::PacedRunner> m_runner;
   std::vector<std::unique_ptr<LineState>> m_lines;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;

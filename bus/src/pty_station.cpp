@@ -38,6 +38,36 @@ int telegram_da(std::span<const std::uint8_t> b) {
   }
 }
 
+/// What the Interface timing needs to know about a telegram from the program.
+struct TelegramKind {
+  bool needs_sync = false;     ///< a request or token: TSYN idle before it
+  bool expects_reply = false;  ///< the next frame from someone else is its reply (or activity)
+};
+
+TelegramKind classify(std::span<const std::uint8_t> b) {
+  TelegramKind k;
+  if (b.empty()) return k;
+  std::size_t fc_at = 0;
+  switch (b[0]) {
+    case 0xDC:  // token: the receiver's activity is awaited, unless passed to itself
+      k.needs_sync = true;
+      k.expects_reply = b.size() >= 3 && (b[1] & 0x7F) != (b[2] & 0x7F);
+      return k;
+    case 0x10:
+    case 0xA2: fc_at = 3; break;
+    case 0x68: fc_at = 6; break;
+    default: return k;  // SC: a response
+  }
+  if (b.size() <= fc_at) return k;
+  const std::uint8_t fc = b[fc_at];
+  if ((fc & 0x40) == 0) return k;  // a response frame
+  k.needs_sync = true;
+  const std::uint8_t fn = fc & 0x0F;
+  const bool reply_fn = fn == 0x3 || fn == 0x5 || fn == 0x7 || fn == 0x9 || fn >= 0xC;
+  k.expects_reply = reply_fn && telegram_da(b) != 127;
+  return k;
+}
+
 }  // namespace
 
 std::int64_t default_slot_time_bits(Baud baud) {
@@ -108,17 +138,88 @@ PtyStation::Stats PtyStation::stats() const {
 void PtyStation::on_power_on(Ticks now) {
   m_powered = true;
   m_tx_free_at = now;
+  m_line_free_at = now;  // an interface synchronises from power-on: TSYN before its first request
   m_reply_after = m_reply_until = -1;
+  m_await_reply = false;
 }
 
 void PtyStation::on_power_off(Ticks) {
   m_powered = false;
   m_reply_after = m_reply_until = -1;
+  m_await_reply = false;
+  m_stats.discarded += m_queue.size();
+  m_queue.clear();
 }
 
-void PtyStation::on_timer(Ticks) {}
+void PtyStation::on_timer(Ticks now) { pump(now); }
+
+std::int64_t PtyStation::window_bits() const {
+  return m_opt.reply_window_bits > 0 ? m_opt.reply_window_bits
+                                     : default_slot_time_bits(port().baud());
+}
+
+void PtyStation::pump(Ticks now) {
+  if (m_opt.timing != Timing::Interface) return;
+  const Ticks bit = ticks_per_bit(port().baud());
+  while (!m_queue.empty() && m_powered) {
+    if (port().receiving()) {
+      // Someone else's frame is on the line: its delivery (on_frame) pumps again. The timer is
+      // only a safety net (a frame longer than any telegram cannot be on the line).
+      port().set_timer(now + chars_to_ticks(256, port().baud()));
+      return;
+    }
+    if (m_await_reply) {
+      if (now < m_await_until) {
+        port().set_timer(m_await_until);
+        return;
+      }
+      m_await_reply = false;  // the slot time has passed and no reply has started
+    }
+    const Held& t = m_queue.front();
+    const Ticks earliest = m_line_free_at + (classify(t.bytes).needs_sync ? kTsynBits * bit : 0);
+    if (now < earliest) {
+      port().set_timer(earliest);
+      return;
+    }
+    send(now, t);
+    m_queue.pop_front();
+  }
+}
+
+void PtyStation::send(Ticks start, const Held& t) {
+  const Ticks bit = ticks_per_bit(port().baud());
+  port().transmit(start, t.bytes);
+  ++m_stats.frames_in;
+  m_stats.octets_sent += t.bytes.size();
+  if (const Ticks hold = start - t.arrived; hold > 0) {
+    ++m_stats.held;
+    m_stats.hold_total += hold;
+    m_stats.hold_max = std::max(m_stats.hold_max, hold);
+  }
+  const Ticks end = start + chars_to_ticks(static_cast<std::int64_t>(t.bytes.size()), port().baud());
+  m_tx_free_at = end + kTsynBits * bit;
+  m_line_free_at = std::max(m_line_free_at, end);
+  if (m_opt.mode == Mode::Station) {
+    m_reply_after = end;
+    m_reply_until = end + window_bits() * bit;
+  }
+  if (m_opt.timing == Timing::Interface && classify(t.bytes).expects_reply) {
+    m_await_reply = true;
+    m_await_from = end;
+    m_await_until = end + window_bits() * bit;
+  }
+}
 
 void PtyStation::on_frame(const RxFrame& f) {
+  // Interface timing: every frame on the line counts for the idle time, and the first one after
+  // our request is its reply (in time or not, the wait is over once it has been heard).
+  m_line_free_at = std::max(m_line_free_at, f.end);
+  if (m_await_reply && f.start >= m_await_from) m_await_reply = false;
+  forward(f);
+  pump(f.end);
+}
+
+void PtyStation::forward(const RxFrame& f) {
   bool out = m_opt.mode == Mode::Monitor;
   if (!out) {
     const int da = telegram_da(f.bytes);
@@ -236,21 +337,17 @@ void PtyStation::feed(std::span<const std::uint8_t> bytes) {
     ++m_stats.abandoned;
   }
   const bool was_idle = m_splitter.pending() == 0;
-  const Ticks bit = ticks_per_bit(port().baud());
   const std::size_t n = m_splitter.feed(bytes, [&](std::span<const std::uint8_t> f) {
-    const Ticks start = std::max(now, m_tx_free_at);
-    port().transmit(start, f);
-    ++m_stats.frames_in;
-    const Ticks end = start + chars_to_ticks(static_cast<std::int64_t>(f.size()), port().baud());
-    m_tx_free_at = end + kTsynBits * bit;
-    if (m_opt.mode == Mode::Station) {
-      const std::int64_t window =
-          m_opt.reply_window_bits > 0 ? m_opt.reply_window_bits : default_slot_time_bits(port().baud());
-      m_reply_after = end;
-      m_reply_until = end + window * bit;
+    Held t{{f.begin(), f.end()}, now};
+    if (m_opt.timing == Timing::Raw) {
+      send(std::max(now, m_tx_free_at), t);
+    } else {
+      m_queue.push_back(std::move(t));
+      m_stats.queue_max = std::max<std::uint64_t>(m_stats.queue_max, m_queue.size());
     }
   });
   if (m_splitter.pending() > 0 && (was_idle || n > 0)) m_first_pending_at = now;
+  pump(now);
   flush_output();
 }
 

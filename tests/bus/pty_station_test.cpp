@@ -127,8 +127,10 @@ TEST_F(PtyTest, ProgramTelegramGoesOnTheLineAtTheCurrentTime) {
   EXPECT_EQ(pty->stats().garbage_bytes, 0u);
 }
 
-TEST_F(PtyTest, TelegramsWrittenAtOnceKeepTsynBetweenThem) {
-  make({});
+TEST_F(PtyTest, RawTelegramsWrittenAtOnceKeepTsynBetweenThem) {
+  PtyStation::Options o;
+  o.timing = PtyStation::Timing::Raw;
+  make(o);
   Program prog(pty->path());
   prog.write_hex("10 03 01 49 4D 16 DC 05 01 E5");
   ASSERT_EQ(poll_until(*pty, 10), 10u);
@@ -137,6 +139,7 @@ TEST_F(PtyTest, TelegramsWrittenAtOnceKeepTsynBetweenThem) {
   EXPECT_EQ(rec.hex_all(), (std::vector<std::string>{kFdlStatusTo3, "DC 05 01", "E5"}));
   EXPECT_EQ(rec.gap_bits(1), 33);
   EXPECT_EQ(rec.gap_bits(2), 33);
+  EXPECT_EQ(rec.start_bits(0), 0);  // at once
 }
 
 TEST_F(PtyTest, GarbageBeforeATelegramIsSkippedAndCounted) {
@@ -207,6 +210,7 @@ TEST_F(PtyTest, StationGetsItsOwnTrafficAndTheReplyToItsRequest) {
 
 TEST_F(PtyTest, ReplyWindowIsTheSlotTime) {
   PtyStation::Options o{PtyStation::Mode::Station, 3};
+  o.timing = PtyStation::Timing::Raw;  // the telegram goes out at 0, when it is fed
   o.reply_window_bits = 50;
   make(o);
   Program prog(pty->path());
@@ -273,6 +277,189 @@ TEST_F(PtyTest, ProgramThatDoesNotReadNeverStallsTheBus) {
   for (std::size_t i = 0; i < all.size(); i += 255) {
     ASSERT_EQ(to_hex(std::span(all).subspan(i, 5)), "68 F9 F9 68 03") << "telegram at octet " << i;
   }
+}
+
+// --- Interface timing (the default): the attachment keeps bus timing for the program --------
+// Bit times at 1.5 Mbit/s; the pty is station 3, the probes play a master and a slave.
+
+constexpr const char* kPtyTo4 = "10 04 03 49 50 16";  // Request FDL Status, 3 -> 4 (66 bit times)
+constexpr const char* kPtyTo5 = "10 05 03 49 51 16";  // Request FDL Status, 3 -> 5
+
+class PtyTiming : public PtyTest {
+ protected:
+  /// Feeds `hex` as if the program had written it at exactly `at`.
+  void feed_at(Ticks at, std::string hex) {
+    sched.schedule(at, [this, h = std::move(hex)] { pty->feed(bytes_from_hex(h)); });
+  }
+  static PtyStation::Options station(PtyStation::Timing t = PtyStation::Timing::Interface) {
+    PtyStation::Options o{PtyStation::Mode::Station, 3};
+    o.timing = t;
+    return o;
+  }
+};
+
+TEST_F(PtyTiming, InterfaceIsTheDefault) {
+  EXPECT_EQ(PtyStation::Options{}.timing, PtyStation::Timing::Interface);
+}
+
+TEST_F(PtyTiming, RequestFedFiveBitTimesAfterAFrameGoesOutAtItsEndPlusTsyn) {
+  make(station());
+  master.send(B(100), "10 05 01 49 4F 16");  // B(100) .. B(166)
+  feed_at(B(171), kPtyTo4);                  // only 5 bit times of idle so far
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).sender, 0);
+  EXPECT_EQ(rec.hex(1), kPtyTo4);
+  EXPECT_EQ(rec.frame(1).start, B(166 + 33));
+  ASSERT_EQ(slave.rx.size(), 2u);
+  EXPECT_EQ(slave.rx[1].idle_before, B(33));
+  const auto s = pty->stats();
+  EXPECT_EQ(s.frames_in, 1u);
+  EXPECT_EQ(s.octets_sent, 6u);
+  EXPECT_EQ(s.held, 1u);
+  EXPECT_EQ(s.hold_total, B(28));
+  EXPECT_EQ(s.hold_max, B(28));
+  EXPECT_EQ(pty->queued(), 0u);
+}
+
+TEST_F(PtyTiming, RequestAfterEnoughIdleGoesOutAtOnce) {
+  make(station());
+  master.send(B(100), "10 05 01 49 4F 16");
+  feed_at(B(166 + 40), kPtyTo4);
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).start, B(206));
+  EXPECT_EQ(pty->stats().held, 0u);
+  EXPECT_EQ(pty->stats().hold_total, 0);
+}
+
+TEST_F(PtyTiming, NeverSendsWhileAnotherStationsFrameIsOnTheLine) {
+  make(station());
+  // A 20-octet SD2 from the master: B(1000) .. B(1220). The program writes in the middle of it,
+  // after plenty of idle before it started.
+  master.send(B(1000), "68 0E 0E 68 05 01 7D 00 01 02 03 04 05 06 07 08 09 0A BA 16");
+  feed_at(B(1100), kPtyTo4);
+  sched.run_until(B(2000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(0).flags, 0);
+  EXPECT_EQ(rec.frame(1).flags, 0);
+  EXPECT_EQ(rec.frame(1).start, B(1220 + 33));
+  EXPECT_EQ(pty->stats().hold_max, B(153));
+}
+
+TEST_F(PtyTiming, ResponseGoesOutWithoutTsyn) {
+  // A program acting as a responder: its SC belongs to the request it just heard, which needs
+  // no idle time before it (only the line must be free).
+  make(station());
+  master.send(B(100), "10 03 01 49 4D 16");  // to the pty: B(100) .. B(166)
+  feed_at(B(150), "E5");                     // written while the request is still on the line
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.hex(1), "E5");
+  EXPECT_EQ(rec.frame(1).start, B(166));
+}
+
+TEST_F(PtyTiming, AfterItsRequestItWaitsForTheReply) {
+  make(station());
+  // Station 4 answers SC 11 bit times after the request.
+  slave.on_rx = [&](const RxFrame& f) {
+    if (to_hex(f.bytes) == kPtyTo4) slave.send(f.end + B(11), "E5");
+  };
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);  // two telegrams in one write
+  sched.run_until(B(2000));
+  ASSERT_EQ(rec.size(), 3u);
+  EXPECT_EQ(rec.frame(0).start, B(1000));           // idle since power-on: at once
+  EXPECT_EQ(rec.frame(1).start, B(1066 + 11));      // the reply
+  EXPECT_EQ(rec.hex(2), kPtyTo5);
+  EXPECT_EQ(rec.frame(2).start, B(1088 + 33));      // TSYN after the reply
+  const auto s = pty->stats();
+  EXPECT_EQ(s.queue_max, 2u);
+  EXPECT_EQ(s.held, 1u);
+  EXPECT_EQ(s.hold_max, B(121));
+}
+
+TEST_F(PtyTiming, WithoutAReplyItWaitsTheSlotTime) {
+  make(station());  // nobody answers; slot time = the 1.5M default, 300 bit times
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);
+  sched.run_until(B(3000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).start, B(1066 + 300));
+}
+
+TEST_F(PtyTiming, SlotTimeIsTheReplyWindow) {
+  PtyStation::Options o = station();
+  o.reply_window_bits = 100;
+  make(o);
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);
+  sched.run_until(B(3000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).start, B(1066 + 100));
+}
+
+TEST_F(PtyTiming, AReplyStartedWithinTheSlotTimeIsAwaitedToItsEnd) {
+  make(station());
+  // Station 4 answers late but in time: 290 bit times after the request, 20 octets long.
+  slave.on_rx = [&](const RxFrame& f) {
+    if (to_hex(f.bytes) == kPtyTo4)
+      slave.send(f.end + B(290), "68 0E 0E 68 03 04 08 00 01 02 03 04 05 06 07 08 09 0A 46 16");
+  };
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);
+  sched.run_until(B(3000));
+  ASSERT_EQ(rec.size(), 3u);
+  EXPECT_EQ(rec.frame(1).start, B(1066 + 290));
+  EXPECT_EQ(rec.frame(2).start, B(1066 + 290 + 220 + 33));
+  EXPECT_EQ(rec.frame(2).flags, 0);
+}
+
+TEST_F(PtyTiming, NoReplyIsAwaitedAfterABroadcastOrAResponse) {
+  make(station());
+  // SDN broadcast (Global_Control-like SD1) then a request: only TSYN between them.
+  feed_at(B(1000), "10 7F 03 44 C6 16 " + std::string(kPtyTo4));
+  sched.run_until(B(2000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).start, B(1066 + 33));
+}
+
+TEST_F(PtyTiming, TokenToAnotherStationWaitsForItsActivity) {
+  make(station());
+  feed_at(B(1000), "DC 01 03 " + std::string(kPtyTo4));  // token to 1 (33 bit times)
+  master.on_rx = [&](const RxFrame& f) {
+    if (to_hex(f.bytes) == "DC 01 03") master.send(f.end + B(50), "10 05 01 49 4F 16");
+  };
+  sched.run_until(B(2000));
+  ASSERT_EQ(rec.size(), 3u);
+  EXPECT_EQ(rec.frame(1).start, B(1033 + 50));     // the new token holder's first frame
+  EXPECT_EQ(rec.frame(2).start, B(1083 + 66 + 33));
+}
+
+TEST_F(PtyTiming, PowerLossDropsWaitingTelegrams) {
+  make(station());
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);
+  sched.schedule(B(1100), [this] { line.set_power(0, false); });
+  sched.run_until(B(3000));
+  EXPECT_EQ(rec.size(), 1u);
+  EXPECT_EQ(pty->stats().discarded, 1u);
+  EXPECT_EQ(pty->queued(), 0u);
+}
+
+TEST_F(PtyTiming, RawSendsAtOnceWhateverIsOnTheLine) {
+  make(station(PtyStation::Timing::Raw));
+  master.send(B(100), "10 05 01 49 4F 16");  // B(100) .. B(166)
+  feed_at(B(171), kPtyTo4);                  // 5 bit times later: out at once
+  sched.run_until(B(1000));
+  ASSERT_EQ(rec.size(), 2u);
+  EXPECT_EQ(rec.frame(1).start, B(171));
+  ASSERT_EQ(slave.rx.size(), 2u);
+  EXPECT_EQ(slave.rx[1].idle_before, B(5));  // what a receiver will judge (and drop)
+  EXPECT_EQ(pty->stats().held, 0u);
+  // Even during another station's frame (a collision, as with a plain UART).
+  master.send(B(2000), "68 0E 0E 68 05 01 7D 00 01 02 03 04 05 06 07 08 09 0A BA 16");
+  feed_at(B(2100), kPtyTo5);
+  sched.run_until(B(3000));
+  ASSERT_EQ(rec.size(), 4u);
+  EXPECT_EQ(rec.frame(2).sender, 0);  // taps see frames in the order they end
+  EXPECT_EQ(rec.frame(2).start, B(2100));
+  EXPECT_NE(rec.frame(2).flags & kRxCollision, 0);
 }
 
 TEST_F(PtyTest, PacedRunnerReadsThePtyAndWritesToIt) {

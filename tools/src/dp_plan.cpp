@@ -152,12 +152,10 @@ class DpPlanner {
     sp.io = s.inputs();
     sp.tsdr = s.tsdr_bits();
     bool ok = true;
-    // The master.
+    // The master: none = whoever parameterises it (a master outside pbvbus).
     int mi = -1;
-    if (!s.has_master()) {
-      error("dp_slave", i, nullptr, -1, "dp_slave needs a master: the address of its dp_master");
-      ok = false;
-    } else {
+    sp.master = dp::kNoMaster;
+    if (s.has_master()) {
       for (std::size_t k = 0; k < m_plan.dp_masters.size(); ++k) {
         const auto& mm = m_plan.proto.dp_master(m_plan.dp_masters[k].source);
         if (mm.has_address() && mm.address() == s.master() && mm.line() == s.line())

@@ -1,6 +1,8 @@
 // The DP section of the `pbvbus run` report, text and JSON (schema in report.hpp).
 #include <cstdio>
+#include <optional>
 #include <ostream>
+#include <string>
 
 #include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/dp_system.hpp"
@@ -84,6 +86,82 @@ void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os) {
          << ",\"retries\":" << st.retries << "}";
     }
     os << "]}";
+  }
+  os << "]";
+}
+
+namespace {
+
+template <class T>
+std::string opt_json(const std::optional<T>& v) {
+  return v ? std::to_string(static_cast<long long>(*v)) : std::string("null");
+}
+
+}  // namespace
+
+void write_dp_slaves_text(const std::vector<DpSlaveView>& r, std::ostream& os) {
+  for (const auto& v : r) {
+    os << "\ndp slave " << static_cast<int>(v.address) << " on line " << v.line << " \"" << v.model
+       << "\" [";
+    for (std::size_t i = 0; i < v.modules.size(); ++i) os << (i ? ", " : "") << v.modules[i];
+    os << "], its own view: " << v.state << ", owner "
+       << (v.owner ? std::to_string(*v.owner) : std::string("none")) << " ("
+       << (v.master ? "dp master " + std::to_string(*v.master) + " in the scenario"
+                    : std::string("no pbvbus master"))
+       << "), watchdog "
+       << (v.watchdog ? std::to_string(*v.watchdog / bus::kTicksPerMs) + " ms" : std::string("off")) << "\n";
+    os << "    diagnosis " << hex(v.diag);
+    if (!v.diag_bits.empty()) {
+      os << " (";
+      for (std::size_t i = 0; i < v.diag_bits.size(); ++i) os << (i ? ", " : "") << v.diag_bits[i];
+      os << ")";
+    }
+    os << "\n    inputs " << v.input_len << " octets: " << (v.inputs.empty() ? "-" : hex(v.inputs))
+       << " (sent last), outputs " << v.output_len
+       << " octets: " << (v.outputs.empty() ? "-" : hex(v.outputs)) << " (received last)\n";
+    const auto& s = v.stats;
+    os << "    answered: Set_Prm " << s.set_prm << ", Chk_Cfg " << s.chk_cfg << ", Slave_Diag "
+       << s.slave_diag << ", Data_Exchange " << s.data_exchange << ", Global_Control "
+       << s.global_control << ", Get_Cfg " << s.get_cfg << ", Rd_Inp " << s.rd_inp << ", Rd_Outp "
+       << s.rd_outp << ", Set_Slave_Add " << s.set_slave_add << ", DP-V1 " << s.dpv1 << ", other "
+       << s.other << "; refused (RS) " << s.refused << "\n";
+    os << "    Prm faults " << s.prm_faults << ", Cfg faults " << s.cfg_faults
+       << ", Data_Exch entered " << s.data_exch_entries << " times, watchdog expiries "
+       << s.watchdog_expiries << "; FDL: " << v.fdl.requests << " requests, " << v.fdl.replies
+       << " replies, " << v.fdl.repeats << " repeats, " << v.fdl.dropped_tsyn
+       << " dropped for too short an idle time (TSYN), " << v.fdl.dropped_errors
+       << " dropped damaged\n";
+  }
+}
+
+void write_dp_slaves_json(const std::vector<DpSlaveView>& r, std::ostream& os) {
+  os << ",\n\"dp_slaves\":[";
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const auto& v = r[i];
+    const auto& s = v.stats;
+    os << (i ? ",\n" : "\n") << "{\"line\":" << json_quote(v.line)
+       << ",\"address\":" << static_cast<int>(v.address) << ",\"model\":" << json_quote(v.model)
+       << ",\"gsd\":" << json_quote(v.gsd) << ",\"modules\":[";
+    for (std::size_t k = 0; k < v.modules.size(); ++k) os << (k ? "," : "") << json_quote(v.modules[k]);
+    os << "],\"master\":" << opt_json(v.master) << ",\"state\":" << json_quote(v.state)
+       << ",\"owner\":" << opt_json(v.owner) << ",\"watchdog_ns\":"
+       << (v.watchdog ? std::to_string(bus::ticks_to_ns(*v.watchdog)) : std::string("null"))
+       << ",\"diag\":" << json_quote(hex(v.diag)) << ",\"diag_bits\":[";
+    for (std::size_t k = 0; k < v.diag_bits.size(); ++k) os << (k ? "," : "") << json_quote(v.diag_bits[k]);
+    os << "],\"input_len\":" << v.input_len << ",\"output_len\":" << v.output_len
+       << ",\"inputs\":" << json_quote(hex(v.inputs)) << ",\"outputs\":" << json_quote(hex(v.outputs))
+       << ",\n \"requests\":{\"set_prm\":" << s.set_prm << ",\"chk_cfg\":" << s.chk_cfg
+       << ",\"slave_diag\":" << s.slave_diag << ",\"data_exchange\":" << s.data_exchange
+       << ",\"global_control\":" << s.global_control << ",\"get_cfg\":" << s.get_cfg
+       << ",\"rd_inp\":" << s.rd_inp << ",\"rd_outp\":" << s.rd_outp
+       << ",\"set_slave_add\":" << s.set_slave_add << ",\"dpv1\":" << s.dpv1
+       << ",\"other\":" << s.other << "},\"refused\":" << s.refused
+       << ",\"prm_faults\":" << s.prm_faults << ",\"cfg_faults\":" << s.cfg_faults
+       << ",\"data_exch_entries\":" << s.data_exch_entries
+       << ",\"watchdog_expiries\":" << s.watchdog_expiries << ",\n \"fdl\":{\"requests\":"
+       << v.fdl.requests << ",\"replies\":" << v.fdl.replies << ",\"repeats\":" << v.fdl.repeats
+       << ",\"fdl_status\":" << v.fdl.fdl_status << ",\"dropped_errors\":" << v.fdl.dropped_errors
+       << ",\"dropped_tsyn\":" << v.fdl.dropped_tsyn << "}}";
   }
   os << "]";
 }

@@ -113,6 +113,34 @@ std::vector<std::string> diag_bit_names(std::span<const std::uint8_t> d) {
   return out;
 }
 
+DpSlaveView dp_slave_view(const DpSlaveNode& node, const DpSlavePlan& p, const std::string& line) {
+  // The engine's diagnosis builder and the station are not const; reading them changes nothing.
+  auto& model = const_cast<devices::SlaveModel&>(const_cast<DpSlaveNode&>(node).model());
+  dp::SlaveEngine& eng = model.engine();
+  DpSlaveView v;
+  v.line = line;
+  v.address = model.address();
+  v.model = p.model;
+  v.gsd = p.gsd_path;
+  v.modules = p.module_names;
+  if (p.master != dp::kNoMaster) v.master = p.master;
+  v.state = std::string(dp::to_string(eng.state()));
+  if (eng.master_address() != dp::kNoMaster) v.owner = eng.master_address();
+  if (eng.watchdog_on()) v.watchdog = eng.watchdog_time();
+  const auto d = eng.current_diag();
+  v.diag.assign(d.begin(), d.end());
+  v.diag_bits = diag_bit_names(v.diag);
+  v.input_len = eng.layout().inputs;
+  v.output_len = eng.layout().outputs;
+  const auto in = eng.last_inputs();
+  const auto out = eng.last_outputs();
+  v.inputs.assign(in.begin(), in.end());
+  v.outputs.assign(out.begin(), out.end());
+  v.stats = eng.stats();
+  v.fdl = model.station().stats();
+  return v;
+}
+
 DpMasterReport dp_master_report(const DpMasterNode& node,
                                 const std::vector<const DpSlaveNode*>& slaves,
                                 const std::vector<const DpSlavePlan*>& plans,

@@ -1,11 +1,19 @@
 #include "pbvbus/tools/line_stats.hpp"
 
 #include "pbvbus/bus/device.hpp"
+#include "pbvbus/bus/line.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 
 namespace pbvbus::tools {
 
 namespace {
+/// FNV-1a of a telegram, never 0 (0 marks "no request").
+std::uint64_t hash_of(std::span<const std::uint8_t> b) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (std::uint8_t x : b) h = (h ^ x) * 1099511628211ULL;
+  return h == 0 ? 1 : h;
+}
+
 int type_index(std::uint8_t sd) {
   switch (sd) {
     case fdl::kSD1: return 0;
@@ -18,7 +26,31 @@ int type_index(std::uint8_t sd) {
 }
 }  // namespace
 
+void LineStats::mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only) {
+  if (addr >= heard.size()) return;
+  const auto v = static_cast<std::int8_t>(t);
+  if (!upgrade_only || heard[addr] < v) heard[addr] = v;
+}
+
+void LineStats::settle(const bus::TapFrame& f, const fdl::Telegram* t) {
+  if (!m_awaiting) return;
+  m_awaiting = false;
+  if (f.flags != 0 || t == nullptr) return;  // a damaged frame decides nothing
+  if (m_await_token) {
+    if (t->type != fdl::FrameType::SC && t->sa == m_await_da) return;  // the receiver is active
+  } else if (t->type == fdl::FrameType::SC) {
+    mark(m_await_da, fdl::StationType::Slave, true);
+    return;
+  } else if (t->type != fdl::FrameType::SD4 && !t->is_request() && t->sa == m_await_da) {
+    return;  // the response: marked by on_frame
+  }
+  heard[m_await_da] = -1;
+  if (m_await_counts) ++no_response;
+}
+
 void LineStats::on_frame(const bus::TapFrame& f) {
+  const bus::Ticks last_end = m_last_end;
+  m_last_end = f.end;
   ++frames;
   octets += f.bytes.size();
   const int ti = f.bytes.empty() ? -1 : type_index(f.bytes[0]);
@@ -27,6 +59,7 @@ void LineStats::on_frame(const bus::TapFrame& f) {
   else
     ++by_type[static_cast<std::size_t>(ti)];
   if (f.flags != 0) {
+    settle(f, nullptr);
     ++m_error_frames;
     if (f.flags & bus::kRxCollision) ++collisions;
     if (f.flags & (bus::kRxParity | bus::kRxFraming)) ++parity;
@@ -37,6 +70,7 @@ void LineStats::on_frame(const bus::TapFrame& f) {
   fdl::Telegram t;
   const fdl::DecodeError e = fdl::decode(f.bytes, t);
   if (e != fdl::DecodeError::None) {
+    settle(f, nullptr);
     ++m_error_frames;
     if (e == fdl::DecodeError::BadFcs)
       ++bad_fcs;
@@ -44,12 +78,36 @@ void LineStats::on_frame(const bus::TapFrame& f) {
       ++malformed;
     return;
   }
+  settle(f, &t);
+  const bool sync_needed = t.type == fdl::FrameType::SD4 || t.is_request();
+  if (sync_needed && last_end >= 0 && f.line != nullptr &&
+      f.start - last_end < 33 * f.line->bit_ticks())
+    ++short_idle;
   if (t.type == fdl::FrameType::SD4) {
     ++tokens_by_sa[t.sa & 0x7F];
+    mark(t.sa, fdl::StationType::MasterInRing, false);
+    if (t.da != t.sa && t.da < 127) {
+      m_awaiting = true;
+      m_await_token = true;
+      m_await_counts = false;
+      m_await_da = t.da;
+    }
   } else if (t.is_request()) {
-    ++requests_by_fn[static_cast<std::size_t>(fdl::fc_request_fn(t.fc))];
+    const fdl::RequestFn fn = fdl::fc_request_fn(t.fc);
+    ++requests_by_fn[static_cast<std::size_t>(fn)];
+    mark(t.sa, fdl::StationType::MasterInRing, false);
+    if (fdl::fn_expects_reply(fn) && t.da != fdl::kBroadcast) {
+      const std::uint64_t h = hash_of(f.bytes);
+      if (m_last_request[t.sa] == h) ++repeats;
+      m_last_request[t.sa] = h;
+      m_awaiting = true;
+      m_await_token = false;
+      m_await_counts = fn != fdl::RequestFn::FdlStatus;
+      m_await_da = t.da;
+    }
   } else if (t.type != fdl::FrameType::SC) {
     ++responses;
+    mark(t.sa, fdl::fc_station_type(t.fc), false);
   }
 }
 

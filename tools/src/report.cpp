@@ -40,16 +40,6 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
-std::uint64_t no_response(const LineReport& l) {
-  std::uint64_t n = 0;
-  for (const auto& m : l.masters) n += m.polls.no_response;
-  return n;
-}
-std::uint64_t retries(const LineReport& l) {
-  std::uint64_t n = 0;
-  for (const auto& m : l.masters) n += m.polls.retries;
-  return n;
-}
 
 }  // namespace
 
@@ -63,9 +53,24 @@ void write_text(const Report& r, std::ostream& os) {
        << "x real time)";
   os << ", " << r.events << " events\n";
   for (const auto& s : r.serial) {
-    os << "serial " << s.mode << " on line " << s.line << ": " << s.path;
+    const auto bit = bus::ticks_per_bit(s.baud);
+    const auto& st = s.stats;
+    os << "serial " << s.mode;
+    if (s.address) os << " " << static_cast<int>(*s.address);
+    os << " on line " << s.line << ": " << s.path;
     if (!s.link.empty()) os << " (" << s.link << ")";
-    os << "\n";
+    os << ", " << s.timing << " timing\n";
+    os << "  from the program: " << st.bytes_in << " octets, " << st.frames_in << " telegrams ("
+       << st.octets_sent << " octets) put on the line, " << st.garbage_bytes
+       << " octets discarded (" << st.abandoned << " incomplete telegrams)";
+    if (st.discarded) os << ", " << st.discarded << " telegrams lost unsent";
+    os << "\n  held " << st.held << " telegrams, total " << format_us(st.hold_total) << " us = "
+       << st.hold_total / bit << " bit times, max " << format_us(st.hold_max) << " us = "
+       << st.hold_max / bit << " bit times, at most " << st.queue_max << " waiting\n";
+    os << "  to the program: " << st.frames_out << " frames (" << st.bytes_out << " octets), "
+       << st.frames_dropped << " dropped (not read)\n";
+    os << "  requests dropped by the line's receivers for too short an idle time (TSYN): "
+       << s.receivers_tsyn_drops << "\n";
   }
   for (const auto& l : r.lines) {
     const auto bit = bus::ticks_per_bit(l.baud);
@@ -98,7 +103,9 @@ void write_text(const Report& r, std::ostream& os) {
     for (const auto& s : l.stations) {
       os << "  station " << static_cast<int>(s.address) << ": " << s.requests << " requests, "
          << s.replies << " replies, " << s.fdl_status << " FDL status, " << s.cycles
-         << " data cycles\n";
+         << " data cycles";
+      if (s.tsyn_drops) os << ", " << s.tsyn_drops << " dropped (TSYN)";
+      os << "\n";
     }
     const auto& t = l.traffic;
     os << "  frames: " << t.frames << " (" << t.octets << " octets):";
@@ -115,11 +122,13 @@ void write_text(const Report& r, std::ostream& os) {
     os << "; responses " << t.responses << "\n";
     os << "  errors: " << t.error_frames() << " frames (collisions " << t.collisions
        << ", parity " << t.parity << ", bad FCS " << t.bad_fcs << ", malformed " << t.malformed
-       << ", partial " << t.partial << ", babble " << t.babble << "); no response "
-       << no_response(l) << ", retries " << retries(l) << "\n";
+       << ", partial " << t.partial << ", babble " << t.babble << "); on the wire: no response "
+       << t.no_response << ", retries " << t.repeats << ", requests after less than TSYN idle "
+       << t.short_idle << "; dropped by the stations (TSYN) " << l.tsyn_drops << "\n";
     for (const auto& f : t.faults) os << "  fault at " << bus::format_duration(f.time) << ": " << f.text << "\n";
   }
   write_dp_text(r.dp_masters, os);
+  write_dp_slaves_text(r.dp_slaves, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -134,8 +143,21 @@ void write_json(const Report& r, std::ostream& os) {
   os << "\"serial\":[";
   for (std::size_t i = 0; i < r.serial.size(); ++i) {
     const auto& s = r.serial[i];
-    os << (i ? "," : "") << "{\"line\":" << json_quote(s.line) << ",\"mode\":" << json_quote(s.mode)
-       << ",\"path\":" << json_quote(s.path) << ",\"link\":" << json_quote(s.link) << "}";
+    const auto bit = bus::ticks_per_bit(s.baud);
+    const auto& st = s.stats;
+    os << (i ? ",\n " : "") << "{\"line\":" << json_quote(s.line) << ",\"mode\":" << json_quote(s.mode)
+       << ",\"path\":" << json_quote(s.path) << ",\"link\":" << json_quote(s.link)
+       << ",\"address\":" << (s.address ? std::to_string(*s.address) : std::string("null"))
+       << ",\"timing\":" << json_quote(s.timing) << ",\"frames_in\":" << st.frames_in
+       << ",\"octets_in\":" << st.bytes_in << ",\"octets_sent\":" << st.octets_sent
+       << ",\"frames_out\":" << st.frames_out << ",\"octets_out\":" << st.bytes_out
+       << ",\"frames_dropped\":" << st.frames_dropped << ",\"garbage\":" << st.garbage_bytes
+       << ",\"abandoned\":" << st.abandoned << ",\"held\":" << st.held
+       << ",\"hold_total_ns\":" << bus::ticks_to_ns(st.hold_total)
+       << ",\"hold_max_ns\":" << bus::ticks_to_ns(st.hold_max)
+       << ",\"hold_total_bits\":" << st.hold_total / bit << ",\"hold_max_bits\":" << st.hold_max / bit
+       << ",\"queue_max\":" << st.queue_max << ",\"discarded\":" << st.discarded
+       << ",\"receivers_tsyn_drops\":" << s.receivers_tsyn_drops << "}";
   }
   os << "],\n\"faults_not_reached\":[";
   for (std::size_t i = 0; i < r.faults_not_reached.size(); ++i)
@@ -168,7 +190,9 @@ void write_json(const Report& r, std::ostream& os) {
     os << "},\n \"errors\":{\"error_frames\":" << t.error_frames() << ",\"collisions\":" << t.collisions
        << ",\"parity\":" << t.parity << ",\"bad_fcs\":" << t.bad_fcs << ",\"malformed\":"
        << t.malformed << ",\"partial\":" << t.partial << ",\"babble\":" << t.babble
-       << ",\"no_response\":" << no_response(l) << ",\"retries\":" << retries(l) << "},\n \"faults\":[";
+       << ",\"no_response\":" << t.no_response << ",\"retries\":" << t.repeats
+       << ",\"short_idle\":" << t.short_idle << ",\"tsyn_drops\":" << l.tsyn_drops
+       << "},\n \"faults\":[";
     for (std::size_t i = 0; i < t.faults.size(); ++i)
       os << (i ? "," : "") << "{\"time_ns\":" << bus::ticks_to_ns(t.faults[i].time)
          << ",\"text\":" << json_quote(t.faults[i].text) << "}";
@@ -197,12 +221,14 @@ void write_json(const Report& r, std::ostream& os) {
       const auto& s = l.stations[i];
       os << (i ? "," : "") << "{\"address\":" << static_cast<int>(s.address)
          << ",\"requests\":" << s.requests << ",\"replies\":" << s.replies
-         << ",\"fdl_status\":" << s.fdl_status << ",\"cycles\":" << s.cycles << "}";
+         << ",\"fdl_status\":" << s.fdl_status << ",\"cycles\":" << s.cycles
+         << ",\"tsyn_drops\":" << s.tsyn_drops << "}";
     }
     os << "]}";
   }
   os << "]";
   write_dp_json(r.dp_masters, os);
+  write_dp_slaves_json(r.dp_slaves, os);
   os << "}\n";
 }
 

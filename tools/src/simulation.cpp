@@ -164,6 +164,9 @@ void Simulation::build_line(std::size_t li) {
         const bool station = ps.kind == StationKind::SerialStation;
         o.mode = station ? bus::PtyStation::Mode::Station : bus::PtyStation::Mode::Monitor;
         o.address = ps.address ? int(*ps.address) : -1;
+        o.timing = sp.timing() == scenario::Serial::RAW ? bus::PtyStation::Timing::Raw
+                                                         : bus::PtyStation::Timing::Interface;
+        o.reply_window_bits = pl.params.tsl;
         try {
           st.pty = std::make_unique<bus::PtyStation>(o);
         } catch (const std::exception& e) {
@@ -172,7 +175,14 @@ void Simulation::build_line(std::size_t li) {
         }
         label = station ? "serial station " + std::to_string(st.address) : "serial monitor";
         st.position = ls->line->attach(*st.pty, label);
-        SerialReport sr{pl.name, station ? "station" : "monitor", st.pty->path(), sp.link()};
+        SerialReport sr;
+        sr.line = pl.name;
+        sr.mode = station ? "station" : "monitor";
+        sr.path = st.pty->path();
+        sr.link = sp.link();
+        if (station) sr.address = st.address;
+        sr.timing = o.timing == bus::PtyStation::Timing::Raw ? "raw" : "interface";
+        sr.baud = pl.baud;
         if (!sp.link().empty()) make_link(st.pty->path(), sp.link());
         m_serial.push_back(std::move(sr));
         break;
@@ -315,8 +325,8 @@ Report Simulation::report(double wall_seconds) const {
   r.duration = m_sched.now();
   r.wall_seconds = wall_seconds;
   r.events = m_sched.events_run();
-  r.serial = m_serial;
   r.faults_not_reached = m_not_reached;
+  std::size_t serial_index = 0;
   for (std::size_t li = 0; li < m_lines.size(); ++li) {
     const LineState& ls = *m_lines[li];
     const PlanLine& pl = m_plan.lines[li];
@@ -362,9 +372,17 @@ Report Simulation::report(double wall_seconds) const {
         sr.replies = ps.replies;
         sr.fdl_status = ps.fdl_status;
         sr.cycles = s.responder->cycle();
+        sr.tsyn_drops = ps.dropped_tsyn;
+        lr.tsyn_drops += ps.dropped_tsyn;
         lr.stations.push_back(sr);
+      } else if (s.dp_slave) {
+        DpSlaveView v = dp_slave_view(*s.dp_slave, *s.dp_slave_plan, pl.name);
+        lr.tsyn_drops += v.fdl.dropped_tsyn;
+        r.dp_slaves.push_back(std::move(v));
       }
     }
+    // What the wire showed, whoever sent it (a master behind a pty too).
+    for (int a = 0; a < 128; ++a) live[a] = std::max<int>(live[a], ls.stats.heard[a]);
     for (const Station& s : ls.stations) {
       if (!s.dp_master) continue;
       // A DP master is a ring member like any FDL master: its live list counts too.
@@ -387,6 +405,13 @@ Report Simulation::report(double wall_seconds) const {
     for (int a = 0; a < 128; ++a)
       if (live[a] >= 0)
         lr.live.push_back({static_cast<std::uint8_t>(a), static_cast<fdl::StationType>(live[a])});
+    for (const Station& s : ls.stations) {
+      if (!s.pty) continue;
+      SerialReport sr = m_serial.at(serial_index++);
+      sr.stats = s.pty->stats();
+      sr.receivers_tsyn_drops = lr.tsyn_drops;
+      r.serial.push_back(std::move(sr));
+    }
     r.lines.push_back(std::move(lr));
   }
   return r;

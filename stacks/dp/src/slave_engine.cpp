@@ -61,6 +61,7 @@ void SlaveEngine::snapshot_inputs(std::span<std::uint8_t> out) {
 
 void SlaveEngine::enter_data_exchange() {
   set_state(SlaveState::DataExch);
+  ++m_stats.data_exch_entries;
   std::lock_guard lk(m_app.m_mu);
   m_app.m_alarms.clear();
   m_app.m_alarms_open = m_dpv1.dpv1_enable();
@@ -111,7 +112,10 @@ bus::Ticks SlaveEngine::next_deadline() const {
 void SlaveEngine::on_time(bus::Ticks now) { check_timers(now); }
 
 void SlaveEngine::check_timers(bus::Ticks now) {
-  if (m_wd_on && now >= m_wd_deadline) go_wait_prm();  // watchdog expiry (§D.8)
+  if (m_wd_on && now >= m_wd_deadline) {  // watchdog expiry (§D.8)
+    ++m_stats.watchdog_expiries;
+    go_wait_prm();
+  }
   for (auto& c : m_c2)
     if (c.st != C2Connection::St::Closed && now >= c.deadline) c = C2Connection{};
 }
@@ -124,7 +128,12 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
   if (from_owner && m_wd_on) m_wd_deadline = ind.now + m_wd_ticks;
 
   if (ind.broadcast()) {
-    if (ind.dsap == kSapGlobalControl) handle_global_control(ind, reply);
+    if (ind.dsap == kSapGlobalControl) {
+      ++m_stats.global_control;
+      handle_global_control(ind, reply);
+    } else {
+      ++m_stats.other;
+    }
     reply.none();
     return;
   }
@@ -134,9 +143,15 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
   if (ind.da != kDefaultSlaveAddress && m_state == SlaveState::PowerOn) set_state(SlaveState::WaitPrm);
 
   if (!ind.dsap) {
-    if (is_srd(ind.fn)) handle_data_exchange(ind, reply);
+    if (is_srd(ind.fn)) {
+      ++m_stats.data_exchange;
+      handle_data_exchange(ind, reply);
+    } else {
+      ++m_stats.other;
+    }
   } else {
     const std::uint8_t dsap = *ind.dsap;
+    count_request(dsap);
     switch (dsap) {
       case kSapSetPrm: handle_set_prm(ind, reply); break;
       case kSapChkCfg: handle_chk_cfg(ind, reply); break;
@@ -162,6 +177,24 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
     }
   }
   if (!fdl::fn_expects_reply(ind.fn)) reply.none();
+  if (reply.kind == Reply::Kind::Status && reply.status == ResponseStatus::RS) ++m_stats.refused;
+}
+
+void SlaveEngine::count_request(std::uint8_t dsap) {
+  switch (dsap) {
+    case kSapSetPrm: ++m_stats.set_prm; break;
+    case kSapChkCfg: ++m_stats.chk_cfg; break;
+    case kSapSlaveDiag: ++m_stats.slave_diag; break;
+    case kSapGetCfg: ++m_stats.get_cfg; break;
+    case kSapGlobalControl: ++m_stats.global_control; break;
+    case kSapSetSlaveAdd: ++m_stats.set_slave_add; break;
+    case kSapRdInp: ++m_stats.rd_inp; break;
+    case kSapRdOutp: ++m_stats.rd_outp; break;
+    default:
+      if (dsap <= kSapC1ReadWrite) ++m_stats.dpv1;
+      else ++m_stats.other;
+      break;
+  }
 }
 
 // --- Set_Prm (§D.2) -----------------------------------------------------------------------------
@@ -173,6 +206,7 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
 
   PrmView pv;
   if (!parse_prm(ind.data, pv)) {
+    ++m_stats.prm_faults;
     m_prm_fault = true;
     go_wait_prm();
     return;
@@ -215,6 +249,7 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
   if (!fault && m_cfg.check_user_prm && !m_cfg.check_user_prm(pv.user_prm)) fault = true;
 
   if (fault || not_supported) {
+    ++m_stats.prm_faults;
     go_wait_prm();
     m_prm_fault = fault;
     m_not_supported = not_supported;
@@ -265,6 +300,7 @@ void SlaveEngine::handle_chk_cfg(const Indication& ind, Reply& reply) {
     }
   }
   if (!ok) {
+    ++m_stats.cfg_faults;
     go_wait_prm();
     m_cfg_fault = true;
     return;
@@ -338,6 +374,7 @@ void SlaveEngine::handle_data_exchange(const Indication& ind, Reply& reply) {
   const std::size_t n_out = m_layout.outputs;
   if (ind.data.size() == n_out) {
     std::copy(ind.data.begin(), ind.data.end(), m_rx_outputs.begin());
+    std::copy(ind.data.begin(), ind.data.end(), m_last_rx.begin());
     m_fail_safe_zero = false;
     if (!m_sync_mode && !m_clear) apply_outputs();
   } else if (ind.data.empty() && m_cfg.features.fail_safe) {

@@ -24,8 +24,12 @@
 //    of every other rotation.
 //  - Errors: unknown or broken GSD file, a GSD that describes a master, a baud rate the GSD does
 //    not support, unknown module name, a module selection the GSD refuses (Max_Module, lengths),
-//    tsdr_bits above the GSD's MaxTsdr (or below min TSDR), a slave without a master or with a
-//    master that is not a dp_master on its line, a dp_master address not below HSA.
+//    tsdr_bits above the GSD's MaxTsdr (or below min TSDR), a slave whose master is not a
+//    dp_master on its line, a dp_master address not below HSA.
+//  - A slave without `master` is planned like any other (configuration, the line's derived bus
+//    parameters) but belongs to no pbvbus master: it serves whatever class-1 master
+//    parameterises it (DpSlavePlan::master = dp::kNoMaster; its SlaveParams are what a
+//    configuration tool would give that master, with the default watchdog of a dp_master).
 //    Addresses used twice on a line are reported by the loader like any other station.
 
 #include <cstdint>
@@ -67,7 +71,7 @@ struct DpSlavePlan {
   int source = 0;  ///< index into Scenario.dp_slave
   int line = -1;   ///< index into ScenarioPlan::lines
   std::uint8_t address = 0;
-  std::uint8_t master = 0;
+  std::uint8_t master = 0;              ///< its dp_master, or dp::kNoMaster (none in pbvbus)
   std::string gsd_path;                 ///< resolved path
   std::string model;                    ///< GSD Model_Name
   std::vector<std::string> module_names;

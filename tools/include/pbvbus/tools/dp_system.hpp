@@ -16,11 +16,15 @@
 // diagnosis with decoded bits, in/out octets and their current values, DP cycle time
 // min/median/max from dp::MasterSlaveStats, failures/returns) and the slave's own state.
 // Global_Control frames are counted as the master hands them to its station.
+// DpSlaveView: every slave's own view (state, owner, the inputs it sent and the outputs it
+// received last, what it was asked: dp::SlaveStats, fdl::PassiveStats), whether or not a
+// pbvbus master is configured for it — the only view there is with a master outside pbvbus.
 
 #include <cstdint>
 #include <iosfwd>
 #include <span>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -96,6 +100,30 @@ struct DpSlaveReport {
   bus::Ticks cycle_median = 0;
 };
 
+/// A DP slave as it sees itself (see the report schema, "dp_slaves").
+struct DpSlaveView {
+  std::string line;
+  std::uint8_t address = 0;
+  std::string model;
+  std::string gsd;                       ///< the GSD file (path as resolved by the loader)
+  std::vector<std::string> modules;
+  std::optional<std::uint8_t> master;    ///< its dp_master in the scenario, if any
+  std::string state;                     ///< e.g. "Data_Exch"
+  std::optional<std::uint8_t> owner;     ///< the master that parameterised it
+  std::optional<bus::Ticks> watchdog;    ///< set by the owner; none = off
+  std::vector<std::uint8_t> diag;        ///< what it would answer to Slave_Diag now
+  std::vector<std::string> diag_bits;
+  std::size_t input_len = 0;
+  std::size_t output_len = 0;
+  std::vector<std::uint8_t> inputs;   ///< sent in its last Data_Exchange reply
+  std::vector<std::uint8_t> outputs;  ///< received in its last accepted Data_Exchange
+  dp::SlaveStats stats;
+  fdl::PassiveStats fdl;
+};
+
+/// The slave's own view; `line` is the line's name.
+DpSlaveView dp_slave_view(const DpSlaveNode& node, const DpSlavePlan& plan, const std::string& line);
+
 struct DpMasterReport {
   std::uint8_t address = 0;
   std::string line;
@@ -117,5 +145,8 @@ DpMasterReport dp_master_report(const DpMasterNode& m, const std::vector<const D
 void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os);
 /// The DP part of the JSON report: `,"dp_masters":[...]` (schema in report.hpp).
 void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os);
+/// The slaves' own views, text and JSON (`,"dp_slaves":[...]`).
+void write_dp_slaves_text(const std::vector<DpSlaveView>& r, std::ostream& os);
+void write_dp_slaves_json(const std::vector<DpSlaveView>& r, std::ostream& os);
 
 }  // namespace pbvbus::tools

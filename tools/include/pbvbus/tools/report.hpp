@@ -12,7 +12,23 @@
 //     "duration_ns": int,            // virtual time simulated
 //     "wall_time_s": float, "speed": float,   // speed = virtual s / wall s
 //     "events": int,                 // scheduler events run
-//     "serial": [ { "line": str, "mode": "monitor"|"station", "path": str, "link": str } ],
+//     "serial": [ { "line": str, "mode": "monitor"|"station", "path": str, "link": str,
+//                   "address": int|null,              // the external station's (STATION)
+//                   "timing": "interface"|"raw",
+//                   "frames_in": int,                 // telegrams from the program put on the line
+//                   "octets_in": int,                 // octets read from the program
+//                   "octets_sent": int,               // octets of those telegrams
+//                   "frames_out","octets_out": int,   // frames (octets) written to the program
+//                   "frames_dropped": int,            // not written: the program did not read
+//                   "garbage": int,                   // octets discarded (no start delimiter,
+//                                                     // abandoned incomplete telegrams)
+//                   "abandoned": int,                 // incomplete telegrams given up
+//                   "held": int,                      // telegrams that went out later than
+//                   "hold_total_ns","hold_max_ns": int,   // written, and by how much
+//                   "hold_total_bits","hold_max_bits": int,
+//                   "queue_max": int, "discarded": int,   // most waiting at once; lost unsent
+//                   "receivers_tsyn_drops": int       // = the line's "tsyn_drops"
+//                 } ],
 //     "faults_not_reached": [ str ], // scheduled after the end of the run
 //     "lines": [ {
 //       "name": str, "baud": int,
@@ -23,7 +39,12 @@
 //       "frames": { "total","octets","SD1","SD2","SD3","SD4","SC","garbage","responses": int },
 //       "requests": { "<function>": int },   // intact requests, e.g. "SRD_low", "FDL_Status"
 //       "errors": { "error_frames","collisions","parity","bad_fcs","malformed","partial",
-//                   "babble","no_response","retries": int },
+//                   "babble": int,
+//                   "no_response": int,  // requests (not FDL Status) without a reply on the wire
+//                   "retries": int,      // requests repeated on the wire (same octets again)
+//                   "short_idle": int,   // requests/tokens after less than TSYN idle
+//                   "tsyn_drops": int }, // requests the stations dropped for too short an idle
+//                                        // time (sum of "stations" and "dp_slaves" below)
 //       "faults": [ { "time_ns": int, "text": str } ],   // faults and repairs as applied
 //       "masters": [ { "address": int, "state": str, "in_ring": bool, "las": [int],
 //                      "tokens_received","tokens_passed","token_pass_retries",
@@ -33,7 +54,8 @@
 //                                    "min_bits","median_bits","max_bits": int },
 //                      "polls": { "requests","ok","no_response","sent","retries",
 //                                 "data_octets": int } } ],
-//       "stations": [ { "address": int, "requests","replies","fdl_status","cycles": int } ]
+//       "stations": [ { "address": int, "requests","replies","fdl_status","cycles",
+//                       "tsyn_drops": int } ]
 //     } ],
 //     "dp_masters": [ { "address": int, "line": str, "mode": "Operate"|"Clear"|"Stop"|"Offline",
 //       "global_controls": int, "data_control_time_ms": int,
@@ -45,7 +67,29 @@
 //                     "cycle": { "count","min_ns","median_ns","max_ns","min_bits",
 //                                "median_bits","max_bits": int },  // DP cycle time
 //                     "data_exchanges","startups","diag_reads","failures","returns",
-//                     "no_response","retries": int } ] } ] }
+//                     "no_response","retries": int } ] } ],
+//     "dp_slaves": [ {              // every DP slave, in line and cable order: its own view
+//       "line": str, "address": int, "model": str, "gsd": str (resolved path), "modules": [str],
+//       "master": int|null,         // its dp_master in the scenario; null: none in pbvbus
+//       "state": "Power_On"|"Wait_Prm"|"Wait_Cfg"|"Data_Exch",
+//       "owner": int|null,          // the master that parameterised (locked) it
+//       "watchdog_ns": int|null,    // response monitoring set by the owner; null = off
+//       "diag": "hex octets", "diag_bits": [str],   // the diagnosis it would send now
+//       "input_len","output_len": int,
+//       "inputs": "hex octets",     // sent in its last Data_Exchange reply
+//       "outputs": "hex octets",    // received in its last accepted Data_Exchange
+//       "requests": { "set_prm","chk_cfg","slave_diag","data_exchange","global_control",
+//                     "get_cfg","rd_inp","rd_outp","set_slave_add","dpv1","other": int },
+//       "refused": int,             // of those, answered RS
+//       "prm_faults","cfg_faults","data_exch_entries","watchdog_expiries": int,
+//       "fdl": { "requests","replies","repeats","fdl_status","dropped_errors",
+//                "dropped_tsyn": int } } ] }
+//
+// A DP slave's "requests" count each request that reached its DP layer once, from any master
+// (FCB repeats are answered by its FDL layer and counted under "fdl"."repeats"), so they match
+// what a master counts as answered. The line's "live_list", "frames", "requests" and "errors"
+// come from what was on the wire, whoever sent it (line_stats.hpp), merged with the live lists
+// of the pbvbus masters.
 //
 // The DP cycle time of a slave is the time between the starts of two consecutive
 // Data_Exchange requests to it (dp::MasterSlaveStats); its median is over the last 1024
@@ -62,6 +106,7 @@
 #include <string>
 #include <vector>
 
+#include "pbvbus/bus/pty_station.hpp"
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/fdl_poller.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
@@ -102,6 +147,7 @@ struct StationReport {
   std::uint64_t replies = 0;
   std::uint64_t fdl_status = 0;
   std::uint64_t cycles = 0;  ///< SRD answered with fresh data
+  std::uint64_t tsyn_drops = 0;  ///< requests dropped after less than TSYN idle
 };
 
 struct LiveEntry {
@@ -115,6 +161,7 @@ struct LineReport {
   fdl::BusParams params;
   std::vector<LiveEntry> live;
   LineStats traffic;  ///< a copy of the line's statistics tap
+  std::uint64_t tsyn_drops = 0;  ///< requests the line's passive stations dropped (TSYN)
   std::vector<MasterReport> masters;
   std::vector<StationReport> stations;
 };
@@ -124,6 +171,11 @@ struct SerialReport {
   std::string mode;  ///< "monitor" or "station"
   std::string path;  ///< the pty, e.g. /dev/pts/7
   std::string link;  ///< the symlink to it, or ""
+  std::optional<std::uint8_t> address;  ///< STATION: the external station's address
+  std::string timing = "interface";     ///< "interface" or "raw"
+  bus::Baud baud = bus::Baud::k1_5M;    ///< the line's, for bit times
+  bus::PtyStation::Stats stats;         ///< as of the report
+  std::uint64_t receivers_tsyn_drops = 0;  ///< the line's LineReport::tsyn_drops
 };
 
 struct Report {
@@ -137,6 +189,7 @@ struct Report {
   std::vector<std::string> faults_not_reached;
   std::vector<LineReport> lines;
   std::vector<DpMasterReport> dp_masters;
+  std::vector<DpSlaveView> dp_slaves;
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

@@ -15,6 +15,8 @@
 //    removed when the Simulation ends.
 //  - Faults scheduled after the end of the run (possible with a shorter --duration) are not
 //    applied and are listed in the report.
+//  - A serial attachment's slot time (bus::PtyStation reply window and Interface timing) is
+//    the line's TSL, so it waits as long for a reply as the line's masters would.
 
 #include <cstdint>
 #include <memory>

@@ -53,6 +53,12 @@
 // - The watchdog is restarted by every frame from the owner (any SAP, broadcast included). On
 //   expiry: outputs safe, Wait_Prm, unlocked; the diagnosis is then `02 05 00 FF idH idL`.
 //
+// - Statistics (SlaveStats, stats()): every request that reaches the engine counts under its
+//   service, whatever the answer and whoever sent it; FCB repeats are answered by the FDL
+//   station from its stored reply and never reach the engine, so they do not count (a master
+//   counting the requests it got an answer to sees the same numbers). Counters run from
+//   construction; power cycles do not reset them.
+//
 // Performance: the Data_Exchange path does not allocate (fixed buffers; Reply::data keeps its
 // capacity when the station reuses its Reply).
 
@@ -69,6 +75,29 @@
 #include "pbvbus/fdl/station.hpp"
 
 namespace pbvbus::dp {
+
+/// What the slave was asked and what became of it (the slave's own view, for reports). Each
+/// request counts once under its service (see the header comment for repeats).
+struct SlaveStats {
+  std::uint64_t set_prm = 0;         ///< Set_Prm (SAP 61)
+  std::uint64_t chk_cfg = 0;         ///< Chk_Cfg (SAP 62)
+  std::uint64_t slave_diag = 0;      ///< Slave_Diag (SAP 60)
+  std::uint64_t data_exchange = 0;   ///< Data_Exchange (default SAP, SRD)
+  std::uint64_t global_control = 0;  ///< Global_Control (SAP 58), unicast or broadcast
+  std::uint64_t get_cfg = 0;         ///< Get_Cfg (SAP 59)
+  std::uint64_t rd_inp = 0;          ///< Rd_Inp (SAP 56)
+  std::uint64_t rd_outp = 0;         ///< Rd_Outp (SAP 57)
+  std::uint64_t set_slave_add = 0;   ///< Set_Slave_Add (SAP 55)
+  std::uint64_t dpv1 = 0;            ///< MSAC_C1 and MSAC_C2 (SAPs 0..51)
+  std::uint64_t other = 0;           ///< any other SAP or function (answered RS)
+  /// Of the requests above, those answered RS (wrong state, locked by another master,
+  /// service not supported, SAP closed).
+  std::uint64_t refused = 0;
+  std::uint64_t prm_faults = 0;         ///< Set_Prm that left Prm_Fault or Not_Supported set
+  std::uint64_t cfg_faults = 0;         ///< Chk_Cfg that did not match the real configuration
+  std::uint64_t data_exch_entries = 0;  ///< transitions into Data_Exch
+  std::uint64_t watchdog_expiries = 0;  ///< response monitoring ran out (back to Wait_Prm)
+};
 
 class SlaveEngine final : public fdl::ResponderUser {
  public:
@@ -90,6 +119,15 @@ class SlaveEngine final : public fdl::ResponderUser {
   bool watchdog_on() const { return m_wd_on; }
   bus::Ticks watchdog_time() const { return m_wd_ticks; }
   const Dpv1Status& dpv1_status() const { return m_dpv1; }
+  /// Counters since construction (see SlaveStats).
+  const SlaveStats& stats() const { return m_stats; }
+  /// The inputs sent in the last Data_Exchange reply (zeros before the first one).
+  std::span<const std::uint8_t> last_inputs() const { return {m_inputs.data(), m_layout.inputs}; }
+  /// The output octets of the last Data_Exchange request accepted (zeros before the first one;
+  /// kept after the slave leaves data exchange, unlike the outputs applied to the device).
+  std::span<const std::uint8_t> last_outputs() const {
+    return {m_last_rx.data(), m_layout.outputs};
+  }
   /// Forgets a No_Add_Chg (the "factory reset" that allows Set_Slave_Add again).
   void factory_reset() { m_no_add_chg = false; }
   /// The Slave_Diag DU the slave would send now.
@@ -120,6 +158,7 @@ class SlaveEngine final : public fdl::ResponderUser {
   };
 
   void check_timers(bus::Ticks now);
+  void count_request(std::uint8_t dsap);
   void handle_set_prm(const fdl::Indication& ind, fdl::Reply& reply);
   void handle_chk_cfg(const fdl::Indication& ind, fdl::Reply& reply);
   void handle_slave_diag(const fdl::Indication& ind, fdl::Reply& reply);
@@ -176,6 +215,7 @@ class SlaveEngine final : public fdl::ResponderUser {
 
   std::array<std::uint8_t, kMaxIoLen> m_rx_outputs{};
   std::array<std::uint8_t, kMaxIoLen> m_inputs{};
+  std::array<std::uint8_t, kMaxIoLen> m_last_rx{};
   std::array<std::uint8_t, kMaxIoLen> m_frozen{};
   std::array<std::uint8_t, kMaxRecordData> m_record_buf{};
   DiagBuilder m_diag;
@@ -184,6 +224,7 @@ class SlaveEngine final : public fdl::ResponderUser {
   PendingRecord m_c1;
   std::vector<C2Connection> m_c2;
   std::uint32_t m_next_record_id = 1;
+  SlaveStats m_stats;
 
 };
 

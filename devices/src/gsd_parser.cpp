@@ -190,6 +190,7 @@ class GsdParser {
   void data_type_line(const Stmt& s);
   bool block_start(const Stmt& s) const;
   void unknown(const Stmt& s, std::string_view where);
+  void defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line);
   void remember(const Stmt& s);
   void close_block_at_end();
   void finish();
@@ -217,7 +218,6 @@ class GsdParser {
   std::unordered_map<std::string, std::uint32_t> m_seen;  // key(+index) -> line
   std::map<bus::Baud, std::uint32_t> m_supp_line;         // supported (= 1) rates
   std::map<bus::Baud, std::uint16_t> m_max_tsdr;
-  std::map<std::uint16_t, std::uint32_t> m_prm_text_lines;
 };
 
 
@@ -673,6 +673,13 @@ void GsdParser::unknown(const Stmt& s, std::string_view where) {
   warning(s.line, "unknown keyword '" + s.keyword + "'" + std::string(where) + " kept");
 }
 
+// Vendor files repeat a PrmText or ExtUserPrmData number (copied blocks); like a repeated
+// keyword, the later definition replaces the earlier one and the file stays usable.
+void GsdParser::defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line) {
+  warning(line, what + " defined twice (first at line " + std::to_string(first_line) +
+                    "); the later definition wins");
+}
+
 void GsdParser::remember(const Stmt& s) {
   m_result_file.m_keywords.push_back({s.keyword, s.index, s.value, s.line});
 }
@@ -954,12 +961,10 @@ void GsdParser::in_module(const Stmt& s) {
 void GsdParser::in_prm_text(const Stmt& s) {
   const std::string where = " in PrmText " + std::to_string(m_prm_text.ref);
   if (s.key == "endprmtext") {
-    auto [it, fresh] = m_prm_text_lines.emplace(m_prm_text.ref, m_prm_text.line);
-    if (!fresh)
-      error(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref) +
-                                 " defined twice (first at line " + std::to_string(it->second) + ")");
-    else
-      m_result_file.m_prm_texts[m_prm_text.ref] = std::move(m_prm_text);
+    auto& texts = m_result_file.m_prm_texts;
+    if (auto it = texts.find(m_prm_text.ref); it != texts.end())
+      defined_twice(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref), it->second.line);
+    texts[m_prm_text.ref] = std::move(m_prm_text);
     m_block = Block::Top;
   } else if (s.key == "text") {
     if (!s.has_index) {
@@ -1109,10 +1114,10 @@ void GsdParser::in_ext_prm(const Stmt& s) {
       error(m_ext.line, what + ": data type line missing");
       return;
     }
-    auto [it, fresh] = m_result_file.m_ext_prm.emplace(m_ext.ref, m_ext);
-    if (!fresh)
-      error(m_ext.line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " defined twice (first at line " +
-                            std::to_string(it->second.line) + ")");
+    auto& defs = m_result_file.m_ext_prm;
+    if (auto it = defs.find(m_ext.ref); it != defs.end())
+      defined_twice(m_ext.line, "ExtUserPrmData " + std::to_string(m_ext.ref), it->second.line);
+    defs[m_ext.ref] = m_ext;
   } else if (k == "bit" || k == "bitarea" || k == "unsigned8" || k == "unsigned16" ||
              k == "unsigned32" || k == "signed8" || k == "signed16" || k == "signed32") {
     data_type_line(s);

@@ -185,6 +185,7 @@ class GsdParser {
   void in_slots(const Stmt& s);
   bool scalar(const Stmt& s);
   bool baud_keyword(const Stmt& s);
+  bool data_length_limit(const Stmt& s);
   void prm_const(const Stmt& s, GsdPrmArea& area);
   void prm_ref(const Stmt& s, GsdPrmArea& area);
   void data_type_line(const Stmt& s);
@@ -271,9 +272,6 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_U("Max_Diag_Data_Len", 244, m_slave.max_diag_data_len),
         PBV_B("Modular_Station", m_slave.modular_station),
         PBV_U("Max_Module", 255, m_slave.max_module),
-        PBV_U("Max_Input_Len", 244, m_slave.max_input_len),
-        PBV_U("Max_Output_Len", 244, m_slave.max_output_len),
-        PBV_U("Max_Data_Len", 488, m_slave.max_data_len),
         PBV_U("Modul_Offset", 255, m_slave.modul_offset),
         // DP-V1
         PBV_B("DPV1_Slave", m_dpv1.dpv1_slave),
@@ -749,6 +747,38 @@ bool GsdParser::baud_keyword(const Stmt& s) {
   return false;
 }
 
+// Max_Input_Len, Max_Output_Len, Max_Data_Len. A DP slave exchanges at most 244 octets in each
+// direction (protocol-facts.md §D.3 "per slave <= 244 B in and <= 244 B out"; §A: 244 octets of
+// DP payload per telegram), so PI 2.122 allows 0..244, 0..244 and 0..488. Files in the field
+// write more (249, the FDL LE limit, and 498): such a value is clamped to the limit with a
+// warning instead of refusing the file, since the limit is what any master will use anyway.
+bool GsdParser::data_length_limit(const Stmt& s) {
+  struct Limit {
+    std::string_view key;
+    std::string_view name;
+    std::uint16_t limit;
+  };
+  static constexpr Limit kLimits[] = {{"max_input_len", "Max_Input_Len", 244},
+                                      {"max_output_len", "Max_Output_Len", 244},
+                                      {"max_data_len", "Max_Data_Len", 488}};
+  const Limit* l = nullptr;
+  for (const auto& k : kLimits)
+    if (k.key == s.key) l = &k;
+  if (l == nullptr) return false;
+  auto v = unsigned_value(s, l->name, 0xFFFF);
+  if (!v) return true;
+  if (*v > l->limit) {
+    warning(s.line, std::string(l->name) + " " + std::to_string(*v) + " above the DP limit " +
+                        std::to_string(l->limit) + "; clamped to " + std::to_string(l->limit));
+    v = l->limit;
+  }
+  auto& sf = m_result_file.m_slave;
+  if (s.key == "max_input_len") sf.max_input_len = static_cast<std::uint8_t>(*v);
+  else if (s.key == "max_output_len") sf.max_output_len = static_cast<std::uint8_t>(*v);
+  else sf.max_data_len = static_cast<std::uint16_t>(*v);
+  return true;
+}
+
 void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
   auto off = index_value(s, 236);
   if (!off || !need_value(s)) return;
@@ -896,7 +926,7 @@ void GsdParser::top(const Stmt& s) {
     std::string v = s.value;
     if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
     f.m_info.slave_family = v;
-  } else if (baud_keyword(s) || scalar(s)) {
+  } else if (baud_keyword(s) || data_length_limit(s) || scalar(s)) {
     // handled
   } else if (known_raw(k)) {
     // kept in keywords() only

@@ -193,6 +193,7 @@ class GsdParser {
   void unknown(const Stmt& s, std::string_view where);
   void defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line);
   void remember(const Stmt& s);
+  void correct_spelling(Stmt& s);
   void close_block_at_end();
   void finish();
   static const std::unordered_map<std::string, ScalarKeyword>& table();
@@ -301,7 +302,6 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_B("Alarm_Type_Mode_supp", m_dpv1.alarm_type_mode_supp),
         PBV_U("Alarm_Sequence_Mode_Count", 32, m_dpv1.alarm_sequence_mode_count),
         PBV_B("WD_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),
-        PBV_B("WB_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),  // misspelling found in real files
         PBV_B("Check_Cfg_Mode", m_dpv1.check_cfg_mode),
         PBV_B("DPV1_Data_Types", m_dpv1.dpv1_data_types),
         PBV_B("Publisher_supp", m_dpv1.publisher_supp),
@@ -799,8 +799,29 @@ void GsdParser::prm_ref(const Stmt& s, GsdPrmArea& area) {
   area.refs.push_back({*off, static_cast<std::uint16_t>(*ref), s.line});
 }
 
-void GsdParser::top(const Stmt& s) {
-  remember(s);
+// Misspellings common in real files, read as the keyword they mean (with a warning, so that the
+// vendor can fix the file). Min_Slave_Interval: the standard's keyword has two l; read with one,
+// the poll interval would silently become 0. WB_Base_1ms_supp: listed by S10 (protocol-facts.md
+// §I.2) next to the right spelling.
+void GsdParser::correct_spelling(Stmt& s) {
+  struct Misspelling {
+    std::string_view wrong;
+    std::string_view right;
+  };
+  static constexpr Misspelling kMisspellings[] = {{"min_slave_interval", "Min_Slave_Intervall"},
+                                                  {"wb_base_1ms_supp", "WD_Base_1ms_supp"}};
+  for (const auto& m : kMisspellings) {
+    if (s.key != m.wrong) continue;
+    warning(s.line, "'" + s.keyword + "' read as '" + std::string(m.right) + "' (common misspelling)");
+    s.key = lower(m.right);
+    return;
+  }
+}
+
+void GsdParser::top(const Stmt& written) {
+  remember(written);
+  Stmt s = written;
+  correct_spelling(s);
   // Blocks repeat; several Ext_User_Prm_Data_Ref at one offset are the normal way to place
   // several bit parameters in one byte.
   static const std::array<std::string_view, 18> kRepeatable = {

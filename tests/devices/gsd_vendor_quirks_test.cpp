@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/devices/slave_model.hpp"
 
 using namespace pbvbus::devices;
 
@@ -63,4 +64,42 @@ TEST(GsdVendorQuirks, DataLengthsWithinTheLimitsAndBeyondSixteenBits) {
   r = parse_gsd(head + "Max_Data_Len=70000\n", "l.gsd");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.errors[0].to_string(), "l.gsd:10: value 70000 out of range for Max_Data_Len (0..65535)");
+}
+
+// --- (c) Min_Slave_Interval (one l) ---------------------------------------------------------------
+
+TEST(GsdVendorQuirks, MinSlaveIntervalWithOneL) {
+  const std::string path = src("tests/data/gsd/vendor-quirks/min-slave-interval.gsd");
+  const GsdParseResult r = load_gsd(path);
+  ASSERT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].to_string());
+  // One warning only: no "Min_Slave_Intervall missing" after it.
+  EXPECT_EQ(texts(r.warnings),
+            (std::vector<std::string>{
+                path + ":21: 'Min_Slave_Interval' read as 'Min_Slave_Intervall' (common misspelling)"}));
+  EXPECT_EQ(r.file->slave_features().min_slave_intervall, 6);  // x 100 us = 600 us
+  EXPECT_TRUE(r.file->unknown_keywords().empty());
+  // The master polls it no faster than that (it was 0, raised to 1, before).
+  auto p = master_slave_params(*r.file, {ModuleChoice::at(0)}, 5);
+  ASSERT_TRUE(p.ok());
+  EXPECT_EQ(p.value->min_slave_interval, 6);
+}
+
+TEST(GsdVendorQuirks, MisspellingsCountAsTheKeywordTheyMean) {
+  const std::string head =
+      "#Profibus_DP\nIdent_Number=0x1234\nStation_Type=0\n12M_supp=1\nMaxTsdr_12M=800\n"
+      "Max_Diag_Data_Len=6\nModule=\"m\" 0x10\nEndModule\n";
+  // Both spellings: the second is a repetition of the first, the later value wins.
+  GsdParseResult r = parse_gsd(head + "Min_Slave_Intervall=2\nMIN_SLAVE_INTERVAL=3\nWB_Base_1ms_supp=1\n", "s.gsd");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(texts(r.warnings),
+            (std::vector<std::string>{
+                "s.gsd:10: 'MIN_SLAVE_INTERVAL' read as 'Min_Slave_Intervall' (common misspelling)",
+                "s.gsd:10: 'MIN_SLAVE_INTERVAL' given twice (first at line 9); the later value wins",
+                "s.gsd:11: 'WB_Base_1ms_supp' read as 'WD_Base_1ms_supp' (common misspelling)"}));
+  EXPECT_EQ(r.file->slave_features().min_slave_intervall, 3);
+  EXPECT_TRUE(r.file->dpv1().wd_base_1ms_supp);
+  // A misspelt keyword is still checked like the right one.
+  r = parse_gsd(head + "Min_Slave_Interval=70000\n", "s.gsd");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.errors[0].to_string(), "s.gsd:9: value 70000 out of range for Min_Slave_Intervall (0..65535)");
 }

@@ -16,7 +16,9 @@
 //   it (warning).
 // - Booleans must be 0 or 1. Numbers are decimal or 0x hex; a value out of the keyword's range is
 //   an error, except Max_Input_Len/Max_Output_Len above 244 and Max_Data_Len above 488 (files
-//   in the field write 249 and 498): those are clamped to the DP limit with a warning. A keyword given twice: the later value wins, with a warning. Likewise a PrmText or
+//   in the field write 249 and 498): those are clamped to the DP limit with a warning.
+// - Common misspellings are read as the keyword they mean, with a warning: Min_Slave_Interval
+//   (one l) as Min_Slave_Intervall, WB_Base_1ms_supp as WD_Base_1ms_supp. A keyword given twice: the later value wins, with a warning. Likewise a PrmText or
 //   ExtUserPrmData number defined twice (vendor files repeat copied blocks): the later block
 //   replaces the earlier one, with a warning at the later block's line.
 // - User_Prm_Data assembly (user_prm_data()): the global area is User_Prm_Data_Len bytes (or, when

@@ -106,6 +106,23 @@ std::optional<bus::Baud> baud_from_gsd(std::string_view lower_name) {
   return std::nullopt;
 }
 
+// A per-baud keyword (lower case): "<rate>_supp" gives kind "_supp"; "maxtsdr_<rate>" and the
+// master's "trdy_", "tqui_", "tset_", "tsdi_" give that prefix as the kind.
+struct BaudKey {
+  std::string_view kind;
+  bus::Baud baud;
+};
+std::optional<BaudKey> split_baud_key(std::string_view k) {
+  static constexpr std::array<std::string_view, 5> kPrefixes = {"maxtsdr_", "trdy_", "tqui_", "tset_", "tsdi_"};
+  constexpr std::string_view kSupp = "_supp";
+  if (k.size() > kSupp.size() && k.substr(k.size() - kSupp.size()) == kSupp)
+    if (auto b = baud_from_gsd(k.substr(0, k.size() - kSupp.size()))) return BaudKey{kSupp, *b};
+  for (std::string_view prefix : kPrefixes)
+    if (k.size() > prefix.size() && k.substr(0, prefix.size()) == prefix)
+      if (auto b = baud_from_gsd(k.substr(prefix.size()))) return BaudKey{prefix, *b};
+  return std::nullopt;
+}
+
 std::string gsd_baud_spelling(bus::Baud b) {
   for (const auto& n : kBaudNames)
     if (n.baud == b) {
@@ -150,6 +167,12 @@ class GsdParser {
   };
 
   enum class Block { Top, Module, PrmText, ExtPrm, DiagArea, Slots, Opaque };
+  struct OpenBlock {
+    Block kind = Block::Top;
+    std::string end;    // the end keyword as PI 2.122 spells it
+    std::uint32_t line = 0;
+    std::string title;  // Opaque blocks: the keyword that opened it
+  };
 
   // --- messages
   void error(std::uint32_t line, std::string reason) {
@@ -190,6 +213,15 @@ class GsdParser {
   void prm_ref(const Stmt& s, GsdPrmArea& area);
   void data_type_line(const Stmt& s);
   bool block_start(const Stmt& s) const;
+  static bool end_keyword(std::string_view key);
+  static bool top_level_keyword(std::string_view key);
+  static bool module_keyword(std::string_view key);
+  Block block() const { return m_open.empty() ? Block::Top : m_open.back().kind; }
+  void open_block(Block kind, std::string end, std::uint32_t line, std::string title = {});
+  std::string block_title(const OpenBlock& b) const;
+  bool own_end(const OpenBlock& b, std::string_view key) const;
+  bool leaves_block(const Stmt& s) const;
+  void unterminated(const Stmt& s);
   void unknown(const Stmt& s, std::string_view where);
   void defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line);
   void remember(const Stmt& s);
@@ -206,10 +238,11 @@ class GsdParser {
   std::uint32_t m_section_line = 0;
   std::vector<std::pair<std::string, std::uint32_t>> m_logical;
 
-  Block m_block = Block::Top;
-  std::uint32_t m_block_line = 0;
-  std::string m_opaque_end;  // end keyword (lower case) of an opaque block
-  Block m_opaque_return = Block::Top;
+  // Open blocks, innermost last (only a Data_Area nests, inside a Module); empty at the top.
+  std::vector<OpenBlock> m_open;
+  // End keyword (lower case) of the last block ended by a statement that cannot be inside it:
+  // its real end keyword may still follow and is then not reported a second time.
+  std::string m_dangling_end;
   std::size_t m_module_stmts = 0;
   GsdModule m_module;
   GsdPrmText m_prm_text;
@@ -373,13 +406,19 @@ bool known_raw(std::string_view key) {
 }
 
 bool known_module_raw(std::string_view key) {
-  static const std::array<std::string_view, 12> kKnown = {
+  static const std::array<std::string_view, 17> kKnown = {
       "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
       "x_ext_module_prm_data_len", "x_ext_user_prm_data_const", "x_ext_user_prm_data_ref",
       "preset",                    "channel_diag",              "module_reference",
       "ordernumber",               "bitmap_device",             "alarm_type_mode_supp",
+      "ident_maintenance_supp",    "channel_diag_help",         "info_text_help",
+      "subsys_module_dir_index",   "order_number",
   };
   return std::find(kKnown.begin(), kKnown.end(), key) != kKnown.end();
+}
+
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
 }
 
 std::string shorten(std::string_view s) {
@@ -388,6 +427,35 @@ std::string shorten(std::string_view s) {
 }
 
 }  // namespace
+
+bool GsdParser::end_keyword(std::string_view key) {
+  static const std::array<std::string_view, 8> kEnds = {
+      "endmodule", "endprmtext", "endextuserprmdata", "unit_diag_area_end", "x_unit_diag_area_end",
+      "endslotdefinition", "endunitdiagtype", "end_physical_interface"};
+  return std::find(kEnds.begin(), kEnds.end(), key) != kEnds.end();
+}
+
+// Keywords the reader knows at the top level of the #Profibus_DP section. Help texts (*_help)
+// are left out: they may accompany an item inside a block.
+bool GsdParser::top_level_keyword(std::string_view key) {
+  if (ends_with(key, "_help")) return false;
+  static const std::array<std::string_view, 13> kOthers = {
+      "unit_diag_bit", "channel_diag", "ext_user_prm_data_const", "ext_user_prm_data_ref",
+      "user_prm_data", "user_prm_data_len", "max_user_prm_data_len", "slave_family",
+      "max_input_len", "max_output_len", "max_data_len", "min_slave_interval", "wb_base_1ms_supp"};
+  return table().count(std::string(key)) != 0 || split_baud_key(key).has_value() || known_raw(key) ||
+         std::find(kOthers.begin(), kOthers.end(), key) != kOthers.end();
+}
+
+// Keywords PI 2.122 allows inside a Module (modelled or kept raw); several of them are top-level
+// keywords too. Alarm requirements may be given per module [U]: accepted there.
+bool GsdParser::module_keyword(std::string_view key) {
+  static const std::array<std::string_view, 5> kModelled = {
+      "ext_module_prm_data_len", "ext_user_prm_data_const", "ext_user_prm_data_ref", "info_text",
+      "data_area_beg"};
+  return known_module_raw(key) || std::find(kModelled.begin(), kModelled.end(), key) != kModelled.end() ||
+         ends_with(key, "_alarm_required") || ends_with(key, "_alarm_supp");
+}
 
 // ---------------------------------------------------------------------------------------------
 // Lexical passes
@@ -683,7 +751,11 @@ void GsdParser::remember(const Stmt& s) {
 }
 
 void GsdParser::statement(const Stmt& s) {
-  switch (m_block) {
+  if (block() != Block::Top && leaves_block(s)) {
+    unterminated(s);
+    return;
+  }
+  switch (block()) {
     case Block::Top: top(s); break;
     case Block::Module: in_module(s); break;
     case Block::PrmText: in_prm_text(s); break;
@@ -691,9 +763,63 @@ void GsdParser::statement(const Stmt& s) {
     case Block::DiagArea: in_diag_area(s); break;
     case Block::Slots: in_slots(s); break;
     case Block::Opaque:
-      if (s.key == m_opaque_end) m_block = m_opaque_return;
+      if (own_end(m_open.back(), s.key)) m_open.pop_back();
       break;
   }
+}
+
+void GsdParser::open_block(Block kind, std::string end, std::uint32_t line, std::string title) {
+  m_open.push_back({kind, std::move(end), line, std::move(title)});
+  m_dangling_end.clear();
+}
+
+std::string GsdParser::block_title(const OpenBlock& b) const {
+  switch (b.kind) {
+    case Block::Module: return "Module '" + m_module.name + "'";
+    case Block::PrmText: return "PrmText " + std::to_string(m_prm_text.ref);
+    case Block::ExtPrm: return "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+    case Block::DiagArea: return m_diag_area.x_variant ? "X_Unit_Diag_Area" : "Unit_Diag_Area";
+    case Block::Slots: return "SlotDefinition";
+    case Block::Top:
+    case Block::Opaque: break;
+  }
+  return b.title;
+}
+
+bool GsdParser::own_end(const OpenBlock& b, std::string_view key) const {
+  // Either diagnosis-area end closes either variant, as files mix them.
+  if (b.kind == Block::DiagArea) return key == "unit_diag_area_end" || key == "x_unit_diag_area_end";
+  return key == lower(b.end);
+}
+
+// A statement that cannot be inside the open block: the block's end keyword is missing. Block
+// starts and other blocks' end keywords never belong inside a block; keywords of the top level
+// end the blocks whose content the reader knows (a Module accepts the keywords PI 2.122 allows in
+// it even where they are top-level keywords too). Opaque blocks end only at a block boundary.
+bool GsdParser::leaves_block(const Stmt& s) const {
+  const OpenBlock& b = m_open.back();
+  if (own_end(b, s.key)) return false;
+  if (block_start(s) || end_keyword(s.key)) return true;
+  switch (b.kind) {
+    case Block::Opaque: return false;
+    case Block::Module: return top_level_keyword(s.key) && !module_keyword(s.key);
+    default: return top_level_keyword(s.key);
+  }
+}
+
+// Reported once, at the line that opened the block, with the statement that showed the end
+// missing; the statement then counts where it belongs. A wrong end keyword is taken as the end
+// of this block (so that it is not reported again as an end without its block).
+void GsdParser::unterminated(const Stmt& s) {
+  const OpenBlock b = m_open.back();
+  const bool is_end = end_keyword(s.key);
+  error(b.line, block_title(b) + " without " + b.end + "; '" + s.keyword + "' at line " +
+                    std::to_string(s.line) +
+                    (is_end ? " ends another kind of block" : " cannot be inside it"));
+  m_open.pop_back();
+  if (is_end && (m_open.empty() || !own_end(m_open.back(), s.key))) return;
+  if (!is_end) m_dangling_end = lower(b.end);
+  statement(s);
 }
 
 bool GsdParser::scalar(const Stmt& s) {
@@ -716,35 +842,27 @@ bool GsdParser::scalar(const Stmt& s) {
 }
 
 bool GsdParser::baud_keyword(const Stmt& s) {
-  const std::string& k = s.key;
-  if (k.size() > 5 && k.compare(k.size() - 5, 5, "_supp") == 0) {
-    auto b = baud_from_gsd(std::string_view(k).substr(0, k.size() - 5));
-    if (!b) return false;
+  const auto bk = split_baud_key(s.key);
+  if (!bk) return false;
+  if (bk->kind == "_supp") {
     if (auto v = boolean(s, s.keyword)) {
       if (*v)
-        m_supp_line[*b] = s.line;
+        m_supp_line[bk->baud] = s.line;
       else
-        m_supp_line.erase(*b);
+        m_supp_line.erase(bk->baud);
     }
     return true;
   }
-  static const std::array<std::string_view, 5> kPrefixes = {"maxtsdr_", "trdy_", "tqui_", "tset_", "tsdi_"};
-  for (std::string_view prefix : kPrefixes) {
-    if (k.size() <= prefix.size() || k.compare(0, prefix.size(), prefix) != 0) continue;
-    auto b = baud_from_gsd(std::string_view(k).substr(prefix.size()));
-    if (!b) return false;
-    auto v = unsigned_value(s, s.keyword, 0xFFFF);
-    if (!v) return true;
-    const auto val = static_cast<std::uint16_t>(*v);
-    auto& m = m_result_file.m_master;
-    if (prefix == "maxtsdr_") m_max_tsdr[*b] = val;
-    else if (prefix == "trdy_") m.trdy[*b] = val;
-    else if (prefix == "tqui_") m.tqui[*b] = val;
-    else if (prefix == "tset_") m.tset[*b] = val;
-    else m.tsdi[*b] = val;
-    return true;
-  }
-  return false;
+  auto v = unsigned_value(s, s.keyword, 0xFFFF);
+  if (!v) return true;
+  const auto val = static_cast<std::uint16_t>(*v);
+  auto& m = m_result_file.m_master;
+  if (bk->kind == "maxtsdr_") m_max_tsdr[bk->baud] = val;
+  else if (bk->kind == "trdy_") m.trdy[bk->baud] = val;
+  else if (bk->kind == "tqui_") m.tqui[bk->baud] = val;
+  else if (bk->kind == "tset_") m.tset[bk->baud] = val;
+  else m.tsdi[bk->baud] = val;
+  return true;
 }
 
 // Max_Input_Len, Max_Output_Len, Max_Data_Len. A DP slave exchanges at most 244 octets in each
@@ -822,6 +940,10 @@ void GsdParser::top(const Stmt& written) {
   remember(written);
   Stmt s = written;
   correct_spelling(s);
+  if (!m_dangling_end.empty() && s.key == m_dangling_end) {
+    m_dangling_end.clear();  // already reported as the missing end of its block
+    return;
+  }
   // Blocks repeat; several Ext_User_Prm_Data_Ref at one offset are the normal way to place
   // several bit parameters in one byte.
   static const std::array<std::string_view, 18> kRepeatable = {
@@ -849,8 +971,7 @@ void GsdParser::top(const Stmt& written) {
     m_module = GsdModule{};
     m_module.name = *name;
     m_module.line = s.line;
-    m_block = Block::Module;
-    m_block_line = s.line;
+    open_block(Block::Module, "EndModule", s.line);
     m_module_stmts = 0;
     auto bytes = byte_list(rest, s.line, "config byte");
     if (!bytes) return;
@@ -863,16 +984,14 @@ void GsdParser::top(const Stmt& written) {
     m_prm_text = GsdPrmText{};
     m_prm_text.ref = static_cast<std::uint16_t>(ref.value_or(0));
     m_prm_text.line = s.line;
-    m_block = Block::PrmText;
-    m_block_line = s.line;
+    open_block(Block::PrmText, "EndPrmText", s.line);
   } else if (k == "endprmtext") {
     error(s.line, "EndPrmText without PrmText");
   } else if (k == "extuserprmdata") {
     m_ext = GsdExtUserPrmData{};
     m_ext.line = s.line;
     m_ext_has_type = false;
-    m_block = Block::ExtPrm;
-    m_block_line = s.line;
+    open_block(Block::ExtPrm, "EndExtUserPrmData", s.line);
     if (!need_value(s)) return;
     const std::string_view v = s.value;
     const std::size_t q = v.find('"');
@@ -894,8 +1013,7 @@ void GsdParser::top(const Stmt& written) {
     m_diag_area = GsdUnitDiagArea{};
     m_diag_area.x_variant = k[0] == 'x';
     m_diag_area.line = s.line;
-    m_block = Block::DiagArea;
-    m_block_line = s.line;
+    open_block(Block::DiagArea, m_diag_area.x_variant ? "X_Unit_Diag_Area_End" : "Unit_Diag_Area_End", s.line);
     if (!need_value(s)) return;
     const std::size_t dash = s.value.find('-');
     auto a = number(std::string_view(s.value).substr(0, dash), s.line);
@@ -911,15 +1029,12 @@ void GsdParser::top(const Stmt& written) {
   } else if (k == "unit_diag_area_end" || k == "x_unit_diag_area_end") {
     error(s.line, s.keyword + " without Unit_Diag_Area");
   } else if (k == "slotdefinition") {
-    m_block = Block::Slots;
-    m_block_line = s.line;
+    open_block(Block::Slots, "EndSlotDefinition", s.line);
   } else if (k == "endslotdefinition") {
     error(s.line, "EndSlotDefinition without SlotDefinition");
   } else if (k == "unitdiagtype" || k == "physical_interface") {
-    m_block = Block::Opaque;
-    m_block_line = s.line;
-    m_opaque_end = k == "unitdiagtype" ? "endunitdiagtype" : "end_physical_interface";
-    m_opaque_return = Block::Top;
+    open_block(Block::Opaque, k == "unitdiagtype" ? "EndUnitDiagType" : "End_Physical_Interface", s.line,
+               s.keyword);
   } else if (k == "endunitdiagtype" || k == "end_physical_interface") {
     error(s.line, s.keyword + " without its block start");
   } else if (k == "unit_diag_bit" || k == "channel_diag") {
@@ -963,7 +1078,7 @@ void GsdParser::in_module(const Stmt& s) {
   if (k == "endmodule") {
     m_result_file.m_modules.push_back(std::move(m_module));
     m_module = GsdModule{};
-    m_block = Block::Top;
+    m_open.pop_back();
     return;
   }
   if (!s.has_eq && !s.has_index && s.value.empty() &&
@@ -982,12 +1097,6 @@ void GsdParser::in_module(const Stmt& s) {
     m_module.reference = static_cast<std::uint32_t>(*v);
     return;
   }
-  if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "'" + where + " (EndModule missing?)");
-    m_block = Block::Top;  // resynchronise: the statement opens its own block
-    top(s);
-    return;
-  }
   if (k == "ext_module_prm_data_len") {
     if (auto v = unsigned_value(s, "Ext_Module_Prm_Data_Len", 237))
       m_module.prm.declared_len = static_cast<std::uint16_t>(*v);
@@ -998,9 +1107,7 @@ void GsdParser::in_module(const Stmt& s) {
   } else if (k == "info_text") {
     if (auto v = string_value(s, "Info_Text")) m_module.info_text = *v;
   } else if (k == "data_area_beg") {
-    m_block = Block::Opaque;
-    m_opaque_end = "data_area_end";
-    m_opaque_return = Block::Module;
+    open_block(Block::Opaque, "Data_Area_End", s.line, s.keyword);
   } else {
     m_module.other_keywords.push_back({s.keyword, s.index, s.value, s.line});
     if (!known_module_raw(k)) {
@@ -1016,7 +1123,7 @@ void GsdParser::in_prm_text(const Stmt& s) {
     if (auto it = texts.find(m_prm_text.ref); it != texts.end())
       defined_twice(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref), it->second.line);
     texts[m_prm_text.ref] = std::move(m_prm_text);
-    m_block = Block::Top;
+    m_open.pop_back();
   } else if (s.key == "text") {
     if (!s.has_index) {
       error(s.line, "'Text' needs an index: Text(value)");
@@ -1027,10 +1134,6 @@ void GsdParser::in_prm_text(const Stmt& s) {
     auto t = string_value(s, "Text");
     if (!t) return;
     m_prm_text.texts.emplace_back(*v, *t);
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "'" + where + " (EndPrmText missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, where);
   }
@@ -1160,7 +1263,7 @@ void GsdParser::in_ext_prm(const Stmt& s) {
   const std::string& k = s.key;
   const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
   if (k == "endextuserprmdata") {
-    m_block = Block::Top;
+    m_open.pop_back();
     if (!m_ext_has_type) {
       error(m_ext.line, what + ": data type line missing");
       return;
@@ -1178,10 +1281,6 @@ void GsdParser::in_ext_prm(const Stmt& s) {
     if (auto v = boolean(s, "Changeable")) m_ext.changeable = *v;
   } else if (k == "visible") {
     if (auto v = boolean(s, "Visible")) m_ext.visible = *v;
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "' in " + what + " (EndExtUserPrmData missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, " in " + what);
   }
@@ -1190,7 +1289,7 @@ void GsdParser::in_ext_prm(const Stmt& s) {
 void GsdParser::in_diag_area(const Stmt& s) {
   if (s.key == "unit_diag_area_end" || s.key == "x_unit_diag_area_end") {
     m_result_file.m_unit_diag_areas.push_back(std::move(m_diag_area));
-    m_block = Block::Top;
+    m_open.pop_back();
   } else if (s.key == "value") {
     if (!s.has_index) {
       error(s.line, "'Value' needs an index: Value(n)");
@@ -1201,10 +1300,6 @@ void GsdParser::in_diag_area(const Stmt& s) {
     auto t = string_value(s, "Value");
     if (!t) return;
     m_diag_area.values.emplace_back(*v, *t);
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "' in Unit_Diag_Area (Unit_Diag_Area_End missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, " in Unit_Diag_Area");
   }
@@ -1212,17 +1307,11 @@ void GsdParser::in_diag_area(const Stmt& s) {
 
 void GsdParser::in_slots(const Stmt& s) {
   if (s.key == "endslotdefinition") {
-    m_block = Block::Top;
+    m_open.pop_back();
     return;
   }
   if (s.key != "slot") {
-    if (block_start(s)) {
-      error(s.line, "'" + s.keyword + "' in SlotDefinition (EndSlotDefinition missing?)");
-      m_block = Block::Top;
-      top(s);
-    } else {
-      unknown(s, " in SlotDefinition");
-    }
+    unknown(s, " in SlotDefinition");
     return;
   }
   GsdSlot slot;
@@ -1272,22 +1361,10 @@ void GsdParser::in_slots(const Stmt& s) {
 }
 
 void GsdParser::close_block_at_end() {
-  switch (m_block) {
-    case Block::Top: return;
-    case Block::Module: error(m_block_line, "Module '" + m_module.name + "' without EndModule"); break;
-    case Block::PrmText:
-      error(m_block_line, "PrmText " + std::to_string(m_prm_text.ref) + " without EndPrmText");
-      break;
-    case Block::ExtPrm:
-      error(m_block_line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " without EndExtUserPrmData");
-      break;
-    case Block::DiagArea: error(m_block_line, "Unit_Diag_Area without Unit_Diag_Area_End"); break;
-    case Block::Slots: error(m_block_line, "SlotDefinition without EndSlotDefinition"); break;
-    case Block::Opaque:
-      error(m_block_line, "block without its end keyword '" + m_opaque_end + "'");
-      break;
+  for (; !m_open.empty(); m_open.pop_back()) {
+    const OpenBlock& b = m_open.back();
+    error(b.line, block_title(b) + " without " + b.end);
   }
-  m_block = Block::Top;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -18,7 +18,13 @@
 //   an error, except Max_Input_Len/Max_Output_Len above 244 and Max_Data_Len above 488 (files
 //   in the field write 249 and 498): those are clamped to the DP limit with a warning.
 // - Common misspellings are read as the keyword they mean, with a warning: Min_Slave_Interval
-//   (one l) as Min_Slave_Intervall, WB_Base_1ms_supp as WD_Base_1ms_supp. A keyword given twice: the later value wins, with a warning. Likewise a PrmText or
+//   (one l) as Min_Slave_Intervall, WB_Base_1ms_supp as WD_Base_1ms_supp.
+// - A block without its end keyword (EndModule, EndPrmText, EndExtUserPrmData, ...) is one error
+//   at the line that opened it, naming the statement that showed the end missing: a block start,
+//   another block's end keyword, or a top-level keyword the block cannot contain (a Module keeps
+//   the keywords PI 2.122 allows in modules; UnitDiagType, Physical_Interface and Data_Area
+//   contents are not interpreted, so only a block boundary ends them). The statement then counts
+//   where it belongs, and the missing end keyword, if it comes later, is not reported again. A keyword given twice: the later value wins, with a warning. Likewise a PrmText or
 //   ExtUserPrmData number defined twice (vendor files repeat copied blocks): the later block
 //   replaces the earlier one, with a warning at the later block's line.
 // - User_Prm_Data assembly (user_prm_data()): the global area is User_Prm_Data_Len bytes (or, when

@@ -343,6 +343,8 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_B("Prm_Block_Structure_supp", m_dpv1.prm_block_structure_supp),
         PBV_B("Prm_Block_Structure_req", m_dpv1.prm_block_structure_req),
         PBV_B("Fail_Safe_required", m_dpv1.fail_safe_required),
+        PBV_B("Isochron_Mode_supp", m_dpv1.isochron_mode_supp),
+        PBV_B("Isochron_Mode_required", m_dpv1.isochron_mode_required),
         // Redundancy (§G.7)
         PBV_B("Redundancy", m_redundancy.redundancy),
         PBV_B("PrmCmd_supp", m_redundancy.prm_cmd_supp),
@@ -386,12 +388,11 @@ namespace {
 
 // Keywords of PI 2.122 that the model does not interpret; kept raw, no warning.
 bool known_raw(std::string_view key) {
-  static const std::array<std::string_view, 42> kKnown = {
-      "bitmap_device",        "bitmap_device",        "bitmap_diag",
-      "bitmap_sf",            "unit_diag_not_bit",    "x_unit_diag_bit",
-      "x_unit_diag_not_bit",  "unit_diag_bit_help",   "x_unit_diag_bit_help",
-      "unit_diag_not_bit_help", "channel_diag_help",  "diag_update_delay",
-      "isochron_mode_supp",   "isochron_mode_required", "tbase_dp",
+  static const std::array<std::string_view, 39> kKnown = {
+      "bitmap_device",        "bitmap_diag",          "bitmap_sf",
+      "unit_diag_not_bit",    "x_unit_diag_bit",      "x_unit_diag_not_bit",
+      "unit_diag_bit_help",   "x_unit_diag_bit_help", "unit_diag_not_bit_help",
+      "channel_diag_help",    "diag_update_delay",    "tbase_dp",
       "tdp_max",              "tdp_min",              "tbase_io",
       "tio_input",            "tio_output",           "to_min",
       "ti_min",               "t_pll_w_max",          "fixpresetmodules",

@@ -153,7 +153,8 @@ void print_text(const GsdFile& f, std::ostream& out) {
 
   const auto& d = f.dpv1();
   out << "\nDP-V1:              " << (d.dpv1_slave ? "yes" : "no") << "\n";
-  if (d.dpv1_slave) {
+  // Every DP-V1 keyword the model holds, also for a file that sets some without DPV1_Slave.
+  if (d != devices::GsdDpv1Features{}) {
     out << "  C1_Read_Write_supp " << yn(d.c1_read_write_supp) << ", C1_Max_Data_Len "
         << int(d.c1_max_data_len) << ", C1_Response_Timeout " << d.c1_response_timeout << "\n";
     out << "  C2_Read_Write_supp " << yn(d.c2_read_write_supp) << ", C2_Max_Data_Len "
@@ -164,8 +165,22 @@ void print_text(const GsdFile& f, std::ostream& out) {
         << yn(d.status_alarm_supp) << ", Update " << yn(d.update_alarm_supp)
         << ", Manufacturer_Specific " << yn(d.manufacturer_specific_alarm_supp)
         << "; Alarm_Sequence_Mode_Count " << int(d.alarm_sequence_mode_count) << "\n";
+    out << "  alarms required: Diagnostic " << yn(d.diagnostic_alarm_required) << ", Process "
+        << yn(d.process_alarm_required) << ", Pull_Plug " << yn(d.pull_plug_alarm_required) << ", Status "
+        << yn(d.status_alarm_required) << ", Update " << yn(d.update_alarm_required)
+        << ", Manufacturer_Specific " << yn(d.manufacturer_specific_alarm_required) << "\n";
+    out << "  Extra_Alarm_SAP_supp " << yn(d.extra_alarm_sap_supp) << ", Alarm_Type_Mode_supp "
+        << yn(d.alarm_type_mode_supp) << "\n";
+    out << "  C1_Read_Write_required " << yn(d.c1_read_write_required) << ", C2_Read_Write_required "
+        << yn(d.c2_read_write_required) << ", Max_Initiate_PDU_Length " << int(d.max_initiate_pdu_length) << "\n";
     out << "  WD_Base_1ms_supp " << yn(d.wd_base_1ms_supp) << ", Check_Cfg_Mode "
         << yn(d.check_cfg_mode) << ", Ident_Maintenance_supp " << yn(d.ident_maintenance_supp) << "\n";
+    out << "  DPV1_Data_Types " << yn(d.dpv1_data_types) << ", Publisher_supp " << yn(d.publisher_supp)
+        << ", Time_Sync_supp " << yn(d.time_sync_supp) << "\n";
+    out << "  Prm_Block_Structure_supp " << yn(d.prm_block_structure_supp) << ", Prm_Block_Structure_req "
+        << yn(d.prm_block_structure_req) << ", Fail_Safe_required " << yn(d.fail_safe_required) << "\n";
+    out << "  Isochron_Mode_supp " << yn(d.isochron_mode_supp) << ", Isochron_Mode_required "
+        << yn(d.isochron_mode_required) << "\n";
   }
   if (f.is_master()) {
     const auto& m = f.master();
@@ -268,8 +283,11 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   out << "\n  ]},\n";
   const auto& d = f.dpv1();
   out << "  \"dpv1\": {\"dpv1_slave\": " << jb(d.dpv1_slave) << ", \"c1_read_write_supp\": " << jb(d.c1_read_write_supp)
+      << ", \"c1_read_write_required\": " << jb(d.c1_read_write_required)
       << ", \"c1_max_data_len\": " << int(d.c1_max_data_len) << ", \"c1_response_timeout\": " << d.c1_response_timeout
-      << ", \"c2_read_write_supp\": " << jb(d.c2_read_write_supp) << ", \"c2_max_data_len\": " << int(d.c2_max_data_len)
+      << ", \"c2_read_write_supp\": " << jb(d.c2_read_write_supp)
+      << ", \"c2_read_write_required\": " << jb(d.c2_read_write_required)
+      << ", \"c2_max_data_len\": " << int(d.c2_max_data_len)
       << ", \"c2_response_timeout\": " << d.c2_response_timeout
       << ", \"c2_max_count_channels\": " << int(d.c2_max_count_channels)
       << ", \"max_initiate_pdu_length\": " << int(d.max_initiate_pdu_length)
@@ -278,10 +296,24 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
       << ", \"pull_plug_alarm_supp\": " << jb(d.pull_plug_alarm_supp)
       << ", \"status_alarm_supp\": " << jb(d.status_alarm_supp) << ", \"update_alarm_supp\": " << jb(d.update_alarm_supp)
       << ", \"manufacturer_specific_alarm_supp\": " << jb(d.manufacturer_specific_alarm_supp)
+      << ", \"diagnostic_alarm_required\": " << jb(d.diagnostic_alarm_required)
+      << ", \"process_alarm_required\": " << jb(d.process_alarm_required)
+      << ", \"pull_plug_alarm_required\": " << jb(d.pull_plug_alarm_required)
+      << ", \"status_alarm_required\": " << jb(d.status_alarm_required)
+      << ", \"update_alarm_required\": " << jb(d.update_alarm_required)
+      << ", \"manufacturer_specific_alarm_required\": " << jb(d.manufacturer_specific_alarm_required)
       << ", \"extra_alarm_sap_supp\": " << jb(d.extra_alarm_sap_supp)
+      << ", \"alarm_type_mode_supp\": " << jb(d.alarm_type_mode_supp)
       << ", \"alarm_sequence_mode_count\": " << int(d.alarm_sequence_mode_count)
       << ", \"wd_base_1ms_supp\": " << jb(d.wd_base_1ms_supp) << ", \"check_cfg_mode\": " << jb(d.check_cfg_mode)
-      << ", \"ident_maintenance_supp\": " << jb(d.ident_maintenance_supp) << "},\n";
+      << ", \"dpv1_data_types\": " << jb(d.dpv1_data_types) << ", \"publisher_supp\": " << jb(d.publisher_supp)
+      << ", \"ident_maintenance_supp\": " << jb(d.ident_maintenance_supp)
+      << ", \"time_sync_supp\": " << jb(d.time_sync_supp)
+      << ", \"prm_block_structure_supp\": " << jb(d.prm_block_structure_supp)
+      << ", \"prm_block_structure_req\": " << jb(d.prm_block_structure_req)
+      << ", \"fail_safe_required\": " << jb(d.fail_safe_required)
+      << ", \"isochron_mode_supp\": " << jb(d.isochron_mode_supp)
+      << ", \"isochron_mode_required\": " << jb(d.isochron_mode_required) << "},\n";
   const auto& r = f.redundancy();
   out << "  \"redundancy\": {\"redundancy\": " << jb(r.redundancy) << ", \"prm_cmd_supp\": " << jb(r.prm_cmd_supp)
       << ", \"slave_redundancy_supp\": " << int(r.slave_redundancy_supp)

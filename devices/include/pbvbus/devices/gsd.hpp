@@ -250,6 +250,9 @@ struct GsdDpv1Features {
   bool prm_block_structure_supp = false;
   bool prm_block_structure_req = false;
   bool fail_safe_required = false;
+  bool isochron_mode_supp = false;      ///< DP-V2 isochronous mode (Isochron_Mode_supp)
+  bool isochron_mode_required = false;  ///< Isochron_Mode_required
+  bool operator==(const GsdDpv1Features&) const = default;
 };
 
 /// Redundancy keywords (§G.7).

@@ -212,6 +212,8 @@ class GsdParser {
   void prm_const(const Stmt& s, GsdPrmArea& area);
   void prm_ref(const Stmt& s, GsdPrmArea& area);
   void data_type_line(const Stmt& s);
+  std::string ext_what() const;
+  bool f_parameter(const Stmt& s);
   bool block_start(const Stmt& s) const;
   static bool end_keyword(std::string_view key);
   static bool top_level_keyword(std::string_view key);
@@ -227,6 +229,7 @@ class GsdParser {
   void remember(const Stmt& s);
   void correct_spelling(Stmt& s);
   void close_block_at_end();
+  void check_f_block(const GsdModule& m);
   void finish();
   static const std::unordered_map<std::string, ScalarKeyword>& table();
 
@@ -247,6 +250,7 @@ class GsdParser {
   GsdModule m_module;
   GsdPrmText m_prm_text;
   GsdExtUserPrmData m_ext;
+  bool m_ext_f = false;  // the block is an F_ExtUserPrmData (PROFIsafe) definition
   bool m_ext_has_type = false;
   GsdUnitDiagArea m_diag_area;
 
@@ -407,8 +411,7 @@ bool known_raw(std::string_view key) {
 }
 
 bool known_module_raw(std::string_view key) {
-  static const std::array<std::string_view, 17> kKnown = {
-      "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
+  static const std::array<std::string_view, 14> kKnown = {
       "x_ext_module_prm_data_len", "x_ext_user_prm_data_const", "x_ext_user_prm_data_ref",
       "preset",                    "channel_diag",              "module_reference",
       "ordernumber",               "bitmap_device",             "alarm_type_mode_supp",
@@ -430,9 +433,9 @@ std::string shorten(std::string_view s) {
 }  // namespace
 
 bool GsdParser::end_keyword(std::string_view key) {
-  static const std::array<std::string_view, 8> kEnds = {
-      "endmodule", "endprmtext", "endextuserprmdata", "unit_diag_area_end", "x_unit_diag_area_end",
-      "endslotdefinition", "endunitdiagtype", "end_physical_interface"};
+  static const std::array<std::string_view, 9> kEnds = {
+      "endmodule", "endprmtext", "endextuserprmdata", "endf_extuserprmdata", "unit_diag_area_end",
+      "x_unit_diag_area_end", "endslotdefinition", "endunitdiagtype", "end_physical_interface"};
   return std::find(kEnds.begin(), kEnds.end(), key) != kEnds.end();
 }
 
@@ -451,8 +454,10 @@ bool GsdParser::top_level_keyword(std::string_view key) {
 // Keywords PI 2.122 allows inside a Module (modelled or kept raw); several of them are top-level
 // keywords too. Alarm requirements may be given per module [U]: accepted there.
 bool GsdParser::module_keyword(std::string_view key) {
-  static const std::array<std::string_view, 5> kModelled = {
-      "ext_module_prm_data_len", "ext_user_prm_data_const", "ext_user_prm_data_ref", "info_text",
+  static const std::array<std::string_view, 10> kModelled = {
+      "ext_module_prm_data_len",   "ext_user_prm_data_const",   "ext_user_prm_data_ref",
+      "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
+      "f_paramdesccrc",            "f_io_structuredesccrc",     "info_text",
       "data_area_beg"};
   return known_module_raw(key) || std::find(kModelled.begin(), kModelled.end(), key) != kModelled.end() ||
          ends_with(key, "_alarm_required") || ends_with(key, "_alarm_supp");
@@ -728,8 +733,8 @@ std::optional<std::uint16_t> GsdParser::index_value(const Stmt& s, std::uint64_t
 // Statements
 
 bool GsdParser::block_start(const Stmt& s) const {
-  static const std::array<std::string_view, 8> kStarts = {
-      "module", "prmtext", "extuserprmdata", "slotdefinition", "unit_diag_area",
+  static const std::array<std::string_view, 9> kStarts = {
+      "module", "prmtext", "extuserprmdata", "f_extuserprmdata", "slotdefinition", "unit_diag_area",
       "x_unit_diag_area", "unitdiagtype", "physical_interface"};
   return std::find(kStarts.begin(), kStarts.end(), s.key) != kStarts.end();
 }
@@ -778,7 +783,7 @@ std::string GsdParser::block_title(const OpenBlock& b) const {
   switch (b.kind) {
     case Block::Module: return "Module '" + m_module.name + "'";
     case Block::PrmText: return "PrmText " + std::to_string(m_prm_text.ref);
-    case Block::ExtPrm: return "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+    case Block::ExtPrm: return ext_what();
     case Block::DiagArea: return m_diag_area.x_variant ? "X_Unit_Diag_Area" : "Unit_Diag_Area";
     case Block::Slots: return "SlotDefinition";
     case Block::Top:
@@ -904,7 +909,7 @@ void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
   auto bytes = byte_list(s.value, s.line, "byte value");
   if (!bytes) return;
   if (bytes->empty()) {
-    error(s.line, "Ext_User_Prm_Data_Const(" + s.index + ") has no bytes");
+    error(s.line, s.keyword + "(" + s.index + ") has no bytes");
     return;
   }
   area.consts.push_back({*off, std::move(*bytes), s.line});
@@ -913,7 +918,7 @@ void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
 void GsdParser::prm_ref(const Stmt& s, GsdPrmArea& area) {
   auto off = index_value(s, 236);
   if (!off) return;
-  auto ref = unsigned_value(s, "Ext_User_Prm_Data_Ref(" + s.index + ")", 0xFFFF);
+  auto ref = unsigned_value(s, s.keyword + "(" + s.index + ")", 0xFFFF);
   if (!ref) return;
   area.refs.push_back({*off, static_cast<std::uint16_t>(*ref), s.line});
 }
@@ -947,8 +952,9 @@ void GsdParser::top(const Stmt& written) {
   }
   // Blocks repeat; several Ext_User_Prm_Data_Ref at one offset are the normal way to place
   // several bit parameters in one byte.
-  static const std::array<std::string_view, 18> kRepeatable = {
+  static const std::array<std::string_view, 20> kRepeatable = {
       "ext_user_prm_data_ref", "ext_user_prm_data_const", "module", "endmodule", "prmtext", "endprmtext", "extuserprmdata", "endextuserprmdata",
+      "f_extuserprmdata", "endf_extuserprmdata",
       "unit_diag_area", "unit_diag_area_end", "x_unit_diag_area", "x_unit_diag_area_end",
       "slotdefinition", "endslotdefinition", "unitdiagtype", "endunitdiagtype",
       "physical_interface", "end_physical_interface"};
@@ -988,28 +994,32 @@ void GsdParser::top(const Stmt& written) {
     open_block(Block::PrmText, "EndPrmText", s.line);
   } else if (k == "endprmtext") {
     error(s.line, "EndPrmText without PrmText");
-  } else if (k == "extuserprmdata") {
+  } else if (k == "extuserprmdata" || k == "f_extuserprmdata") {
     m_ext = GsdExtUserPrmData{};
     m_ext.line = s.line;
+    m_ext_f = k[0] == 'f';
     m_ext_has_type = false;
-    open_block(Block::ExtPrm, "EndExtUserPrmData", s.line);
+    const std::string kind = m_ext_f ? "F_ExtUserPrmData" : "ExtUserPrmData";
+    open_block(Block::ExtPrm, m_ext_f ? "EndF_ExtUserPrmData" : "EndExtUserPrmData", s.line);
     if (!need_value(s)) return;
     const std::string_view v = s.value;
     const std::size_t q = v.find('"');
     auto ref = number(v.substr(0, q), s.line);
     if (!ref) return;
     if (*ref < 0 || *ref > 0xFFFF) {
-      error(s.line, "ExtUserPrmData reference " + std::to_string(*ref) + " out of range (0..65535)");
+      error(s.line, kind + " reference " + std::to_string(*ref) + " out of range (0..65535)");
       return;
     }
     m_ext.ref = static_cast<std::uint16_t>(*ref);
     if (q == std::string_view::npos) {
-      error(s.line, "ExtUserPrmData " + std::to_string(*ref) + ": name missing");
+      error(s.line, kind + " " + std::to_string(*ref) + ": name missing");
       return;
     }
     if (auto name = quoted(v.substr(q), s.line, nullptr)) m_ext.name = *name;
   } else if (k == "endextuserprmdata") {
     error(s.line, "EndExtUserPrmData without ExtUserPrmData");
+  } else if (k == "endf_extuserprmdata") {
+    error(s.line, "EndF_ExtUserPrmData without F_ExtUserPrmData");
   } else if (k == "unit_diag_area" || k == "x_unit_diag_area") {
     m_diag_area = GsdUnitDiagArea{};
     m_diag_area.x_variant = k[0] == 'x';
@@ -1105,6 +1115,8 @@ void GsdParser::in_module(const Stmt& s) {
     prm_const(s, m_module.prm);
   } else if (k == "ext_user_prm_data_ref") {
     prm_ref(s, m_module.prm);
+  } else if (f_parameter(s)) {
+    // PROFIsafe F-parameters (decisions in gsd.hpp)
   } else if (k == "info_text") {
     if (auto v = string_value(s, "Info_Text")) m_module.info_text = *v;
   } else if (k == "data_area_beg") {
@@ -1115,6 +1127,28 @@ void GsdParser::in_module(const Stmt& s) {
       warning(s.line, "unknown keyword '" + s.keyword + "'" + where + " kept");
     }
   }
+}
+
+// PROFIsafe module keywords: the F-parameter block, its description CRCs.
+bool GsdParser::f_parameter(const Stmt& s) {
+  GsdFParameters& f = m_module.f;
+  const std::string& k = s.key;
+  if (k == "f_ext_module_prm_data_len") {
+    if (auto v = unsigned_value(s, "F_Ext_Module_Prm_Data_Len", 237))
+      f.prm.declared_len = static_cast<std::uint16_t>(*v);
+  } else if (k == "f_ext_user_prm_data_const") {
+    prm_const(s, f.prm);
+  } else if (k == "f_ext_user_prm_data_ref") {
+    prm_ref(s, f.prm);
+  } else if (k == "f_paramdesccrc") {
+    if (auto v = unsigned_value(s, "F_ParamDescCRC", 0xFFFF)) f.param_desc_crc = static_cast<std::uint16_t>(*v);
+  } else if (k == "f_io_structuredesccrc") {
+    if (auto v = unsigned_value(s, "F_IO_StructureDescCRC", 0xFFFFFFFF))
+      f.io_structure_desc_crc = static_cast<std::uint32_t>(*v);
+  } else {
+    return false;
+  }
+  return true;
 }
 
 void GsdParser::in_prm_text(const Stmt& s) {
@@ -1140,8 +1174,12 @@ void GsdParser::in_prm_text(const Stmt& s) {
   }
 }
 
+std::string GsdParser::ext_what() const {
+  return (m_ext_f ? "F_ExtUserPrmData " : "ExtUserPrmData ") + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+}
+
 void GsdParser::data_type_line(const Stmt& s) {
-  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+  const std::string what = ext_what();
   if (m_ext_has_type) {
     error(s.line, what + ": more than one data type line");
     return;
@@ -1262,16 +1300,17 @@ void GsdParser::data_type_line(const Stmt& s) {
 
 void GsdParser::in_ext_prm(const Stmt& s) {
   const std::string& k = s.key;
-  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
-  if (k == "endextuserprmdata") {
+  const std::string what = ext_what();
+  if (own_end(m_open.back(), k)) {
     m_open.pop_back();
     if (!m_ext_has_type) {
       error(m_ext.line, what + ": data type line missing");
       return;
     }
-    auto& defs = m_result_file.m_ext_prm;
+    auto& defs = m_ext_f ? m_result_file.m_f_ext_prm : m_result_file.m_ext_prm;
     if (auto it = defs.find(m_ext.ref); it != defs.end())
-      defined_twice(m_ext.line, "ExtUserPrmData " + std::to_string(m_ext.ref), it->second.line);
+      defined_twice(m_ext.line, (m_ext_f ? "F_ExtUserPrmData " : "ExtUserPrmData ") + std::to_string(m_ext.ref),
+                    it->second.line);
     defs[m_ext.ref] = m_ext;
   } else if (k == "bit" || k == "bitarea" || k == "unsigned8" || k == "unsigned16" ||
              k == "unsigned32" || k == "signed8" || k == "signed16" || k == "signed32") {
@@ -1371,6 +1410,23 @@ void GsdParser::close_block_at_end() {
 // ---------------------------------------------------------------------------------------------
 // Whole-file checks
 
+// The F-parameter block of a PROFIsafe module: its length is F_Ext_Module_Prm_Data_Len; the
+// same rule as for Ext_Module_Prm_Data_Len applies when overlays reach beyond it or it is absent.
+void GsdParser::check_f_block(const GsdModule& m) {
+  if (!m.f.present()) return;
+  const GsdPrmArea& fp = m.f.prm;
+  const std::size_t len = fp.length(m_result_file.m_f_defs);
+  const std::string what = "Module '" + m.name + "': ";
+  if (!fp.declared_len) {
+    if (len > 0)
+      warning(m.line, what + "F-parameters without F_Ext_Module_Prm_Data_Len; F block of " + std::to_string(len) +
+                          " bytes, as far as they reach");
+  } else if (len > *fp.declared_len) {
+    warning(m.line, what + "F-parameters reach byte " + std::to_string(len) + ", beyond F_Ext_Module_Prm_Data_Len " +
+                        std::to_string(*fp.declared_len) + "; F block extended");
+  }
+}
+
 void GsdParser::finish() {
   auto& f = m_result_file;
   auto seen = [&](std::string_view key) -> std::optional<std::uint32_t> {
@@ -1417,19 +1473,30 @@ void GsdParser::finish() {
     error(*l, "Max_Initiate_PDU_Length " + std::to_string(f.m_dpv1.max_initiate_pdu_length) +
                   " not allowed (0 or 52..244)");
 
-  // References between blocks.
-  auto check_refs = [&](const GsdPrmArea& area) {
+  // References between blocks. F_Ext_User_Prm_Data_Ref resolves to F_ExtUserPrmData, else to
+  // the ExtUserPrmData of that number (gsd.hpp).
+  f.m_f_defs = f.m_ext_prm;
+  for (const auto& [ref, e] : f.m_f_ext_prm) f.m_f_defs[ref] = e;
+  auto check_refs = [&](const GsdPrmArea& area, const std::map<std::uint16_t, GsdExtUserPrmData>& defs,
+                        std::string_view keyword, std::string_view kind) {
     for (const auto& r : area.refs)
-      if (!f.m_ext_prm.count(r.ref))
-        error(r.line, "Ext_User_Prm_Data_Ref(" + std::to_string(r.offset) +
-                          ") refers to undefined ExtUserPrmData " + std::to_string(r.ref));
+      if (!defs.count(r.ref))
+        error(r.line, std::string(keyword) + "(" + std::to_string(r.offset) + ") refers to undefined " +
+                          std::string(kind) + " " + std::to_string(r.ref));
   };
-  check_refs(f.m_global_prm);
-  for (const auto& m : f.m_modules) check_refs(m.prm);
-  for (const auto& [ref, e] : f.m_ext_prm)
-    if (e.prm_text_ref && !f.m_prm_texts.count(*e.prm_text_ref))
-      error(e.line, "ExtUserPrmData " + std::to_string(ref) + " '" + e.name +
-                        "': Prm_Text_Ref refers to undefined PrmText " + std::to_string(*e.prm_text_ref));
+  check_refs(f.m_global_prm, f.m_ext_prm, "Ext_User_Prm_Data_Ref", "ExtUserPrmData");
+  for (const auto& m : f.m_modules) {
+    check_refs(m.prm, f.m_ext_prm, "Ext_User_Prm_Data_Ref", "ExtUserPrmData");
+    check_refs(m.f.prm, f.m_f_defs, "F_Ext_User_Prm_Data_Ref", "F_ExtUserPrmData");
+  }
+  auto check_texts = [&](const std::map<std::uint16_t, GsdExtUserPrmData>& defs, std::string_view kind) {
+    for (const auto& [ref, e] : defs)
+      if (e.prm_text_ref && !f.m_prm_texts.count(*e.prm_text_ref))
+        error(e.line, std::string(kind) + " " + std::to_string(ref) + " '" + e.name +
+                          "': Prm_Text_Ref refers to undefined PrmText " + std::to_string(*e.prm_text_ref));
+  };
+  check_texts(f.m_ext_prm, "ExtUserPrmData");
+  check_texts(f.m_f_ext_prm, "F_ExtUserPrmData");
 
   // Modules: identifiers well formed; lengths derived from them.
   std::map<std::uint32_t, std::uint32_t> refs_seen;
@@ -1455,6 +1522,7 @@ void GsdParser::finish() {
       warning(m.line, "Module '" + m.name + "': parameters reach byte " + std::to_string(len) +
                           ", beyond Ext_Module_Prm_Data_Len " + std::to_string(*m.prm.declared_len) +
                           "; area extended");
+    check_f_block(m);
   }
 
   // Global parameter area.

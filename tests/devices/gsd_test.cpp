@@ -348,7 +348,11 @@ TEST(Gsd, VendorStyleFile) {
   // 0xC1 = 2 words in consistent.
   EXPECT_EQ(f.modules()[2].output_len, 2u);
   EXPECT_EQ(f.modules()[2].input_len, 4u);
-  ASSERT_EQ(f.modules()[2].other_keywords.size(), 1u);
+  // F_Ext_Module_Prm_Data_Len = 0: a PROFIsafe module keyword with an empty F-parameter block.
+  EXPECT_TRUE(f.modules()[2].other_keywords.empty());
+  EXPECT_TRUE(f.modules()[2].f.present());
+  EXPECT_EQ(f.modules()[2].f.prm.declared_len, 0u);
+  EXPECT_TRUE(f.f_prm_defaults(f.modules()[2]).empty());
   EXPECT_EQ(f.modules()[3].input_len + f.modules()[3].output_len, 0u);
 
   ASSERT_EQ(f.slots().size(), 2u);

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -256,4 +258,59 @@ TEST(CmdGsd, EveryDpv1FeatureInJson) {
             "update_alarm_required=false\n"
             "update_alarm_supp=true\n"
             "wd_base_1ms_supp=false\n");
+}
+
+// PROFIsafe module: its F-parameter block (defaults, worked out in gsd_vendor_quirks_test.cpp) and
+// description CRCs under the module, the F_ExtUserPrmData definitions with the parameters.
+TEST(CmdGsd, ProfisafeModuleText) {
+  GsdRun r = run({src("tests/data/gsd/vendor-quirks/profisafe-module.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(has_line(r.out, "  [1] \"F-DI 2x24V PROFIsafe\" ref 2: cfg 0xC1,0x85,0x85,0x0A, in 6, out 6, "
+                              "consistent, prm 01 0A"));
+  EXPECT_TRUE(has_line(r.out, "      F-parameters 08 40 00 01 00 64 00 96 4A 2B; F_Ext_Module_Prm_Data_Len 10, "
+                              "F_ParamDescCRC 0x1D6E, F_IO_StructureDescCRC 0x0000A3F1"))
+      << r.out;
+  EXPECT_TRUE(has_line(r.out, "  ExtUserPrmData 2 \"Sensor supply\": Bit(0), default 1, allowed 0-1"));
+  EXPECT_TRUE(has_line(r.out, "  F_ExtUserPrmData 2 \"F_Check_iPar\": Bit(1), default 0, allowed 0-1, not changeable"));
+  EXPECT_TRUE(has_line(r.out, "  F_ExtUserPrmData 8 \"F_Dest_Add\": Unsigned16, default 100, allowed 1-65534"));
+  // The standard module has no F-parameters line.
+  EXPECT_EQ(r.out.find("F-parameters"), r.out.rfind("F-parameters"));
+}
+
+TEST(CmdGsd, ProfisafeModuleJson) {
+  GsdRun r = run({src("tests/data/gsd/vendor-quirks/profisafe-module.gsd"), "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  // 0x1D6E = 7534, 0x0000A3F1 = 41969; the block 08 40 00 01 00 64 00 96 4A 2B in decimal.
+  EXPECT_EQ(python_on_json(r.out, "json.dumps(d['modules'][0]['f_parameters']), "
+                                  "json.dumps(d['modules'][1]['f_parameters'], sort_keys=True)"),
+            "null {\"defaults\": [8, 64, 0, 1, 0, 100, 0, 150, 74, 43], \"f_ext_module_prm_data_len\": 10, "
+            "\"f_io_structure_desc_crc\": 41969, \"f_param_desc_crc\": 7534}\n");
+  EXPECT_EQ(python_on_json(r.out, "len(d['parameters']['f_ext_user_prm_data']), "
+                                  "len(d['parameters']['ext_user_prm_data']), "
+                                  "[(e['ref'], e['name'], e['default'], e['changeable']) for e in "
+                                  "d['parameters']['f_ext_user_prm_data'] if e['ref'] in (3, 8)]"),
+            "10 3 [(3, 'F_SIL', 2, True), (8, 'F_Dest_Add', 100, True)]\n");
+}
+
+// Every GSD file of the repository (examples, test data, vendor quirks) is read without an error
+// by the command, in text and JSON form, and the JSON is one valid document.
+TEST(CmdGsd, ReadsEveryGsdFileOfTheRepository) {
+  std::vector<std::string> files;
+  for (const char* dir : {"examples/gsd", "tests/data/gsd", "tests/data/gsd/vendor-quirks"})
+    for (const auto& e : std::filesystem::directory_iterator(src(dir))) {
+      std::string ext = e.path().extension().string();
+      std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+      if (e.is_regular_file() && ext == ".gsd") files.push_back(e.path().string());
+    }
+  std::sort(files.begin(), files.end());
+  EXPECT_GE(files.size(), 10u);
+  for (const auto& file : files) {
+    GsdRun r = run({file});
+    EXPECT_EQ(r.rc, 0) << file << "\n" << r.err;
+    EXPECT_TRUE(has_line(r.out, "File:               " + file)) << file;
+    r = run({file, "--json"});
+    ASSERT_EQ(r.rc, 0) << file << "\n" << r.err;
+    EXPECT_EQ(python_on_json(r.out, "d['file']"), file + "\n");
+  }
 }

@@ -65,7 +65,8 @@ const char* const kTokens[] = {
     "Max_User_Prm_Data_Len = 0", "DPV1_Slave = 1", "Modular_Station = 0", "Max_Module = 0",
     "Station_Type = 1", "F_ExtUserPrmData = 1 \"f\"\n", "EndF_ExtUserPrmData",
     "F_Ext_Module_Prm_Data_Len = 10", "F_Ext_User_Prm_Data_Ref(9)=8", "Min_Slave_Interval = 1",
-    "Max_Input_Len = 249", "\xDC", "\xEF\xBB\xBF", std::string("\0", 1).c_str(),
+    "Max_Input_Len = 249", "\xDC", "\xEF\xBB\xBF",
+    "",  // a NUL byte (mutate() inserts one for the empty token)
 };
 
 std::string mutate(std::string s, SplitMix64& rng) {

@@ -41,7 +41,11 @@ bool has_line(const std::string& text, const std::string& line) {
 // Runs a python3 expression on the parsed JSON document `d` and returns what it prints; the
 // process fails (and the test with it) if the text is not one valid JSON document.
 std::string python_on_json(const std::string& json, const std::string& expression) {
-  const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_test_eval.json";
+  // One file per test and call: ctest runs the tests of this file in parallel processes.
+  static int calls = 0;
+  const std::string path = std::string(PBVBUS_BINARY_DIR) + "/cmd_gsd_test_" +
+                           ::testing::UnitTest::GetInstance()->current_test_info()->name() + "_" +
+                           std::to_string(++calls) + ".json";
   {
     std::ofstream o(path, std::ios::binary);
     o << json;

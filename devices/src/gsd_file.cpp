@@ -160,22 +160,32 @@ GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modu
                            std::to_string(m_modules.size()) + " modules)");
   if (!out.errors.empty()) return out;
 
-  // Settings per area: index 0 = station area, 1 + n = the n-th selected module.
-  std::vector<std::vector<const GsdPrmSetting*>> per_area(modules.size() + 1);
+  // Settings per area: index 0 = station area; for the n-th selected module, 1 + 2n = its
+  // parameter area and 2 + 2n = its F-parameter block.
+  std::vector<std::vector<const GsdPrmSetting*>> per_area(2 * modules.size() + 1);
   for (const auto& s : settings) {
-    const std::string where = s.slot ? "slot " + std::to_string(*s.slot) : std::string("the station parameters");
+    if (s.f_parameter && !s.slot) {
+      out.errors.push_back("F-parameter setting without a slot: F-parameters belong to a module");
+      continue;
+    }
+    std::string where = s.slot ? "slot " + std::to_string(*s.slot) : std::string("the station parameters");
+    if (s.f_parameter) where = "the F-parameters of " + where;
     if (s.slot && *s.slot >= modules.size()) {
       out.errors.push_back("setting for " + where + ": only " + std::to_string(modules.size()) +
                            " modules selected");
       continue;
     }
-    auto def = m_ext_prm.find(s.ref);
-    if (def == m_ext_prm.end()) {
-      out.errors.push_back("setting for " + where + ": no ExtUserPrmData " + std::to_string(s.ref));
+    const auto& defs = s.f_parameter ? m_f_defs : m_ext_prm;
+    const std::string kind = s.f_parameter ? "F_ExtUserPrmData " : "ExtUserPrmData ";
+    auto def = defs.find(s.ref);
+    if (def == defs.end()) {
+      out.errors.push_back("setting for " + where + ": no " + kind + std::to_string(s.ref));
       continue;
     }
-    const std::string what = "ExtUserPrmData " + std::to_string(s.ref) + " '" + def->second.name + "'";
-    const GsdPrmArea& area = s.slot ? m_modules[modules[*s.slot]].prm : m_global_prm;
+    const std::string what = kind + std::to_string(s.ref) + " '" + def->second.name + "'";
+    const GsdPrmArea& area = !s.slot         ? m_global_prm
+                             : s.f_parameter ? m_modules[modules[*s.slot]].f.prm
+                                             : m_modules[modules[*s.slot]].prm;
     const bool used = std::any_of(area.refs.begin(), area.refs.end(), [&](const GsdPrmRef& r) {
       return r.ref == s.ref && (!s.offset || *s.offset == r.offset);
     });
@@ -192,7 +202,7 @@ GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modu
       out.errors.push_back(what + ": value " + std::to_string(s.value) + " not allowed");
       continue;
     }
-    per_area[s.slot ? *s.slot + 1 : 0].push_back(&s);
+    per_area[s.slot ? 1 + 2 * *s.slot + (s.f_parameter ? 1 : 0) : 0].push_back(&s);
   }
   if (!out.errors.empty()) return out;
 
@@ -202,10 +212,13 @@ GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modu
     for (std::size_t i = data.size(); i < 3; ++i) data.push_back(kMinimalDpv1Status[i]);
     out.notes.push_back("DPV1_Status_1..3 not all given by the file; filled with 80 00 00");
   }
+  // Each module: its parameter area, then its F-parameter block (PROFIsafe, gsd.hpp).
   for (std::size_t n = 0; n < modules.size(); ++n) {
-    const auto& area = m_modules[modules[n]].prm;
-    GsdBytes part = build_area(area, m_ext_prm, area.length(m_ext_prm), per_area[n + 1]);
+    const GsdModule& m = m_modules[modules[n]];
+    const GsdBytes part = build_area(m.prm, m_ext_prm, m.prm.length(m_ext_prm), per_area[1 + 2 * n]);
     data.insert(data.end(), part.begin(), part.end());
+    const GsdBytes f = build_area(m.f.prm, m_f_defs, m.f.prm.length(m_f_defs), per_area[2 + 2 * n]);
+    data.insert(data.end(), f.begin(), f.end());
   }
   if (data.size() > m_max_user_prm_data_len) {
     out.notes.push_back("User_Prm_Data of " + std::to_string(data.size()) +
@@ -219,6 +232,14 @@ GsdOutcome<GsdBytes> GsdFile::user_prm_data(const std::vector<std::size_t>& modu
 
 GsdBytes GsdFile::prm_area_defaults(const GsdPrmArea& area) const {
   return build_area(area, m_ext_prm, area.length(m_ext_prm));
+}
+
+GsdBytes GsdFile::f_prm_defaults(const GsdModule& module) const {
+  return build_area(module.f.prm, m_f_defs, module.f.prm.length(m_f_defs));
+}
+
+std::size_t GsdFile::module_prm_length(const GsdModule& module) const {
+  return module.prm.length(m_ext_prm) + module.f.prm.length(m_f_defs);
 }
 
 GsdOutcome<GsdBytes> GsdFile::cfg_data(const std::vector<std::size_t>& modules) const {
@@ -278,7 +299,7 @@ GsdOutcome<std::pair<std::size_t, std::size_t>> GsdFile::check_modules(
     in += m_modules[idx].input_len;
     outp += m_modules[idx].output_len;
     cfg_len += m_modules[idx].config.size();
-    prm_len += m_modules[idx].prm.length(m_ext_prm);
+    prm_len += module_prm_length(m_modules[idx]);
   }
   if (!m_slave.modular_station && modules.size() > 1)
     out.errors.push_back("a compact station (Modular_Station = 0) takes exactly one module, " +

@@ -106,6 +106,23 @@ std::optional<bus::Baud> baud_from_gsd(std::string_view lower_name) {
   return std::nullopt;
 }
 
+// A per-baud keyword (lower case): "<rate>_supp" gives kind "_supp"; "maxtsdr_<rate>" and the
+// master's "trdy_", "tqui_", "tset_", "tsdi_" give that prefix as the kind.
+struct BaudKey {
+  std::string_view kind;
+  bus::Baud baud;
+};
+std::optional<BaudKey> split_baud_key(std::string_view k) {
+  static constexpr std::array<std::string_view, 5> kPrefixes = {"maxtsdr_", "trdy_", "tqui_", "tset_", "tsdi_"};
+  constexpr std::string_view kSupp = "_supp";
+  if (k.size() > kSupp.size() && k.substr(k.size() - kSupp.size()) == kSupp)
+    if (auto b = baud_from_gsd(k.substr(0, k.size() - kSupp.size()))) return BaudKey{kSupp, *b};
+  for (std::string_view prefix : kPrefixes)
+    if (k.size() > prefix.size() && k.substr(0, prefix.size()) == prefix)
+      if (auto b = baud_from_gsd(k.substr(prefix.size()))) return BaudKey{prefix, *b};
+  return std::nullopt;
+}
+
 std::string gsd_baud_spelling(bus::Baud b) {
   for (const auto& n : kBaudNames)
     if (n.baud == b) {
@@ -150,6 +167,12 @@ class GsdParser {
   };
 
   enum class Block { Top, Module, PrmText, ExtPrm, DiagArea, Slots, Opaque };
+  struct OpenBlock {
+    Block kind = Block::Top;
+    std::string end;    // the end keyword as PI 2.122 spells it
+    std::uint32_t line = 0;
+    std::string title;  // Opaque blocks: the keyword that opened it
+  };
 
   // --- messages
   void error(std::uint32_t line, std::string reason) {
@@ -185,13 +208,28 @@ class GsdParser {
   void in_slots(const Stmt& s);
   bool scalar(const Stmt& s);
   bool baud_keyword(const Stmt& s);
+  bool data_length_limit(const Stmt& s);
   void prm_const(const Stmt& s, GsdPrmArea& area);
   void prm_ref(const Stmt& s, GsdPrmArea& area);
   void data_type_line(const Stmt& s);
+  std::string ext_what() const;
+  bool f_parameter(const Stmt& s);
   bool block_start(const Stmt& s) const;
+  static bool end_keyword(std::string_view key);
+  static bool top_level_keyword(std::string_view key);
+  static bool module_keyword(std::string_view key);
+  Block block() const { return m_open.empty() ? Block::Top : m_open.back().kind; }
+  void open_block(Block kind, std::string end, std::uint32_t line, std::string title = {});
+  std::string block_title(const OpenBlock& b) const;
+  bool own_end(const OpenBlock& b, std::string_view key) const;
+  bool leaves_block(const Stmt& s) const;
+  void unterminated(const Stmt& s);
   void unknown(const Stmt& s, std::string_view where);
+  void defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line);
   void remember(const Stmt& s);
+  void correct_spelling(Stmt& s);
   void close_block_at_end();
+  void check_f_block(const GsdModule& m);
   void finish();
   static const std::unordered_map<std::string, ScalarKeyword>& table();
 
@@ -203,21 +241,22 @@ class GsdParser {
   std::uint32_t m_section_line = 0;
   std::vector<std::pair<std::string, std::uint32_t>> m_logical;
 
-  Block m_block = Block::Top;
-  std::uint32_t m_block_line = 0;
-  std::string m_opaque_end;  // end keyword (lower case) of an opaque block
-  Block m_opaque_return = Block::Top;
+  // Open blocks, innermost last (only a Data_Area nests, inside a Module); empty at the top.
+  std::vector<OpenBlock> m_open;
+  // End keyword (lower case) of the last block ended by a statement that cannot be inside it:
+  // its real end keyword may still follow and is then not reported a second time.
+  std::string m_dangling_end;
   std::size_t m_module_stmts = 0;
   GsdModule m_module;
   GsdPrmText m_prm_text;
   GsdExtUserPrmData m_ext;
+  bool m_ext_f = false;  // the block is an F_ExtUserPrmData (PROFIsafe) definition
   bool m_ext_has_type = false;
   GsdUnitDiagArea m_diag_area;
 
   std::unordered_map<std::string, std::uint32_t> m_seen;  // key(+index) -> line
   std::map<bus::Baud, std::uint32_t> m_supp_line;         // supported (= 1) rates
   std::map<bus::Baud, std::uint16_t> m_max_tsdr;
-  std::map<std::uint16_t, std::uint32_t> m_prm_text_lines;
 };
 
 
@@ -271,9 +310,6 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_U("Max_Diag_Data_Len", 244, m_slave.max_diag_data_len),
         PBV_B("Modular_Station", m_slave.modular_station),
         PBV_U("Max_Module", 255, m_slave.max_module),
-        PBV_U("Max_Input_Len", 244, m_slave.max_input_len),
-        PBV_U("Max_Output_Len", 244, m_slave.max_output_len),
-        PBV_U("Max_Data_Len", 488, m_slave.max_data_len),
         PBV_U("Modul_Offset", 255, m_slave.modul_offset),
         // DP-V1
         PBV_B("DPV1_Slave", m_dpv1.dpv1_slave),
@@ -303,7 +339,6 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_B("Alarm_Type_Mode_supp", m_dpv1.alarm_type_mode_supp),
         PBV_U("Alarm_Sequence_Mode_Count", 32, m_dpv1.alarm_sequence_mode_count),
         PBV_B("WD_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),
-        PBV_B("WB_Base_1ms_supp", m_dpv1.wd_base_1ms_supp),  // misspelling found in real files
         PBV_B("Check_Cfg_Mode", m_dpv1.check_cfg_mode),
         PBV_B("DPV1_Data_Types", m_dpv1.dpv1_data_types),
         PBV_B("Publisher_supp", m_dpv1.publisher_supp),
@@ -312,6 +347,8 @@ const std::unordered_map<std::string, ScalarKeyword>& GsdParser::table() {
         PBV_B("Prm_Block_Structure_supp", m_dpv1.prm_block_structure_supp),
         PBV_B("Prm_Block_Structure_req", m_dpv1.prm_block_structure_req),
         PBV_B("Fail_Safe_required", m_dpv1.fail_safe_required),
+        PBV_B("Isochron_Mode_supp", m_dpv1.isochron_mode_supp),
+        PBV_B("Isochron_Mode_required", m_dpv1.isochron_mode_required),
         // Redundancy (§G.7)
         PBV_B("Redundancy", m_redundancy.redundancy),
         PBV_B("PrmCmd_supp", m_redundancy.prm_cmd_supp),
@@ -355,12 +392,11 @@ namespace {
 
 // Keywords of PI 2.122 that the model does not interpret; kept raw, no warning.
 bool known_raw(std::string_view key) {
-  static const std::array<std::string_view, 42> kKnown = {
-      "bitmap_device",        "bitmap_device",        "bitmap_diag",
-      "bitmap_sf",            "unit_diag_not_bit",    "x_unit_diag_bit",
-      "x_unit_diag_not_bit",  "unit_diag_bit_help",   "x_unit_diag_bit_help",
-      "unit_diag_not_bit_help", "channel_diag_help",  "diag_update_delay",
-      "isochron_mode_supp",   "isochron_mode_required", "tbase_dp",
+  static const std::array<std::string_view, 39> kKnown = {
+      "bitmap_device",        "bitmap_diag",          "bitmap_sf",
+      "unit_diag_not_bit",    "x_unit_diag_bit",      "x_unit_diag_not_bit",
+      "unit_diag_bit_help",   "x_unit_diag_bit_help", "unit_diag_not_bit_help",
+      "channel_diag_help",    "diag_update_delay",    "tbase_dp",
       "tdp_max",              "tdp_min",              "tbase_io",
       "tio_input",            "tio_output",           "to_min",
       "ti_min",               "t_pll_w_max",          "fixpresetmodules",
@@ -375,13 +411,18 @@ bool known_raw(std::string_view key) {
 }
 
 bool known_module_raw(std::string_view key) {
-  static const std::array<std::string_view, 12> kKnown = {
-      "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
+  static const std::array<std::string_view, 14> kKnown = {
       "x_ext_module_prm_data_len", "x_ext_user_prm_data_const", "x_ext_user_prm_data_ref",
       "preset",                    "channel_diag",              "module_reference",
       "ordernumber",               "bitmap_device",             "alarm_type_mode_supp",
+      "ident_maintenance_supp",    "channel_diag_help",         "info_text_help",
+      "subsys_module_dir_index",   "order_number",
   };
   return std::find(kKnown.begin(), kKnown.end(), key) != kKnown.end();
+}
+
+bool ends_with(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
 }
 
 std::string shorten(std::string_view s) {
@@ -390,6 +431,37 @@ std::string shorten(std::string_view s) {
 }
 
 }  // namespace
+
+bool GsdParser::end_keyword(std::string_view key) {
+  static const std::array<std::string_view, 9> kEnds = {
+      "endmodule", "endprmtext", "endextuserprmdata", "endf_extuserprmdata", "unit_diag_area_end",
+      "x_unit_diag_area_end", "endslotdefinition", "endunitdiagtype", "end_physical_interface"};
+  return std::find(kEnds.begin(), kEnds.end(), key) != kEnds.end();
+}
+
+// Keywords the reader knows at the top level of the #Profibus_DP section. Help texts (*_help)
+// are left out: they may accompany an item inside a block.
+bool GsdParser::top_level_keyword(std::string_view key) {
+  if (ends_with(key, "_help")) return false;
+  static const std::array<std::string_view, 13> kOthers = {
+      "unit_diag_bit", "channel_diag", "ext_user_prm_data_const", "ext_user_prm_data_ref",
+      "user_prm_data", "user_prm_data_len", "max_user_prm_data_len", "slave_family",
+      "max_input_len", "max_output_len", "max_data_len", "min_slave_interval", "wb_base_1ms_supp"};
+  return table().count(std::string(key)) != 0 || split_baud_key(key).has_value() || known_raw(key) ||
+         std::find(kOthers.begin(), kOthers.end(), key) != kOthers.end();
+}
+
+// Keywords PI 2.122 allows inside a Module (modelled or kept raw); several of them are top-level
+// keywords too. Alarm requirements may be given per module [U]: accepted there.
+bool GsdParser::module_keyword(std::string_view key) {
+  static const std::array<std::string_view, 10> kModelled = {
+      "ext_module_prm_data_len",   "ext_user_prm_data_const",   "ext_user_prm_data_ref",
+      "f_ext_module_prm_data_len", "f_ext_user_prm_data_const", "f_ext_user_prm_data_ref",
+      "f_paramdesccrc",            "f_io_structuredesccrc",     "info_text",
+      "data_area_beg"};
+  return known_module_raw(key) || std::find(kModelled.begin(), kModelled.end(), key) != kModelled.end() ||
+         ends_with(key, "_alarm_required") || ends_with(key, "_alarm_supp");
+}
 
 // ---------------------------------------------------------------------------------------------
 // Lexical passes
@@ -661,8 +733,8 @@ std::optional<std::uint16_t> GsdParser::index_value(const Stmt& s, std::uint64_t
 // Statements
 
 bool GsdParser::block_start(const Stmt& s) const {
-  static const std::array<std::string_view, 8> kStarts = {
-      "module", "prmtext", "extuserprmdata", "slotdefinition", "unit_diag_area",
+  static const std::array<std::string_view, 9> kStarts = {
+      "module", "prmtext", "extuserprmdata", "f_extuserprmdata", "slotdefinition", "unit_diag_area",
       "x_unit_diag_area", "unitdiagtype", "physical_interface"};
   return std::find(kStarts.begin(), kStarts.end(), s.key) != kStarts.end();
 }
@@ -673,12 +745,23 @@ void GsdParser::unknown(const Stmt& s, std::string_view where) {
   warning(s.line, "unknown keyword '" + s.keyword + "'" + std::string(where) + " kept");
 }
 
+// Vendor files repeat a PrmText or ExtUserPrmData number (copied blocks); like a repeated
+// keyword, the later definition replaces the earlier one and the file stays usable.
+void GsdParser::defined_twice(std::uint32_t line, const std::string& what, std::uint32_t first_line) {
+  warning(line, what + " defined twice (first at line " + std::to_string(first_line) +
+                    "); the later definition wins");
+}
+
 void GsdParser::remember(const Stmt& s) {
   m_result_file.m_keywords.push_back({s.keyword, s.index, s.value, s.line});
 }
 
 void GsdParser::statement(const Stmt& s) {
-  switch (m_block) {
+  if (block() != Block::Top && leaves_block(s)) {
+    unterminated(s);
+    return;
+  }
+  switch (block()) {
     case Block::Top: top(s); break;
     case Block::Module: in_module(s); break;
     case Block::PrmText: in_prm_text(s); break;
@@ -686,9 +769,63 @@ void GsdParser::statement(const Stmt& s) {
     case Block::DiagArea: in_diag_area(s); break;
     case Block::Slots: in_slots(s); break;
     case Block::Opaque:
-      if (s.key == m_opaque_end) m_block = m_opaque_return;
+      if (own_end(m_open.back(), s.key)) m_open.pop_back();
       break;
   }
+}
+
+void GsdParser::open_block(Block kind, std::string end, std::uint32_t line, std::string title) {
+  m_open.push_back({kind, std::move(end), line, std::move(title)});
+  m_dangling_end.clear();
+}
+
+std::string GsdParser::block_title(const OpenBlock& b) const {
+  switch (b.kind) {
+    case Block::Module: return "Module '" + m_module.name + "'";
+    case Block::PrmText: return "PrmText " + std::to_string(m_prm_text.ref);
+    case Block::ExtPrm: return ext_what();
+    case Block::DiagArea: return m_diag_area.x_variant ? "X_Unit_Diag_Area" : "Unit_Diag_Area";
+    case Block::Slots: return "SlotDefinition";
+    case Block::Top:
+    case Block::Opaque: break;
+  }
+  return b.title;
+}
+
+bool GsdParser::own_end(const OpenBlock& b, std::string_view key) const {
+  // Either diagnosis-area end closes either variant, as files mix them.
+  if (b.kind == Block::DiagArea) return key == "unit_diag_area_end" || key == "x_unit_diag_area_end";
+  return key == lower(b.end);
+}
+
+// A statement that cannot be inside the open block: the block's end keyword is missing. Block
+// starts and other blocks' end keywords never belong inside a block; keywords of the top level
+// end the blocks whose content the reader knows (a Module accepts the keywords PI 2.122 allows in
+// it even where they are top-level keywords too). Opaque blocks end only at a block boundary.
+bool GsdParser::leaves_block(const Stmt& s) const {
+  const OpenBlock& b = m_open.back();
+  if (own_end(b, s.key)) return false;
+  if (block_start(s) || end_keyword(s.key)) return true;
+  switch (b.kind) {
+    case Block::Opaque: return false;
+    case Block::Module: return top_level_keyword(s.key) && !module_keyword(s.key);
+    default: return top_level_keyword(s.key);
+  }
+}
+
+// Reported once, at the line that opened the block, with the statement that showed the end
+// missing; the statement then counts where it belongs. A wrong end keyword is taken as the end
+// of this block (so that it is not reported again as an end without its block).
+void GsdParser::unterminated(const Stmt& s) {
+  const OpenBlock b = m_open.back();
+  const bool is_end = end_keyword(s.key);
+  error(b.line, block_title(b) + " without " + b.end + "; '" + s.keyword + "' at line " +
+                    std::to_string(s.line) +
+                    (is_end ? " ends another kind of block" : " cannot be inside it"));
+  m_open.pop_back();
+  if (is_end && (m_open.empty() || !own_end(m_open.back(), s.key))) return;
+  if (!is_end) m_dangling_end = lower(b.end);
+  statement(s);
 }
 
 bool GsdParser::scalar(const Stmt& s) {
@@ -711,35 +848,59 @@ bool GsdParser::scalar(const Stmt& s) {
 }
 
 bool GsdParser::baud_keyword(const Stmt& s) {
-  const std::string& k = s.key;
-  if (k.size() > 5 && k.compare(k.size() - 5, 5, "_supp") == 0) {
-    auto b = baud_from_gsd(std::string_view(k).substr(0, k.size() - 5));
-    if (!b) return false;
+  const auto bk = split_baud_key(s.key);
+  if (!bk) return false;
+  if (bk->kind == "_supp") {
     if (auto v = boolean(s, s.keyword)) {
       if (*v)
-        m_supp_line[*b] = s.line;
+        m_supp_line[bk->baud] = s.line;
       else
-        m_supp_line.erase(*b);
+        m_supp_line.erase(bk->baud);
     }
     return true;
   }
-  static const std::array<std::string_view, 5> kPrefixes = {"maxtsdr_", "trdy_", "tqui_", "tset_", "tsdi_"};
-  for (std::string_view prefix : kPrefixes) {
-    if (k.size() <= prefix.size() || k.compare(0, prefix.size(), prefix) != 0) continue;
-    auto b = baud_from_gsd(std::string_view(k).substr(prefix.size()));
-    if (!b) return false;
-    auto v = unsigned_value(s, s.keyword, 0xFFFF);
-    if (!v) return true;
-    const auto val = static_cast<std::uint16_t>(*v);
-    auto& m = m_result_file.m_master;
-    if (prefix == "maxtsdr_") m_max_tsdr[*b] = val;
-    else if (prefix == "trdy_") m.trdy[*b] = val;
-    else if (prefix == "tqui_") m.tqui[*b] = val;
-    else if (prefix == "tset_") m.tset[*b] = val;
-    else m.tsdi[*b] = val;
-    return true;
+  auto v = unsigned_value(s, s.keyword, 0xFFFF);
+  if (!v) return true;
+  const auto val = static_cast<std::uint16_t>(*v);
+  auto& m = m_result_file.m_master;
+  if (bk->kind == "maxtsdr_") m_max_tsdr[bk->baud] = val;
+  else if (bk->kind == "trdy_") m.trdy[bk->baud] = val;
+  else if (bk->kind == "tqui_") m.tqui[bk->baud] = val;
+  else if (bk->kind == "tset_") m.tset[bk->baud] = val;
+  else m.tsdi[bk->baud] = val;
+  return true;
+}
+
+// Max_Input_Len, Max_Output_Len, Max_Data_Len. A DP slave exchanges at most 244 octets in each
+// direction (protocol-facts.md §D.3 "per slave <= 244 B in and <= 244 B out"; §A: 244 octets of
+// DP payload per telegram), so PI 2.122 allows 0..244, 0..244 and 0..488. Files in the field
+// write more (249, the FDL LE limit, and 498): such a value is clamped to the limit with a
+// warning instead of refusing the file, since the limit is what any master will use anyway.
+bool GsdParser::data_length_limit(const Stmt& s) {
+  struct Limit {
+    std::string_view key;
+    std::string_view name;
+    std::uint16_t limit;
+  };
+  static constexpr Limit kLimits[] = {{"max_input_len", "Max_Input_Len", 244},
+                                      {"max_output_len", "Max_Output_Len", 244},
+                                      {"max_data_len", "Max_Data_Len", 488}};
+  const Limit* l = nullptr;
+  for (const auto& k : kLimits)
+    if (k.key == s.key) l = &k;
+  if (l == nullptr) return false;
+  auto v = unsigned_value(s, l->name, 0xFFFF);
+  if (!v) return true;
+  if (*v > l->limit) {
+    warning(s.line, std::string(l->name) + " " + std::to_string(*v) + " above the DP limit " +
+                        std::to_string(l->limit) + "; clamped to " + std::to_string(l->limit));
+    v = l->limit;
   }
-  return false;
+  auto& sf = m_result_file.m_slave;
+  if (s.key == "max_input_len") sf.max_input_len = static_cast<std::uint8_t>(*v);
+  else if (s.key == "max_output_len") sf.max_output_len = static_cast<std::uint8_t>(*v);
+  else sf.max_data_len = static_cast<std::uint16_t>(*v);
+  return true;
 }
 
 void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
@@ -748,7 +909,7 @@ void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
   auto bytes = byte_list(s.value, s.line, "byte value");
   if (!bytes) return;
   if (bytes->empty()) {
-    error(s.line, "Ext_User_Prm_Data_Const(" + s.index + ") has no bytes");
+    error(s.line, s.keyword + "(" + s.index + ") has no bytes");
     return;
   }
   area.consts.push_back({*off, std::move(*bytes), s.line});
@@ -757,17 +918,43 @@ void GsdParser::prm_const(const Stmt& s, GsdPrmArea& area) {
 void GsdParser::prm_ref(const Stmt& s, GsdPrmArea& area) {
   auto off = index_value(s, 236);
   if (!off) return;
-  auto ref = unsigned_value(s, "Ext_User_Prm_Data_Ref(" + s.index + ")", 0xFFFF);
+  auto ref = unsigned_value(s, s.keyword + "(" + s.index + ")", 0xFFFF);
   if (!ref) return;
   area.refs.push_back({*off, static_cast<std::uint16_t>(*ref), s.line});
 }
 
-void GsdParser::top(const Stmt& s) {
-  remember(s);
+// Misspellings common in real files, read as the keyword they mean (with a warning, so that the
+// vendor can fix the file). Min_Slave_Interval: the standard's keyword has two l; read with one,
+// the poll interval would silently become 0. WB_Base_1ms_supp: listed by S10 (protocol-facts.md
+// §I.2) next to the right spelling.
+void GsdParser::correct_spelling(Stmt& s) {
+  struct Misspelling {
+    std::string_view wrong;
+    std::string_view right;
+  };
+  static constexpr Misspelling kMisspellings[] = {{"min_slave_interval", "Min_Slave_Intervall"},
+                                                  {"wb_base_1ms_supp", "WD_Base_1ms_supp"}};
+  for (const auto& m : kMisspellings) {
+    if (s.key != m.wrong) continue;
+    warning(s.line, "'" + s.keyword + "' read as '" + std::string(m.right) + "' (common misspelling)");
+    s.key = lower(m.right);
+    return;
+  }
+}
+
+void GsdParser::top(const Stmt& written) {
+  remember(written);
+  Stmt s = written;
+  correct_spelling(s);
+  if (!m_dangling_end.empty() && s.key == m_dangling_end) {
+    m_dangling_end.clear();  // already reported as the missing end of its block
+    return;
+  }
   // Blocks repeat; several Ext_User_Prm_Data_Ref at one offset are the normal way to place
   // several bit parameters in one byte.
-  static const std::array<std::string_view, 18> kRepeatable = {
+  static const std::array<std::string_view, 20> kRepeatable = {
       "ext_user_prm_data_ref", "ext_user_prm_data_const", "module", "endmodule", "prmtext", "endprmtext", "extuserprmdata", "endextuserprmdata",
+      "f_extuserprmdata", "endf_extuserprmdata",
       "unit_diag_area", "unit_diag_area_end", "x_unit_diag_area", "x_unit_diag_area_end",
       "slotdefinition", "endslotdefinition", "unitdiagtype", "endunitdiagtype",
       "physical_interface", "end_physical_interface"};
@@ -791,8 +978,7 @@ void GsdParser::top(const Stmt& s) {
     m_module = GsdModule{};
     m_module.name = *name;
     m_module.line = s.line;
-    m_block = Block::Module;
-    m_block_line = s.line;
+    open_block(Block::Module, "EndModule", s.line);
     m_module_stmts = 0;
     auto bytes = byte_list(rest, s.line, "config byte");
     if (!bytes) return;
@@ -805,39 +991,40 @@ void GsdParser::top(const Stmt& s) {
     m_prm_text = GsdPrmText{};
     m_prm_text.ref = static_cast<std::uint16_t>(ref.value_or(0));
     m_prm_text.line = s.line;
-    m_block = Block::PrmText;
-    m_block_line = s.line;
+    open_block(Block::PrmText, "EndPrmText", s.line);
   } else if (k == "endprmtext") {
     error(s.line, "EndPrmText without PrmText");
-  } else if (k == "extuserprmdata") {
+  } else if (k == "extuserprmdata" || k == "f_extuserprmdata") {
     m_ext = GsdExtUserPrmData{};
     m_ext.line = s.line;
+    m_ext_f = k[0] == 'f';
     m_ext_has_type = false;
-    m_block = Block::ExtPrm;
-    m_block_line = s.line;
+    const std::string kind = m_ext_f ? "F_ExtUserPrmData" : "ExtUserPrmData";
+    open_block(Block::ExtPrm, m_ext_f ? "EndF_ExtUserPrmData" : "EndExtUserPrmData", s.line);
     if (!need_value(s)) return;
     const std::string_view v = s.value;
     const std::size_t q = v.find('"');
     auto ref = number(v.substr(0, q), s.line);
     if (!ref) return;
     if (*ref < 0 || *ref > 0xFFFF) {
-      error(s.line, "ExtUserPrmData reference " + std::to_string(*ref) + " out of range (0..65535)");
+      error(s.line, kind + " reference " + std::to_string(*ref) + " out of range (0..65535)");
       return;
     }
     m_ext.ref = static_cast<std::uint16_t>(*ref);
     if (q == std::string_view::npos) {
-      error(s.line, "ExtUserPrmData " + std::to_string(*ref) + ": name missing");
+      error(s.line, kind + " " + std::to_string(*ref) + ": name missing");
       return;
     }
     if (auto name = quoted(v.substr(q), s.line, nullptr)) m_ext.name = *name;
   } else if (k == "endextuserprmdata") {
     error(s.line, "EndExtUserPrmData without ExtUserPrmData");
+  } else if (k == "endf_extuserprmdata") {
+    error(s.line, "EndF_ExtUserPrmData without F_ExtUserPrmData");
   } else if (k == "unit_diag_area" || k == "x_unit_diag_area") {
     m_diag_area = GsdUnitDiagArea{};
     m_diag_area.x_variant = k[0] == 'x';
     m_diag_area.line = s.line;
-    m_block = Block::DiagArea;
-    m_block_line = s.line;
+    open_block(Block::DiagArea, m_diag_area.x_variant ? "X_Unit_Diag_Area_End" : "Unit_Diag_Area_End", s.line);
     if (!need_value(s)) return;
     const std::size_t dash = s.value.find('-');
     auto a = number(std::string_view(s.value).substr(0, dash), s.line);
@@ -853,15 +1040,12 @@ void GsdParser::top(const Stmt& s) {
   } else if (k == "unit_diag_area_end" || k == "x_unit_diag_area_end") {
     error(s.line, s.keyword + " without Unit_Diag_Area");
   } else if (k == "slotdefinition") {
-    m_block = Block::Slots;
-    m_block_line = s.line;
+    open_block(Block::Slots, "EndSlotDefinition", s.line);
   } else if (k == "endslotdefinition") {
     error(s.line, "EndSlotDefinition without SlotDefinition");
   } else if (k == "unitdiagtype" || k == "physical_interface") {
-    m_block = Block::Opaque;
-    m_block_line = s.line;
-    m_opaque_end = k == "unitdiagtype" ? "endunitdiagtype" : "end_physical_interface";
-    m_opaque_return = Block::Top;
+    open_block(Block::Opaque, k == "unitdiagtype" ? "EndUnitDiagType" : "End_Physical_Interface", s.line,
+               s.keyword);
   } else if (k == "endunitdiagtype" || k == "end_physical_interface") {
     error(s.line, s.keyword + " without its block start");
   } else if (k == "unit_diag_bit" || k == "channel_diag") {
@@ -889,7 +1073,7 @@ void GsdParser::top(const Stmt& s) {
     std::string v = s.value;
     if (v.size() >= 2 && v.front() == '"' && v.back() == '"') v = v.substr(1, v.size() - 2);
     f.m_info.slave_family = v;
-  } else if (baud_keyword(s) || scalar(s)) {
+  } else if (baud_keyword(s) || data_length_limit(s) || scalar(s)) {
     // handled
   } else if (known_raw(k)) {
     // kept in keywords() only
@@ -905,7 +1089,7 @@ void GsdParser::in_module(const Stmt& s) {
   if (k == "endmodule") {
     m_result_file.m_modules.push_back(std::move(m_module));
     m_module = GsdModule{};
-    m_block = Block::Top;
+    m_open.pop_back();
     return;
   }
   if (!s.has_eq && !s.has_index && s.value.empty() &&
@@ -924,12 +1108,6 @@ void GsdParser::in_module(const Stmt& s) {
     m_module.reference = static_cast<std::uint32_t>(*v);
     return;
   }
-  if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "'" + where + " (EndModule missing?)");
-    m_block = Block::Top;  // resynchronise: the statement opens its own block
-    top(s);
-    return;
-  }
   if (k == "ext_module_prm_data_len") {
     if (auto v = unsigned_value(s, "Ext_Module_Prm_Data_Len", 237))
       m_module.prm.declared_len = static_cast<std::uint16_t>(*v);
@@ -937,12 +1115,12 @@ void GsdParser::in_module(const Stmt& s) {
     prm_const(s, m_module.prm);
   } else if (k == "ext_user_prm_data_ref") {
     prm_ref(s, m_module.prm);
+  } else if (f_parameter(s)) {
+    // PROFIsafe F-parameters (decisions in gsd.hpp)
   } else if (k == "info_text") {
     if (auto v = string_value(s, "Info_Text")) m_module.info_text = *v;
   } else if (k == "data_area_beg") {
-    m_block = Block::Opaque;
-    m_opaque_end = "data_area_end";
-    m_opaque_return = Block::Module;
+    open_block(Block::Opaque, "Data_Area_End", s.line, s.keyword);
   } else {
     m_module.other_keywords.push_back({s.keyword, s.index, s.value, s.line});
     if (!known_module_raw(k)) {
@@ -951,16 +1129,36 @@ void GsdParser::in_module(const Stmt& s) {
   }
 }
 
+// PROFIsafe module keywords: the F-parameter block, its description CRCs.
+bool GsdParser::f_parameter(const Stmt& s) {
+  GsdFParameters& f = m_module.f;
+  const std::string& k = s.key;
+  if (k == "f_ext_module_prm_data_len") {
+    if (auto v = unsigned_value(s, "F_Ext_Module_Prm_Data_Len", 237))
+      f.prm.declared_len = static_cast<std::uint16_t>(*v);
+  } else if (k == "f_ext_user_prm_data_const") {
+    prm_const(s, f.prm);
+  } else if (k == "f_ext_user_prm_data_ref") {
+    prm_ref(s, f.prm);
+  } else if (k == "f_paramdesccrc") {
+    if (auto v = unsigned_value(s, "F_ParamDescCRC", 0xFFFF)) f.param_desc_crc = static_cast<std::uint16_t>(*v);
+  } else if (k == "f_io_structuredesccrc") {
+    if (auto v = unsigned_value(s, "F_IO_StructureDescCRC", 0xFFFFFFFF))
+      f.io_structure_desc_crc = static_cast<std::uint32_t>(*v);
+  } else {
+    return false;
+  }
+  return true;
+}
+
 void GsdParser::in_prm_text(const Stmt& s) {
   const std::string where = " in PrmText " + std::to_string(m_prm_text.ref);
   if (s.key == "endprmtext") {
-    auto [it, fresh] = m_prm_text_lines.emplace(m_prm_text.ref, m_prm_text.line);
-    if (!fresh)
-      error(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref) +
-                                 " defined twice (first at line " + std::to_string(it->second) + ")");
-    else
-      m_result_file.m_prm_texts[m_prm_text.ref] = std::move(m_prm_text);
-    m_block = Block::Top;
+    auto& texts = m_result_file.m_prm_texts;
+    if (auto it = texts.find(m_prm_text.ref); it != texts.end())
+      defined_twice(m_prm_text.line, "PrmText " + std::to_string(m_prm_text.ref), it->second.line);
+    texts[m_prm_text.ref] = std::move(m_prm_text);
+    m_open.pop_back();
   } else if (s.key == "text") {
     if (!s.has_index) {
       error(s.line, "'Text' needs an index: Text(value)");
@@ -971,17 +1169,17 @@ void GsdParser::in_prm_text(const Stmt& s) {
     auto t = string_value(s, "Text");
     if (!t) return;
     m_prm_text.texts.emplace_back(*v, *t);
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "'" + where + " (EndPrmText missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, where);
   }
 }
 
+std::string GsdParser::ext_what() const {
+  return (m_ext_f ? "F_ExtUserPrmData " : "ExtUserPrmData ") + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+}
+
 void GsdParser::data_type_line(const Stmt& s) {
-  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
+  const std::string what = ext_what();
   if (m_ext_has_type) {
     error(s.line, what + ": more than one data type line");
     return;
@@ -1102,17 +1300,18 @@ void GsdParser::data_type_line(const Stmt& s) {
 
 void GsdParser::in_ext_prm(const Stmt& s) {
   const std::string& k = s.key;
-  const std::string what = "ExtUserPrmData " + std::to_string(m_ext.ref) + " '" + m_ext.name + "'";
-  if (k == "endextuserprmdata") {
-    m_block = Block::Top;
+  const std::string what = ext_what();
+  if (own_end(m_open.back(), k)) {
+    m_open.pop_back();
     if (!m_ext_has_type) {
       error(m_ext.line, what + ": data type line missing");
       return;
     }
-    auto [it, fresh] = m_result_file.m_ext_prm.emplace(m_ext.ref, m_ext);
-    if (!fresh)
-      error(m_ext.line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " defined twice (first at line " +
-                            std::to_string(it->second.line) + ")");
+    auto& defs = m_ext_f ? m_result_file.m_f_ext_prm : m_result_file.m_ext_prm;
+    if (auto it = defs.find(m_ext.ref); it != defs.end())
+      defined_twice(m_ext.line, (m_ext_f ? "F_ExtUserPrmData " : "ExtUserPrmData ") + std::to_string(m_ext.ref),
+                    it->second.line);
+    defs[m_ext.ref] = m_ext;
   } else if (k == "bit" || k == "bitarea" || k == "unsigned8" || k == "unsigned16" ||
              k == "unsigned32" || k == "signed8" || k == "signed16" || k == "signed32") {
     data_type_line(s);
@@ -1122,10 +1321,6 @@ void GsdParser::in_ext_prm(const Stmt& s) {
     if (auto v = boolean(s, "Changeable")) m_ext.changeable = *v;
   } else if (k == "visible") {
     if (auto v = boolean(s, "Visible")) m_ext.visible = *v;
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "' in " + what + " (EndExtUserPrmData missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, " in " + what);
   }
@@ -1134,7 +1329,7 @@ void GsdParser::in_ext_prm(const Stmt& s) {
 void GsdParser::in_diag_area(const Stmt& s) {
   if (s.key == "unit_diag_area_end" || s.key == "x_unit_diag_area_end") {
     m_result_file.m_unit_diag_areas.push_back(std::move(m_diag_area));
-    m_block = Block::Top;
+    m_open.pop_back();
   } else if (s.key == "value") {
     if (!s.has_index) {
       error(s.line, "'Value' needs an index: Value(n)");
@@ -1145,10 +1340,6 @@ void GsdParser::in_diag_area(const Stmt& s) {
     auto t = string_value(s, "Value");
     if (!t) return;
     m_diag_area.values.emplace_back(*v, *t);
-  } else if (block_start(s)) {
-    error(s.line, "'" + s.keyword + "' in Unit_Diag_Area (Unit_Diag_Area_End missing?)");
-    m_block = Block::Top;
-    top(s);
   } else {
     unknown(s, " in Unit_Diag_Area");
   }
@@ -1156,17 +1347,11 @@ void GsdParser::in_diag_area(const Stmt& s) {
 
 void GsdParser::in_slots(const Stmt& s) {
   if (s.key == "endslotdefinition") {
-    m_block = Block::Top;
+    m_open.pop_back();
     return;
   }
   if (s.key != "slot") {
-    if (block_start(s)) {
-      error(s.line, "'" + s.keyword + "' in SlotDefinition (EndSlotDefinition missing?)");
-      m_block = Block::Top;
-      top(s);
-    } else {
-      unknown(s, " in SlotDefinition");
-    }
+    unknown(s, " in SlotDefinition");
     return;
   }
   GsdSlot slot;
@@ -1216,26 +1401,31 @@ void GsdParser::in_slots(const Stmt& s) {
 }
 
 void GsdParser::close_block_at_end() {
-  switch (m_block) {
-    case Block::Top: return;
-    case Block::Module: error(m_block_line, "Module '" + m_module.name + "' without EndModule"); break;
-    case Block::PrmText:
-      error(m_block_line, "PrmText " + std::to_string(m_prm_text.ref) + " without EndPrmText");
-      break;
-    case Block::ExtPrm:
-      error(m_block_line, "ExtUserPrmData " + std::to_string(m_ext.ref) + " without EndExtUserPrmData");
-      break;
-    case Block::DiagArea: error(m_block_line, "Unit_Diag_Area without Unit_Diag_Area_End"); break;
-    case Block::Slots: error(m_block_line, "SlotDefinition without EndSlotDefinition"); break;
-    case Block::Opaque:
-      error(m_block_line, "block without its end keyword '" + m_opaque_end + "'");
-      break;
+  for (; !m_open.empty(); m_open.pop_back()) {
+    const OpenBlock& b = m_open.back();
+    error(b.line, block_title(b) + " without " + b.end);
   }
-  m_block = Block::Top;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Whole-file checks
+
+// The F-parameter block of a PROFIsafe module: its length is F_Ext_Module_Prm_Data_Len; the
+// same rule as for Ext_Module_Prm_Data_Len applies when overlays reach beyond it or it is absent.
+void GsdParser::check_f_block(const GsdModule& m) {
+  if (!m.f.present()) return;
+  const GsdPrmArea& fp = m.f.prm;
+  const std::size_t len = fp.length(m_result_file.m_f_defs);
+  const std::string what = "Module '" + m.name + "': ";
+  if (!fp.declared_len) {
+    if (len > 0)
+      warning(m.line, what + "F-parameters without F_Ext_Module_Prm_Data_Len; F block of " + std::to_string(len) +
+                          " bytes, as far as they reach");
+  } else if (len > *fp.declared_len) {
+    warning(m.line, what + "F-parameters reach byte " + std::to_string(len) + ", beyond F_Ext_Module_Prm_Data_Len " +
+                        std::to_string(*fp.declared_len) + "; F block extended");
+  }
+}
 
 void GsdParser::finish() {
   auto& f = m_result_file;
@@ -1283,19 +1473,30 @@ void GsdParser::finish() {
     error(*l, "Max_Initiate_PDU_Length " + std::to_string(f.m_dpv1.max_initiate_pdu_length) +
                   " not allowed (0 or 52..244)");
 
-  // References between blocks.
-  auto check_refs = [&](const GsdPrmArea& area) {
+  // References between blocks. F_Ext_User_Prm_Data_Ref resolves to F_ExtUserPrmData, else to
+  // the ExtUserPrmData of that number (gsd.hpp).
+  f.m_f_defs = f.m_ext_prm;
+  for (const auto& [ref, e] : f.m_f_ext_prm) f.m_f_defs[ref] = e;
+  auto check_refs = [&](const GsdPrmArea& area, const std::map<std::uint16_t, GsdExtUserPrmData>& defs,
+                        std::string_view keyword, std::string_view kind) {
     for (const auto& r : area.refs)
-      if (!f.m_ext_prm.count(r.ref))
-        error(r.line, "Ext_User_Prm_Data_Ref(" + std::to_string(r.offset) +
-                          ") refers to undefined ExtUserPrmData " + std::to_string(r.ref));
+      if (!defs.count(r.ref))
+        error(r.line, std::string(keyword) + "(" + std::to_string(r.offset) + ") refers to undefined " +
+                          std::string(kind) + " " + std::to_string(r.ref));
   };
-  check_refs(f.m_global_prm);
-  for (const auto& m : f.m_modules) check_refs(m.prm);
-  for (const auto& [ref, e] : f.m_ext_prm)
-    if (e.prm_text_ref && !f.m_prm_texts.count(*e.prm_text_ref))
-      error(e.line, "ExtUserPrmData " + std::to_string(ref) + " '" + e.name +
-                        "': Prm_Text_Ref refers to undefined PrmText " + std::to_string(*e.prm_text_ref));
+  check_refs(f.m_global_prm, f.m_ext_prm, "Ext_User_Prm_Data_Ref", "ExtUserPrmData");
+  for (const auto& m : f.m_modules) {
+    check_refs(m.prm, f.m_ext_prm, "Ext_User_Prm_Data_Ref", "ExtUserPrmData");
+    check_refs(m.f.prm, f.m_f_defs, "F_Ext_User_Prm_Data_Ref", "F_ExtUserPrmData");
+  }
+  auto check_texts = [&](const std::map<std::uint16_t, GsdExtUserPrmData>& defs, std::string_view kind) {
+    for (const auto& [ref, e] : defs)
+      if (e.prm_text_ref && !f.m_prm_texts.count(*e.prm_text_ref))
+        error(e.line, std::string(kind) + " " + std::to_string(ref) + " '" + e.name +
+                          "': Prm_Text_Ref refers to undefined PrmText " + std::to_string(*e.prm_text_ref));
+  };
+  check_texts(f.m_ext_prm, "ExtUserPrmData");
+  check_texts(f.m_f_ext_prm, "F_ExtUserPrmData");
 
   // Modules: identifiers well formed; lengths derived from them.
   std::map<std::uint32_t, std::uint32_t> refs_seen;
@@ -1321,6 +1522,7 @@ void GsdParser::finish() {
       warning(m.line, "Module '" + m.name + "': parameters reach byte " + std::to_string(len) +
                           ", beyond Ext_Module_Prm_Data_Len " + std::to_string(*m.prm.declared_len) +
                           "; area extended");
+    check_f_block(m);
   }
 
   // Global parameter area.

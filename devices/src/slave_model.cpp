@@ -249,22 +249,26 @@ SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleCh
   // Structured parameter blocks follow the GSD part when the slave accepts them.
   cfg.max_user_prm_len = cfg.features.prm_structure ? dp::kMaxUserPrmLen : prm.size();
 
-  // Every Ext_User_Prm_Data_Ref parameter at its place: station area, then the modules' areas.
+  // Every Ext_User_Prm_Data_Ref parameter at its place: station area, then per module its area
+  // and its PROFIsafe F-parameter block (F_Ext_User_Prm_Data_Ref).
   std::vector<PrmCheck> checks;
   const auto& defs = gsd.ext_user_prm_data();
-  auto add_area = [&](const GsdPrmArea& area, std::size_t base) {
+  auto add_area = [&](const GsdPrmArea& area, const std::map<std::uint16_t, GsdExtUserPrmData>& area_defs,
+                      std::size_t base) {
     for (const auto& ref : area.refs) {
-      auto it = defs.find(ref.ref);
-      if (it != defs.end()) checks.push_back({base + ref.offset, it->second});
+      auto it = area_defs.find(ref.ref);
+      if (it != area_defs.end()) checks.push_back({base + ref.offset, it->second});
     }
   };
   std::size_t base = 0;
-  add_area(gsd.global_prm(), 0);
+  add_area(gsd.global_prm(), defs, 0);
   base = gsd.global_prm().length(defs);
   if (v1.dpv1_slave) base = std::max<std::size_t>(base, 3);
   for (std::size_t i : chosen) {
-    add_area(gsd.modules()[i].prm, base);
-    base += gsd.modules()[i].prm.length(defs);
+    const GsdModule& m = gsd.modules()[i];
+    add_area(m.prm, defs, base);
+    add_area(m.f.prm, gsd.f_prm_defs(), base + m.prm.length(defs));
+    base += gsd.module_prm_length(m);
   }
   cfg.check_user_prm = [checks = std::move(checks)](std::span<const std::uint8_t> data) {
     for (const auto& c : checks) {

@@ -63,7 +63,10 @@ const char* const kTokens[] = {
     "Ext_User_Prm_Data_Const(236)=0xFF,0xFF,0xFF", "Unit_Diag_Area = 5-1", "SlotDefinition\n",
     "Slot(1) = \"s\" 1 9-1", "Data_Area_Beg\n", "#Profibus_DP\n", "User_Prm_Data_Len = 237",
     "Max_User_Prm_Data_Len = 0", "DPV1_Slave = 1", "Modular_Station = 0", "Max_Module = 0",
-    "Station_Type = 1", "\xDC", "\xEF\xBB\xBF", std::string("\0", 1).c_str(),
+    "Station_Type = 1", "F_ExtUserPrmData = 1 \"f\"\n", "EndF_ExtUserPrmData",
+    "F_Ext_Module_Prm_Data_Len = 10", "F_Ext_User_Prm_Data_Ref(9)=8", "Min_Slave_Interval = 1",
+    "Max_Input_Len = 249", "\xDC", "\xEF\xBB\xBF",
+    "",  // a NUL byte (mutate() inserts one for the empty token)
 };
 
 std::string mutate(std::string s, SplitMix64& rng) {
@@ -130,7 +133,8 @@ std::size_t count_lines(const std::string& s) {
 TEST(GsdMutation, NeverCrashesAndAlwaysLocatesErrors) {
   const std::vector<std::string> seeds = {
       read("examples/gsd/PBVB0A01.gsd"), read("examples/gsd/PBVB0A02.gsd"),
-      read("examples/gsd/PBVB0A03.gsd"), read("tests/data/gsd/VNDR4711.gsd")};
+      read("examples/gsd/PBVB0A03.gsd"), read("tests/data/gsd/VNDR4711.gsd"),
+      read("tests/data/gsd/vendor-quirks/profisafe-module.gsd")};
   for (const auto& s : seeds) ASSERT_FALSE(s.empty());
 
   SplitMix64 rng{0x5EED'0000'0122ULL};

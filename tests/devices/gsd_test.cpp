@@ -253,6 +253,23 @@ TEST(Gsd, Dpv1Station) {
   EXPECT_EQ(f.ext_user_prm_data().at(12).min_value, -27648);
 }
 
+TEST(Gsd, EveryDpv1Keyword) {
+  // PBVB0A04 sets every DP-V1 keyword the model holds; spot checks of the less common ones.
+  const GsdFile f = load_ok("tests/data/gsd/PBVB0A04.gsd");
+  const auto& d = f.dpv1();
+  EXPECT_TRUE(d.isochron_mode_supp);
+  EXPECT_FALSE(d.isochron_mode_required);
+  EXPECT_TRUE(d.time_sync_supp);
+  EXPECT_TRUE(d.publisher_supp);
+  EXPECT_FALSE(d.prm_block_structure_supp);
+  EXPECT_TRUE(d.prm_block_structure_req);
+  EXPECT_TRUE(d.c2_read_write_required);
+  EXPECT_TRUE(d.manufacturer_specific_alarm_required);
+  EXPECT_FALSE(d.dpv1_data_types);
+  EXPECT_TRUE(f.unknown_keywords().empty());
+  EXPECT_EQ(f.keyword("Isochron_Mode_supp")->line, 60u);
+}
+
 TEST(Gsd, VendorStyleFile) {
   GsdParseResult r = load_gsd(src("tests/data/gsd/VNDR4711.gsd"));
   ASSERT_TRUE(r.ok());
@@ -331,7 +348,11 @@ TEST(Gsd, VendorStyleFile) {
   // 0xC1 = 2 words in consistent.
   EXPECT_EQ(f.modules()[2].output_len, 2u);
   EXPECT_EQ(f.modules()[2].input_len, 4u);
-  ASSERT_EQ(f.modules()[2].other_keywords.size(), 1u);
+  // F_Ext_Module_Prm_Data_Len = 0: a PROFIsafe module keyword with an empty F-parameter block.
+  EXPECT_TRUE(f.modules()[2].other_keywords.empty());
+  EXPECT_TRUE(f.modules()[2].f.present());
+  EXPECT_EQ(f.modules()[2].f.prm.declared_len, 0u);
+  EXPECT_TRUE(f.f_prm_defaults(f.modules()[2]).empty());
   EXPECT_EQ(f.modules()[3].input_len + f.modules()[3].output_len, 0u);
 
   ASSERT_EQ(f.slots().size(), 2u);

@@ -552,6 +552,45 @@ TEST(SlaveModelErrors, BaudTheGsdDoesNotSupport) {
   EXPECT_TRUE(SlaveModel::build(*parsed.file, {ModuleChoice::at(0)}, opts(bus::Baud::k6M)).ok());
 }
 
+// --- PROFIsafe module (tests/data/gsd/vendor-quirks/profisafe-module.gsd) ---------------------
+
+TEST(SlaveModelLine, ProfisafeModuleFParametersInSetPrm) {
+  auto parsed = load_gsd(std::string(PBVBUS_SOURCE_DIR) + "/tests/data/gsd/vendor-quirks/profisafe-module.gsd");
+  ASSERT_TRUE(parsed.ok());
+  const GsdFile& gsd = *parsed.file;
+  Bench b(gsd, {ModuleChoice::named("8DI DC24V"), ModuleChoice::named("F-DI 2x24V PROFIsafe")}, 7);
+  // DPV1_Status 80 00 00, 8DI 01, F-DI 01 0A, F-parameters 08 40 00 01 00 64 00 96 4A 2B
+  // (worked out in gsd_vendor_quirks_test.cpp).
+  const Bytes user_prm = pbvbus::test::bytes_from_hex("80 00 00 01 01 0A 08 40 00 01 00 64 00 96 4A 2B");
+  EXPECT_EQ(b.model->default_user_prm(), user_prm);
+  EXPECT_EQ(b.model->config().min_user_prm_len, 16u);
+  b.start();
+  b.run_for(20 * kMs);
+  ASSERT_EQ(b.master->slave_state(7), dp::SlaveStatusState::DataExchange);
+  // The Set_Prm on the wire carries the 7 standard octets, then the whole User_Prm_Data.
+  std::vector<std::size_t> idx;
+  const auto d = dialogue(b.rec, 7, &idx);
+  ASSERT_GE(d.size(), 3u);
+  fdl::Telegram t;
+  ASSERT_EQ(fdl::decode(b.rec.frame(idx[2]).bytes, t), fdl::DecodeError::None);
+  EXPECT_EQ(t.dsap, 0x3D);  // Set_Prm SAP 61
+  ASSERT_EQ(t.data.size(), 7u + user_prm.size());
+  EXPECT_EQ(Bytes(t.data.begin() + 7, t.data.end()), user_prm);
+
+  // The slave checks the F-parameters against their F_ExtUserPrmData ranges: F_Par_Version 0
+  // (octet 7, bits 6-7) and F_Dest_Add 0 (octets 10-11) are refused.
+  const auto& check = b.model->config().check_user_prm;
+  ASSERT_TRUE(check);
+  EXPECT_TRUE(check(user_prm));
+  Bytes bad = user_prm;
+  bad[7] = 0x00;
+  EXPECT_FALSE(check(bad));
+  bad = user_prm;
+  bad[10] = 0x00;
+  bad[11] = 0x00;
+  EXPECT_FALSE(check(bad));
+}
+
 TEST(SlaveModelErrors, BadBehavioursAndFaults) {
   const GsdFile gsd = load("PBVB0A02.gsd");
   auto r = SlaveModel::build(gsd, ms8_modules(), opts(kBaud));

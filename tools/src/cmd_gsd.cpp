@@ -1,6 +1,7 @@
 // `pbvbus gsd FILE [--json]`: reads a GSD file (PI 2.122) and prints what it describes: ident,
 // station type, vendor/model, baud rates with MaxTsdr, modules with their config bytes and
-// lengths, parameters (ExtUserPrmData), DP-V1 and redundancy features. Warnings go to stderr.
+// lengths and PROFIsafe F-parameters, parameters (ExtUserPrmData, F_ExtUserPrmData), DP-V1 and
+// redundancy features. Warnings go to stderr.
 // Exit 0 on success, 2 for bad usage or a broken file ("file:line: reason" on stderr).
 
 #include <cstdint>
@@ -26,8 +27,9 @@ constexpr const char* kUsage =
     "\n"
     "Reads a GSD device description (PI 2.122, ISO-8859-1) and prints its ident number,\n"
     "station type, vendor and model, supported baud rates with MaxTsdr, modules (config bytes,\n"
-    "input/output lengths), parameters (ExtUserPrmData with defaults, ranges and texts), DP-V1\n"
-    "and redundancy features. Warnings go to stderr.\n"
+    "input/output lengths, PROFIsafe F-parameters), parameters (ExtUserPrmData and\n"
+    "F_ExtUserPrmData with defaults, ranges and texts), DP-V1 and redundancy features.\n"
+    "Warnings go to stderr.\n"
     "\n"
     "  --json    print the same as one JSON object\n"
     "  --help    this text\n"
@@ -66,6 +68,12 @@ std::string hex16(std::uint16_t v) {
   return buf;
 }
 
+std::string hex32(std::uint32_t v) {
+  char buf[12];
+  std::snprintf(buf, sizeof buf, "0x%08X", static_cast<unsigned>(v));
+  return buf;
+}
+
 const char* yn(bool b) { return b ? "1" : "0"; }
 
 std::string station_type_name(std::uint8_t t) { return t == 1 ? "DP master" : "DP slave"; }
@@ -89,6 +97,33 @@ std::string type_text(const devices::GsdExtUserPrmData& e) {
 }
 
 // --- text output -------------------------------------------------------------------------------
+
+// A PROFIsafe module's F-parameter block (defaults) and its description CRCs, under its module.
+void print_f_parameters(const GsdFile& f, const devices::GsdModule& m, std::ostream& out) {
+  const GsdBytes block = f.f_prm_defaults(m);
+  out << "      F-parameters " << (block.empty() ? std::string("(none)") : hex_plain(block))
+      << "; F_Ext_Module_Prm_Data_Len "
+      << (m.f.prm.declared_len ? std::to_string(*m.f.prm.declared_len) : std::string("-"));
+  if (m.f.param_desc_crc) out << ", F_ParamDescCRC " << hex16(*m.f.param_desc_crc);
+  if (m.f.io_structure_desc_crc) out << ", F_IO_StructureDescCRC " << hex32(*m.f.io_structure_desc_crc);
+  out << "\n";
+}
+
+void print_ext_user_prm_data(const GsdFile& f, const char* kind,
+                             const std::map<std::uint16_t, devices::GsdExtUserPrmData>& defs, std::ostream& out) {
+  for (const auto& [ref, e] : defs) {
+    out << "  " << kind << " " << ref << " \"" << e.name << "\": " << type_text(e) << ", default "
+        << e.default_value << ", allowed " << allowed_text(e);
+    if (!e.changeable) out << ", not changeable";
+    if (!e.visible) out << ", hidden";
+    out << "\n";
+    if (e.prm_text_ref) {
+      auto it = f.prm_texts().find(*e.prm_text_ref);
+      if (it != f.prm_texts().end())
+        for (const auto& [v, t] : it->second.texts) out << "      " << v << " = " << t << "\n";
+    }
+  }
+}
 
 void print_text(const GsdFile& f, std::ostream& out) {
   const auto& i = f.info();
@@ -130,6 +165,7 @@ void print_text(const GsdFile& f, std::ostream& out) {
     const GsdBytes prm = f.prm_area_defaults(m.prm);
     if (!prm.empty()) out << ", prm " << hex_plain(prm);
     out << "\n";
+    if (m.f.present()) print_f_parameters(f, m, out);
   }
 
   out << "\nParameters:\n";
@@ -138,22 +174,13 @@ void print_text(const GsdFile& f, std::ostream& out) {
       << (g.declared_len ? std::to_string(*g.declared_len) : std::string("-"))
       << ", Max_User_Prm_Data_Len " << int(f.max_user_prm_data_len()) << "\n";
   out << "  station defaults: " << (hex_plain(f.prm_area_defaults(g)).empty() ? "(none)" : hex_plain(f.prm_area_defaults(g))) << "\n";
-  for (const auto& [ref, e] : f.ext_user_prm_data()) {
-    out << "  ExtUserPrmData " << ref << " \"" << e.name << "\": " << type_text(e) << ", default "
-        << e.default_value << ", allowed " << allowed_text(e);
-    if (!e.changeable) out << ", not changeable";
-    if (!e.visible) out << ", hidden";
-    out << "\n";
-    if (e.prm_text_ref) {
-      auto it = f.prm_texts().find(*e.prm_text_ref);
-      if (it != f.prm_texts().end())
-        for (const auto& [v, t] : it->second.texts) out << "      " << v << " = " << t << "\n";
-    }
-  }
+  print_ext_user_prm_data(f, "ExtUserPrmData", f.ext_user_prm_data(), out);
+  print_ext_user_prm_data(f, "F_ExtUserPrmData", f.f_ext_user_prm_data(), out);
 
   const auto& d = f.dpv1();
   out << "\nDP-V1:              " << (d.dpv1_slave ? "yes" : "no") << "\n";
-  if (d.dpv1_slave) {
+  // Every DP-V1 keyword the model holds, also for a file that sets some without DPV1_Slave.
+  if (d != devices::GsdDpv1Features{}) {
     out << "  C1_Read_Write_supp " << yn(d.c1_read_write_supp) << ", C1_Max_Data_Len "
         << int(d.c1_max_data_len) << ", C1_Response_Timeout " << d.c1_response_timeout << "\n";
     out << "  C2_Read_Write_supp " << yn(d.c2_read_write_supp) << ", C2_Max_Data_Len "
@@ -164,8 +191,22 @@ void print_text(const GsdFile& f, std::ostream& out) {
         << yn(d.status_alarm_supp) << ", Update " << yn(d.update_alarm_supp)
         << ", Manufacturer_Specific " << yn(d.manufacturer_specific_alarm_supp)
         << "; Alarm_Sequence_Mode_Count " << int(d.alarm_sequence_mode_count) << "\n";
+    out << "  alarms required: Diagnostic " << yn(d.diagnostic_alarm_required) << ", Process "
+        << yn(d.process_alarm_required) << ", Pull_Plug " << yn(d.pull_plug_alarm_required) << ", Status "
+        << yn(d.status_alarm_required) << ", Update " << yn(d.update_alarm_required)
+        << ", Manufacturer_Specific " << yn(d.manufacturer_specific_alarm_required) << "\n";
+    out << "  Extra_Alarm_SAP_supp " << yn(d.extra_alarm_sap_supp) << ", Alarm_Type_Mode_supp "
+        << yn(d.alarm_type_mode_supp) << "\n";
+    out << "  C1_Read_Write_required " << yn(d.c1_read_write_required) << ", C2_Read_Write_required "
+        << yn(d.c2_read_write_required) << ", Max_Initiate_PDU_Length " << int(d.max_initiate_pdu_length) << "\n";
     out << "  WD_Base_1ms_supp " << yn(d.wd_base_1ms_supp) << ", Check_Cfg_Mode "
         << yn(d.check_cfg_mode) << ", Ident_Maintenance_supp " << yn(d.ident_maintenance_supp) << "\n";
+    out << "  DPV1_Data_Types " << yn(d.dpv1_data_types) << ", Publisher_supp " << yn(d.publisher_supp)
+        << ", Time_Sync_supp " << yn(d.time_sync_supp) << "\n";
+    out << "  Prm_Block_Structure_supp " << yn(d.prm_block_structure_supp) << ", Prm_Block_Structure_req "
+        << yn(d.prm_block_structure_req) << ", Fail_Safe_required " << yn(d.fail_safe_required) << "\n";
+    out << "  Isochron_Mode_supp " << yn(d.isochron_mode_supp) << ", Isochron_Mode_required "
+        << yn(d.isochron_mode_required) << "\n";
   }
   if (f.is_master()) {
     const auto& m = f.master();
@@ -194,6 +235,42 @@ std::string jbytes(const GsdBytes& b) {
     s += std::to_string(b[i]);
   }
   return s + "]";
+}
+
+std::string json_f_parameters(const GsdFile& f, const devices::GsdModule& m) {
+  if (!m.f.present()) return "null";
+  auto opt = [](const auto& o) { return o ? std::to_string(*o) : std::string("null"); };
+  return "{\"f_ext_module_prm_data_len\": " + opt(m.f.prm.declared_len) + ", \"defaults\": " +
+         jbytes(f.f_prm_defaults(m)) + ", \"f_param_desc_crc\": " + opt(m.f.param_desc_crc) +
+         ", \"f_io_structure_desc_crc\": " + opt(m.f.io_structure_desc_crc) + "}";
+}
+
+std::string json_ext_user_prm_data(const GsdFile& f, const std::map<std::uint16_t, devices::GsdExtUserPrmData>& defs) {
+  std::ostringstream out;
+  out << "[";
+  bool first = true;
+  for (const auto& [ref, e] : defs) {
+    out << (first ? "" : ",") << "\n    {\"ref\": " << ref << ", \"name\": " << json_quote(e.name)
+        << ", \"type\": " << json_quote(devices::gsd_data_type_name(e.type)) << ", \"bit_first\": " << int(e.bit_first)
+        << ", \"bit_last\": " << int(e.bit_last) << ", \"default\": " << e.default_value
+        << ", \"min\": " << e.min_value << ", \"max\": " << e.max_value << ", \"allowed\": [";
+    for (std::size_t k = 0; k < e.allowed.size(); ++k) out << (k ? "," : "") << e.allowed[k];
+    out << "], \"changeable\": " << jb(e.changeable) << ", \"visible\": " << jb(e.visible) << ", \"texts\": [";
+    if (e.prm_text_ref) {
+      auto it = f.prm_texts().find(*e.prm_text_ref);
+      if (it != f.prm_texts().end()) {
+        bool ft = true;
+        for (const auto& [v, t] : it->second.texts) {
+          out << (ft ? "" : ", ") << "{\"value\": " << v << ", \"text\": " << json_quote(t) << "}";
+          ft = false;
+        }
+      }
+    }
+    out << "]}";
+    first = false;
+  }
+  out << (first ? "]" : "\n  ]");
+  return out.str();
 }
 
 void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnings, std::ostream& out) {
@@ -236,40 +313,23 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
         << jbytes(m.config) << ", \"config_hex\": " << json_quote(hex_list(m.config, ","))
         << ", \"input_len\": " << m.input_len << ", \"output_len\": " << m.output_len
         << ", \"consistent\": " << jb(m.consistent) << ", \"prm_defaults\": " << jbytes(f.prm_area_defaults(m.prm))
-        << ", \"info_text\": " << json_quote(m.info_text) << "}";
+        << ", \"f_parameters\": " << json_f_parameters(f, m) << ", \"info_text\": " << json_quote(m.info_text) << "}";
   }
   out << "\n  ],\n";
   const auto& g = f.global_prm();
   out << "  \"parameters\": {\"user_prm_data_len\": "
       << (g.declared_len ? std::to_string(*g.declared_len) : std::string("null"))
       << ", \"max_user_prm_data_len\": " << int(f.max_user_prm_data_len())
-      << ", \"station_defaults\": " << jbytes(f.prm_area_defaults(g)) << ", \"ext_user_prm_data\": [";
-  bool first = true;
-  for (const auto& [ref, e] : f.ext_user_prm_data()) {
-    out << (first ? "" : ",") << "\n    {\"ref\": " << ref << ", \"name\": " << json_quote(e.name)
-        << ", \"type\": " << json_quote(devices::gsd_data_type_name(e.type)) << ", \"bit_first\": " << int(e.bit_first)
-        << ", \"bit_last\": " << int(e.bit_last) << ", \"default\": " << e.default_value
-        << ", \"min\": " << e.min_value << ", \"max\": " << e.max_value << ", \"allowed\": [";
-    for (std::size_t k = 0; k < e.allowed.size(); ++k) out << (k ? "," : "") << e.allowed[k];
-    out << "], \"changeable\": " << jb(e.changeable) << ", \"visible\": " << jb(e.visible) << ", \"texts\": [";
-    if (e.prm_text_ref) {
-      auto it = f.prm_texts().find(*e.prm_text_ref);
-      if (it != f.prm_texts().end()) {
-        bool ft = true;
-        for (const auto& [v, t] : it->second.texts) {
-          out << (ft ? "" : ", ") << "{\"value\": " << v << ", \"text\": " << json_quote(t) << "}";
-          ft = false;
-        }
-      }
-    }
-    out << "]}";
-    first = false;
-  }
-  out << "\n  ]},\n";
+      << ", \"station_defaults\": " << jbytes(f.prm_area_defaults(g))
+      << ", \"ext_user_prm_data\": " << json_ext_user_prm_data(f, f.ext_user_prm_data())
+      << ", \"f_ext_user_prm_data\": " << json_ext_user_prm_data(f, f.f_ext_user_prm_data()) << "},\n";
   const auto& d = f.dpv1();
   out << "  \"dpv1\": {\"dpv1_slave\": " << jb(d.dpv1_slave) << ", \"c1_read_write_supp\": " << jb(d.c1_read_write_supp)
+      << ", \"c1_read_write_required\": " << jb(d.c1_read_write_required)
       << ", \"c1_max_data_len\": " << int(d.c1_max_data_len) << ", \"c1_response_timeout\": " << d.c1_response_timeout
-      << ", \"c2_read_write_supp\": " << jb(d.c2_read_write_supp) << ", \"c2_max_data_len\": " << int(d.c2_max_data_len)
+      << ", \"c2_read_write_supp\": " << jb(d.c2_read_write_supp)
+      << ", \"c2_read_write_required\": " << jb(d.c2_read_write_required)
+      << ", \"c2_max_data_len\": " << int(d.c2_max_data_len)
       << ", \"c2_response_timeout\": " << d.c2_response_timeout
       << ", \"c2_max_count_channels\": " << int(d.c2_max_count_channels)
       << ", \"max_initiate_pdu_length\": " << int(d.max_initiate_pdu_length)
@@ -278,10 +338,24 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
       << ", \"pull_plug_alarm_supp\": " << jb(d.pull_plug_alarm_supp)
       << ", \"status_alarm_supp\": " << jb(d.status_alarm_supp) << ", \"update_alarm_supp\": " << jb(d.update_alarm_supp)
       << ", \"manufacturer_specific_alarm_supp\": " << jb(d.manufacturer_specific_alarm_supp)
+      << ", \"diagnostic_alarm_required\": " << jb(d.diagnostic_alarm_required)
+      << ", \"process_alarm_required\": " << jb(d.process_alarm_required)
+      << ", \"pull_plug_alarm_required\": " << jb(d.pull_plug_alarm_required)
+      << ", \"status_alarm_required\": " << jb(d.status_alarm_required)
+      << ", \"update_alarm_required\": " << jb(d.update_alarm_required)
+      << ", \"manufacturer_specific_alarm_required\": " << jb(d.manufacturer_specific_alarm_required)
       << ", \"extra_alarm_sap_supp\": " << jb(d.extra_alarm_sap_supp)
+      << ", \"alarm_type_mode_supp\": " << jb(d.alarm_type_mode_supp)
       << ", \"alarm_sequence_mode_count\": " << int(d.alarm_sequence_mode_count)
       << ", \"wd_base_1ms_supp\": " << jb(d.wd_base_1ms_supp) << ", \"check_cfg_mode\": " << jb(d.check_cfg_mode)
-      << ", \"ident_maintenance_supp\": " << jb(d.ident_maintenance_supp) << "},\n";
+      << ", \"dpv1_data_types\": " << jb(d.dpv1_data_types) << ", \"publisher_supp\": " << jb(d.publisher_supp)
+      << ", \"ident_maintenance_supp\": " << jb(d.ident_maintenance_supp)
+      << ", \"time_sync_supp\": " << jb(d.time_sync_supp)
+      << ", \"prm_block_structure_supp\": " << jb(d.prm_block_structure_supp)
+      << ", \"prm_block_structure_req\": " << jb(d.prm_block_structure_req)
+      << ", \"fail_safe_required\": " << jb(d.fail_safe_required)
+      << ", \"isochron_mode_supp\": " << jb(d.isochron_mode_supp)
+      << ", \"isochron_mode_required\": " << jb(d.isochron_mode_required) << "},\n";
   const auto& r = f.redundancy();
   out << "  \"redundancy\": {\"redundancy\": " << jb(r.redundancy) << ", \"prm_cmd_supp\": " << jb(r.prm_cmd_supp)
       << ", \"slave_redundancy_supp\": " << int(r.slave_redundancy_supp)

@@ -15,13 +15,26 @@
 // - Only the `#Profibus_DP` section is read; text before it is ignored, a later `#...` line ends
 //   it (warning).
 // - Booleans must be 0 or 1. Numbers are decimal or 0x hex; a value out of the keyword's range is
-//   an error. A keyword given twice: the later value wins, with a warning.
+//   an error, except Max_Input_Len/Max_Output_Len above 244 and Max_Data_Len above 488 (files
+//   in the field write 249 and 498): those are clamped to the DP limit with a warning.
+// - A keyword given twice: the later value wins, with a warning. Likewise a PrmText or
+//   ExtUserPrmData number defined twice (vendor files repeat copied blocks): the later block
+//   replaces the earlier one, with a warning at the later block's line.
+// - Common misspellings are read as the keyword they mean, with a warning: Min_Slave_Interval
+//   (one l) as Min_Slave_Intervall, WB_Base_1ms_supp as WD_Base_1ms_supp.
+// - A block without its end keyword (EndModule, EndPrmText, EndExtUserPrmData, ...) is one error
+//   at the line that opened it, naming the statement that showed the end missing: a block start,
+//   another block's end keyword, or a top-level keyword the block cannot contain (a Module keeps
+//   the keywords PI 2.122 allows in modules; UnitDiagType, Physical_Interface and Data_Area
+//   contents are not interpreted, so only a block boundary ends them). The statement then counts
+//   where it belongs, and the missing end keyword, if it comes later, is not reported again.
 // - User_Prm_Data assembly (user_prm_data()): the global area is User_Prm_Data_Len bytes (or, when
 //   absent, as long as its data), initialised from User_Prm_Data, then the
 //   Ext_User_Prm_Data_Const(o) overlays, then the Ext_User_Prm_Data_Ref(o) defaults; every
-//   selected module appends an area of Ext_Module_Prm_Data_Len bytes built the same way. An overlay
-//   beyond the declared length extends the area (with a parse warning). The whole is truncated to
-//   Max_User_Prm_Data_Len (reported in the outcome's notes).
+//   selected module appends an area of Ext_Module_Prm_Data_Len bytes built the same way, then
+//   its PROFIsafe F-parameter block if it has one (below). An overlay beyond the declared length
+//   extends the area (with a parse warning). The whole is truncated to Max_User_Prm_Data_Len
+//   (reported in the outcome's notes).
 // - DP-V1 slaves: the first three bytes of the global area are DPV1_Status_1..3 as the file writes
 //   them (vendors put them in Ext_User_Prm_Data_Const(0)). A DP-V1 file whose global area is
 //   shorter than 3 bytes gets a warning, and the assembly fills the missing status bytes with the
@@ -32,6 +45,27 @@
 // - A module without Ext_Module_Prm_Data_Len has a parameter area as long as its overlays reach.
 // - Configuration identifiers (§D.3): a special identifier's manufacturer count 15 means "none
 //   follow" (Chk_Cfg semantics, since the GSD bytes are what the master sends in Chk_Cfg).
+// - PROFIsafe (fail-safe) modules. protocol-facts.md is silent on them; what follows is our
+//   reading of the PROFIsafe keywords of PI 2.122 (module items F_Ext_Module_Prm_Data_Len,
+//   F_Ext_User_Prm_Data_Const/Ref, F_ParamDescCRC, F_IO_StructureDescCRC in the GSD grammar of
+//   ISO 15745-3) and of how configuration tools fill the F-parameters:
+//   * A module's part of User_Prm_Data is its Ext_Module_Prm_Data area followed by its
+//     F-parameter block of F_Ext_Module_Prm_Data_Len octets (typically 10: F_Prm_Flag1,
+//     F_Prm_Flag2, F_Source_Add, F_Dest_Add, F_WD_Time, F_Par_CRC; 14 with F_iPar_CRC).
+//     F_Ext_User_Prm_Data_Const(o)/Ref(o) offsets count from the start of the F block, not of
+//     the module's area: a module may carry both an Ext_User_Prm_Data_Const(0) and an
+//     F_Ext_User_Prm_Data_Const(0) covering the whole F block, which only fits this reading [U].
+//   * F_Ext_User_Prm_Data_Ref(o) = n names an `F_ExtUserPrmData = n "name" ...
+//     EndF_ExtUserPrmData` block (same syntax as ExtUserPrmData, own numbering); when the file
+//     has no F_ExtUserPrmData n, an ordinary ExtUserPrmData n is used [U: both forms are said to
+//     occur; we could not see the PROFIsafe part of PI 2.122].
+//   * The F block is assembled like any area: zeros, F_Ext_User_Prm_Data_Const overlays, then
+//     the F_Ext_User_Prm_Data_Ref defaults (or settings with GsdPrmSetting::f_parameter). Without
+//     F_Ext_Module_Prm_Data_Len the block is as long as its overlays reach (with a warning).
+//   * F_Par_CRC (CRC1 over the F-parameters) is taken as the file gives it; a configuration tool
+//     computes it, and a real F-host would reject a stale value. F_ParamDescCRC and
+//     F_IO_StructureDescCRC are kept and shown, not verified (they cover the GSD description
+//     text by a rule we do not have). [U: not computed]
 // - Mandatory keywords: Ident_Number missing, a `*_supp = 1` baud rate without its MaxTsdr, no
 //   baud rate at all, a slave without any Module, and Modular_Station = 1 without Max_Module are
 //   errors; missing Station_Type, Min_Slave_Intervall or Max_Diag_Data_Len only warn.
@@ -170,6 +204,20 @@ struct GsdPrmArea {
   std::size_t length(const std::map<std::uint16_t, GsdExtUserPrmData>& defs) const;
 };
 
+/// A PROFIsafe module's F-parameters (see the PROFIsafe decisions above).
+struct GsdFParameters {
+  /// F_Ext_Module_Prm_Data_Len, F_Ext_User_Prm_Data_Const(o), F_Ext_User_Prm_Data_Ref(o); offsets
+  /// count from the start of the F-parameter block.
+  GsdPrmArea prm;
+  std::optional<std::uint16_t> param_desc_crc;         ///< F_ParamDescCRC (not verified)
+  std::optional<std::uint32_t> io_structure_desc_crc;  ///< F_IO_StructureDescCRC (not verified)
+  /// Any F-parameter keyword given: a fail-safe (PROFIsafe) module.
+  bool present() const {
+    return prm.declared_len || !prm.consts.empty() || !prm.refs.empty() || param_desc_crc ||
+           io_structure_desc_crc;
+  }
+};
+
 /// Module = "name" cfg bytes ... EndModule.
 struct GsdModule {
   std::string name;
@@ -179,6 +227,7 @@ struct GsdModule {
   std::size_t output_len = 0;  ///< bytes
   bool consistent = false;     ///< any identifier asks for consistency over the whole length
   GsdPrmArea prm;
+  GsdFParameters f;  ///< PROFIsafe F-parameters, appended after prm in User_Prm_Data
   std::string info_text;
   std::vector<GsdKeyword> other_keywords;  ///< module-local keywords not modelled (raw)
   std::uint32_t line = 0;
@@ -239,6 +288,9 @@ struct GsdDpv1Features {
   bool prm_block_structure_supp = false;
   bool prm_block_structure_req = false;
   bool fail_safe_required = false;
+  bool isochron_mode_supp = false;      ///< DP-V2 isochronous mode (Isochron_Mode_supp)
+  bool isochron_mode_required = false;  ///< Isochron_Mode_required
+  bool operator==(const GsdDpv1Features&) const = default;
 };
 
 /// Redundancy keywords (§G.7).
@@ -278,11 +330,14 @@ struct GsdMasterFeatures {
 /// A parameter value other than the default, for user_prm_data(). `slot` is nullopt for the
 /// station (global) area, otherwise the position in the module list passed alongside. The value
 /// goes to every Ext_User_Prm_Data_Ref(o) = ref of that area, or only to the one at `offset`.
+/// With `f_parameter`, the setting addresses the slot's F-parameter block instead (its
+/// F_Ext_User_Prm_Data_Ref, `offset` within the F block), e.g. F_Dest_Add.
 struct GsdPrmSetting {
   std::optional<std::size_t> slot;
   std::uint16_t ref = 0;
   std::int64_t value = 0;
   std::optional<std::uint16_t> offset;
+  bool f_parameter = false;
 };
 
 /// Result of an assembly or a check on a module selection.
@@ -324,6 +379,11 @@ class GsdFile {
   std::uint8_t max_user_prm_data_len() const { return m_max_user_prm_data_len; }
   const std::map<std::uint16_t, GsdExtUserPrmData>& ext_user_prm_data() const { return m_ext_prm; }
   const std::map<std::uint16_t, GsdPrmText>& prm_texts() const { return m_prm_texts; }
+  /// F_ExtUserPrmData blocks as the file defines them.
+  const std::map<std::uint16_t, GsdExtUserPrmData>& f_ext_user_prm_data() const { return m_f_ext_prm; }
+  /// What F_Ext_User_Prm_Data_Ref resolves to: the F_ExtUserPrmData blocks, and for numbers
+  /// without one, the ExtUserPrmData of that number.
+  const std::map<std::uint16_t, GsdExtUserPrmData>& f_prm_defs() const { return m_f_defs; }
 
   const std::map<std::uint32_t, std::string>& unit_diag_bits() const { return m_unit_diag_bits; }
   const std::vector<GsdUnitDiagArea>& unit_diag_areas() const { return m_unit_diag_areas; }
@@ -347,6 +407,10 @@ class GsdFile {
                                      const std::vector<GsdPrmSetting>& settings) const;
   /// The bytes one parameter area (global_prm() or a module's prm) contributes, all defaults.
   GsdBytes prm_area_defaults(const GsdPrmArea& area) const;
+  /// A module's F-parameter block with every F-parameter at its default (empty if none).
+  GsdBytes f_prm_defaults(const GsdModule& module) const;
+  /// Octets a module adds to User_Prm_Data: its parameter area plus its F-parameter block.
+  std::size_t module_prm_length(const GsdModule& module) const;
   /// Chk_Cfg data: the concatenated config bytes of these modules. Errors: index out of range.
   GsdOutcome<GsdBytes> cfg_data(const std::vector<std::size_t>& modules) const;
   /// Splits Chk_Cfg (or Get_Cfg) data into modules of this file: a module list whose
@@ -373,6 +437,8 @@ class GsdFile {
   std::uint8_t m_max_user_prm_data_len = 237;
   std::map<std::uint16_t, GsdExtUserPrmData> m_ext_prm;
   std::map<std::uint16_t, GsdPrmText> m_prm_texts;
+  std::map<std::uint16_t, GsdExtUserPrmData> m_f_ext_prm;
+  std::map<std::uint16_t, GsdExtUserPrmData> m_f_defs;
   std::map<std::uint32_t, std::string> m_unit_diag_bits;
   std::vector<GsdUnitDiagArea> m_unit_diag_areas;
   std::map<std::uint32_t, std::string> m_channel_diag;

@@ -219,6 +219,17 @@ void Line::remove_tap(Tap& tap) {
   refresh_probes();
 }
 
+bool Line::is_whole_line_tap(const Tap& tap) const {
+  return std::find(m_taps.begin(), m_taps.end(), &tap) != m_taps.end();
+}
+
+std::vector<AttachmentId> Line::probe_points(const Tap& tap) const {
+  std::vector<AttachmentId> v;
+  for (const ProbeTap& p : m_probes)
+    if (p.tap == &tap) v.push_back(p.at);
+  return v;
+}
+
 void Line::refresh_probes() {
   m_probe_by_segment.assign(m_listening.size(), 0);
   if (m_short) return;

@@ -117,6 +117,10 @@ class Line final : private EventTarget {
   /// Removes every registration of `tap` (whole-line and probes).
   void remove_tap(Tap& tap);
   int probe_count() const { return static_cast<int>(m_probes.size()); }
+  /// Where `tap` sits on this line: whether it is a whole-line tap, and its probe positions in
+  /// the order they were added (for a tap that declares itself lazily, e.g. a capture).
+  bool is_whole_line_tap(const Tap& tap) const;
+  std::vector<AttachmentId> probe_points(const Tap& tap) const;
 
   /// The earliest start among the transmissions still on the wire (anywhere on the line, cut
   /// short or not yet delivered), or kNever if there is none. Every frame that a tap will still

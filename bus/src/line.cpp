@@ -240,7 +240,7 @@ void Line::refresh_probes() {
 }
 
 Ticks Line::earliest_start_in_flight() const {
-  Ticks t = kNever;
+  Ticks t = m_tapping_start;
   for (const auto& x : m_in_flight) t = std::min(t, x->start);
   return t;
 }
@@ -476,8 +476,12 @@ void Line::end_transmission(std::uint64_t id) {
     to.w[k] = owned->rx.w[k] & want;
   }
   to.for_each([&](std::size_t i) { deliver(*owned, i, owned->bytes.size(), 0, end); });
+  // Until every tap has it, the frame still counts as on the wire (earliest_start_in_flight):
+  // a tap told first must not take it for gone while the others are still to be told.
+  m_tapping_start = owned->start;
   tap_frame(*owned, owned->bytes.size(), 0, owned->end);
   if (owned->probes != 0) probe_frame(*owned, owned->probes, owned->bytes.size(), 0, owned->end);
+  m_tapping_start = kNever;
   m_pool.push_back(std::move(owned));
 }
 

@@ -261,7 +261,9 @@ TEST_F(LineProbeTest, OverlappingFramesArriveByEndAndTheLineSaysWhatIsStillOnThe
   EXPECT_EQ(r.frames[0].flags, bus::kRxCollision);
   EXPECT_EQ(r.frames[1].start, 0);
   EXPECT_EQ(r.frames[1].end, B(121));
-  EXPECT_EQ(r.frames[1].earliest_in_flight, bus::kNever);
+  // While the taps are told about a frame it still counts as on the wire: a tap that sits at
+  // several points must not take it for gone before its other probes have it.
+  EXPECT_EQ(r.frames[1].earliest_in_flight, 0);
   EXPECT_EQ(line.earliest_start_in_flight(), bus::kNever);
 }
 

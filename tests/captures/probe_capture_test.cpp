@@ -81,8 +81,10 @@ TEST(ProbeCapture, OverlappingFramesAndEventsAreWrittenInStartTimeOrder) {
     }
     line.remove_tap(w);
   }
-  // Held: the SC from 341, the token from 393, the event at 400; all out when the request ends.
-  EXPECT_EQ(held, (std::vector<std::size_t>{1, 2, 3, 0, 0}));
+  // Held: the SC from 341, the token from 393, the event at 400. The request itself goes out
+  // when it ends at 421 (no earlier start is left); the three after it wait for the next
+  // record, the FDL Status request ending at 566 (or a flush).
+  EXPECT_EQ(held, (std::vector<std::size_t>{1, 2, 3, 3, 0}));
 
   const Read r = read_all(mem.data);
   ASSERT_EQ(r.ifs.size(), 2u);

@@ -123,8 +123,9 @@ class Line final : private EventTarget {
   std::vector<AttachmentId> probe_points(const Tap& tap) const;
 
   /// The earliest start among the transmissions still on the wire (anywhere on the line, cut
-  /// short or not yet delivered), or kNever if there is none. Every frame that a tap will still
-  /// be told about starts at or after min(this, now).
+  /// short or not yet delivered; the one whose end the taps are being told about included), or
+  /// kNever if there is none. Every frame that a tap will still be told about starts at or after
+  /// min(this, now).
   Ticks earliest_start_in_flight() const;
 
   // --- faults and repairs (each takes effect at the scheduler's current time) ---------------
@@ -219,6 +220,8 @@ class Line final : private EventTarget {
   /// Per segment: the probes (bits of m_probes) that hear it; none while the line is shorted.
   std::vector<std::uint64_t> m_probe_by_segment;
   std::vector<Tap*> m_event_taps;  ///< every tap once, in order of first registration
+  /// Start of the frame whose end the taps are being told about (kNever otherwise).
+  Ticks m_tapping_start = kNever;
   std::vector<std::unique_ptr<Transmission>> m_in_flight;
   std::vector<std::unique_ptr<Transmission>> m_pool;
   /// Byte buffers recycled between pending transmissions and transmissions, so that the

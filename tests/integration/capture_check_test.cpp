@@ -13,6 +13,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <unistd.h>
 #include <sstream>
 #include <sys/stat.h>
 
@@ -30,8 +31,10 @@ constexpr const char* kPython = "/usr/bin/python3";
 const std::string kScript = PBVBUS_SOURCE_DIR "/tests/integration/check_capture.py";
 const std::string kExample = PBVBUS_SOURCE_DIR "/examples/multimaster.textproto";
 
+/// Unique per process: ctest runs every test case as a process of its own, in parallel.
 std::string temp_path(const std::string& name) {
-  return std::string(PBVBUS_BINARY_DIR) + "/capture_check_test_" + name;
+  return std::string(PBVBUS_BINARY_DIR) + "/capture_check_test_" + std::to_string(::getpid()) +
+         "_" + name;
 }
 
 bool have_python() {

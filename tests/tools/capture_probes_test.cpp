@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <unistd.h>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -121,7 +122,8 @@ Result run(const Args& args) {
 }
 
 std::string temp_path(const std::string& name) {
-  return std::string(PBVBUS_BINARY_DIR) + "/capture_probes_test_" + name;
+  return std::string(PBVBUS_BINARY_DIR) + "/capture_probes_test_" + std::to_string(::getpid()) +
+         "_" + name;
 }
 
 TEST(CaptureProbes, CommandLineProbeOption) {

@@ -214,7 +214,10 @@ void Line::remove_tap(Tap& tap) {
     if (m_probes[k].tap != &tap) continue;
     m_probes.erase(m_probes.begin() + static_cast<std::ptrdiff_t>(k));
     const std::uint64_t below = (std::uint64_t{1} << k) - 1;
-    for (auto& t : m_in_flight) t->probes = (t->probes & below) | ((t->probes >> (k + 1)) << k);
+    for (auto& t : m_in_flight) {
+      const std::uint64_t above = k + 1 < 64 ? (t->probes >> (k + 1)) << k : 0;
+      t->probes = (t->probes & below) | above;
+    }
   }
   refresh_probes();
 }

@@ -449,7 +449,7 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
     flags = classify_frame(f.bytes, f.flags, f.sent_len, m_comment);
     comment = m_comment;
   }
-  put_epb(f.start, f.end, id, f.bytes, flags, comment);
+  put_epb(f.start, std::max(f.start, f.end), id, f.bytes, flags, comment);
   ++m_frames;
 }
 

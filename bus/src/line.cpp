@@ -38,6 +38,7 @@ struct Line::Transmission {
   std::uint16_t flags = 0;
   bool cut_counted = false;  // counted in LineStats::partial already
   Mask rx;
+  std::uint64_t probes = 0;  // probe taps (bits of m_probes) still hearing it
   /// Idle time each receiver had seen when this frame started (valid where rx is set).
   std::array<Ticks, kMaxAttachments> idle_before{};
 };
@@ -187,8 +188,65 @@ void Line::start() {
     if (!a->powered) set_power(a->id, true);
 }
 
-void Line::add_tap(Tap& tap) { m_taps.push_back(&tap); }
-void Line::remove_tap(Tap& tap) { std::erase(m_taps, &tap); }
+void Line::add_tap(Tap& tap) {
+  m_taps.push_back(&tap);
+  if (std::find(m_event_taps.begin(), m_event_taps.end(), &tap) == m_event_taps.end())
+    m_event_taps.push_back(&tap);
+}
+
+void Line::add_tap(Tap& tap, ProbePoint p) {
+  if (p.at < 0 || p.at >= attachment_count())
+    throw std::out_of_range("line " + m_name + ": no attachment " + std::to_string(p.at) +
+                            " to put a probe at");
+  if (m_probes.size() >= static_cast<std::size_t>(kMaxProbes))
+    throw std::length_error("line " + m_name + ": too many probes");
+  m_probes.push_back({&tap, p.at});
+  if (std::find(m_event_taps.begin(), m_event_taps.end(), &tap) == m_event_taps.end())
+    m_event_taps.push_back(&tap);
+  refresh_probes();
+}
+
+void Line::remove_tap(Tap& tap) {
+  std::erase(m_taps, &tap);
+  std::erase(m_event_taps, &tap);
+  // Probe bits of frames on the wire follow the probes' new indices.
+  for (std::size_t k = m_probes.size(); k-- > 0;) {
+    if (m_probes[k].tap != &tap) continue;
+    m_probes.erase(m_probes.begin() + static_cast<std::ptrdiff_t>(k));
+    const std::uint64_t below = (std::uint64_t{1} << k) - 1;
+    for (auto& t : m_in_flight) {
+      const std::uint64_t above = k + 1 < 64 ? (t->probes >> (k + 1)) << k : 0;
+      t->probes = (t->probes & below) | above;
+    }
+  }
+  refresh_probes();
+}
+
+bool Line::is_whole_line_tap(const Tap& tap) const {
+  return std::find(m_taps.begin(), m_taps.end(), &tap) != m_taps.end();
+}
+
+std::vector<AttachmentId> Line::probe_points(const Tap& tap) const {
+  std::vector<AttachmentId> v;
+  for (const ProbeTap& p : m_probes)
+    if (p.tap == &tap) v.push_back(p.at);
+  return v;
+}
+
+void Line::refresh_probes() {
+  m_probe_by_segment.assign(m_listening.size(), 0);
+  if (m_short) return;
+  for (std::size_t k = 0; k < m_probes.size(); ++k) {
+    const auto seg = static_cast<std::size_t>(m_atts[static_cast<std::size_t>(m_probes[k].at)]->segment);
+    m_probe_by_segment[seg] |= std::uint64_t{1} << k;
+  }
+}
+
+Ticks Line::earliest_start_in_flight() const {
+  Ticks t = m_tapping_start;
+  for (const auto& x : m_in_flight) t = std::min(t, x->start);
+  return t;
+}
 
 std::vector<std::uint8_t> Line::take_buffer() {
   if (m_buffers.empty()) {
@@ -249,6 +307,7 @@ bool Line::accepts(std::size_t i, int da) const {
 
 void Line::refresh_listening() {
   m_listening.assign(m_atts.empty() ? 1 : static_cast<std::size_t>(m_atts.back()->segment) + 1, Mask{});
+  refresh_probes();
   if (m_short) return;
   for (auto& a : m_atts)
     if (a->powered && a->xcvr_ok) m_listening[static_cast<std::size_t>(a->segment)].set(static_cast<std::size_t>(a->id));
@@ -331,6 +390,7 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
   t->cut_counted = false;
   // Everyone listening on the sender's segment (the sender is listening: it got this far).
   t->rx = m_listening[static_cast<std::size_t>(from.segment)];
+  t->probes = m_probe_by_segment[static_cast<std::size_t>(from.segment)];
   const auto self = static_cast<std::size_t>(from.id);
   t->rx.reset(self);
   t->rx.for_each([&](std::size_t i) {
@@ -382,6 +442,23 @@ void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra
   for (Tap* tap : m_taps) tap->on_frame(f);
 }
 
+void Line::probe_frame(const Transmission& t, std::uint64_t probes, std::size_t len,
+                       std::uint16_t extra_flags, Ticks end) {
+  TapFrame f;
+  f.line = this;
+  f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
+  f.start = t.start;
+  f.end = end;
+  f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
+  f.sender = static_cast<std::uint16_t>(t.from->id);
+  f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  for (std::uint64_t b = probes; b != 0; b &= b - 1) {
+    const ProbeTap& p = m_probes[static_cast<std::size_t>(std::countr_zero(b))];
+    f.probe = static_cast<std::int16_t>(p.at);
+    p.tap->on_frame(f);
+  }
+}
+
 void Line::on_event(Ticks, std::uint64_t tag) { end_transmission(tag); }
 
 void Line::end_transmission(std::uint64_t id) {
@@ -402,7 +479,12 @@ void Line::end_transmission(std::uint64_t id) {
     to.w[k] = owned->rx.w[k] & want;
   }
   to.for_each([&](std::size_t i) { deliver(*owned, i, owned->bytes.size(), 0, end); });
+  // Until every tap has it, the frame still counts as on the wire (earliest_start_in_flight):
+  // a tap told first must not take it for gone while the others are still to be told.
+  m_tapping_start = owned->start;
   tap_frame(*owned, owned->bytes.size(), 0, owned->end);
+  if (owned->probes != 0) probe_frame(*owned, owned->probes, owned->bytes.size(), 0, owned->end);
+  m_tapping_start = kNever;
   m_pool.push_back(std::move(owned));
 }
 
@@ -424,6 +506,14 @@ void Line::truncate_in_flight() {
     const auto done = static_cast<std::size_t>(std::clamp<Ticks>((now - t.start) / char_ticks, 0,
                                                                  static_cast<Ticks>(t.bytes.size())));
     const bool sender_gone = m_short || !t.from->powered || !t.from->xcvr_ok;
+    // Probes that lose the sender (all of them if it is gone): the characters so far.
+    const std::uint64_t lost_probes =
+        sender_gone ? t.probes
+                    : t.probes & ~m_probe_by_segment[static_cast<std::size_t>(t.from->segment)];
+    if (lost_probes != 0) {
+      t.probes &= ~lost_probes;
+      if (done > 0) probe_frame(t, lost_probes, done, kRxPartial, now);
+    }
     const Mask rx = t.rx;
     rx.for_each([&](std::size_t bit) {
       Attachment& a = *m_atts[bit];
@@ -492,7 +582,7 @@ void Line::join_in_flight() {
 
 void Line::emit_event(LineEventKind k, int a, int b, std::uint64_t v) {
   LineEvent e{this, m_sched.now(), k, a, b, v};
-  for (Tap* tap : m_taps) tap->on_line_event(e);
+  for (Tap* tap : m_event_taps) tap->on_line_event(e);
 }
 
 void Line::set_cut_after(AttachmentId a, bool cut) {

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cerrno>
 #include <cstring>
+#include <iterator>
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"
@@ -14,6 +15,9 @@ namespace pbvbus::captures {
 namespace {
 
 constexpr std::size_t kBufferSize = 1u << 20;
+/// Hold-back buffer: reserved up front; compacted when it grows past this while records stay
+/// held (they are released as soon as the overlap ends, so this is a safety net).
+constexpr std::size_t kHoldReserve = 1u << 16;
 
 inline void put16(std::uint8_t* p, std::uint16_t v) {
   std::memcpy(p, &v, 2);
@@ -172,6 +176,10 @@ PcapngWriter::PcapngWriter(Sink sink, PcapngWriterOptions opts)
   m_event_buf.resize(kEventHeaderSize + kEventMaxText);
   m_comment.reserve(256);
   m_lines.reserve(16);
+  m_known_lines.reserve(16);
+  m_held.reserve(256);
+  m_hold.reserve(kHoldReserve);
+  m_hold_spare.reserve(kHoldReserve);
   write_shb();
 }
 
@@ -206,7 +214,7 @@ std::unique_ptr<PcapngWriter> PcapngWriter::open(const std::string& path, Pcapng
 
 std::uint8_t* PcapngWriter::reserve(std::size_t n) {
   if (m_len + n > m_buf.size()) {
-    flush();
+    flush_buffer();
     if (n > m_buf.size()) m_buf.resize(n);
   }
   std::uint8_t* p = m_buf.data() + m_len;
@@ -215,6 +223,11 @@ std::uint8_t* PcapngWriter::reserve(std::size_t n) {
 }
 
 bool PcapngWriter::flush() {
+  release(bus::kNever);
+  return flush_buffer();
+}
+
+bool PcapngWriter::flush_buffer() {
   if (m_len == 0) return m_ok;
   if (m_ok && !m_sink(std::span<const std::uint8_t>(m_buf.data(), m_len))) {
     m_ok = false;
@@ -225,7 +238,7 @@ bool PcapngWriter::flush() {
 }
 
 void PcapngWriter::block_done() {
-  if (m_opts.streaming) flush();
+  if (m_opts.streaming) flush_buffer();
 }
 
 void PcapngWriter::write_shb() {
@@ -276,24 +289,64 @@ std::uint32_t PcapngWriter::add_interface(std::string_view name, std::string_vie
 }
 
 std::uint32_t PcapngWriter::add_line(const bus::Line& line) {
-  return interface_for(line);
+  return declare(line, -1, {}, {});
 }
 
-std::uint32_t PcapngWriter::interface_for(const bus::Line& line) {
-  if (&line == m_last_line) return m_last_id;
+std::uint32_t PcapngWriter::add_probe(const bus::Line& line, bus::AttachmentId at,
+                                      std::string_view name, std::string_view where) {
+  return declare(line, at, name, where);
+}
+
+std::uint32_t PcapngWriter::declare(const bus::Line& line, int probe, std::string_view name,
+                                    std::string_view where) {
   for (const LineIf& l : m_lines)
-    if (l.line == &line) {
-      m_last_line = &line;
-      m_last_id = l.id;
-      return l.id;
-    }
+    if (l.line == &line && l.probe == probe) return l.id;
   const auto speed = static_cast<std::uint64_t>(line.baud());
-  const std::uint32_t id =
-      add_interface(line.name(), baud_description(speed), m_opts.line_link_type, speed);
-  m_lines.push_back({&line, id});
-  m_last_line = &line;
-  m_last_id = id;
+  std::string desc = baud_description(speed);
+  if (probe >= 0) desc += ", probe at " + (where.empty() ? station_name(line, probe) : std::string(where));
+  const std::uint32_t id = add_interface(name.empty() ? std::string_view(line.name()) : name, desc,
+                                         m_opts.line_link_type, speed);
+  m_lines.push_back({&line, probe, id});
+  if (std::find(m_known_lines.begin(), m_known_lines.end(), &line) == m_known_lines.end())
+    m_known_lines.push_back(&line);
   return id;
+}
+
+void PcapngWriter::declare_taps_of(const bus::Line& line) {
+  std::vector<int> points;
+  if (line.is_whole_line_tap(*this)) points.push_back(-1);
+  for (bus::AttachmentId a : line.probe_points(*this)) points.push_back(a);
+  std::size_t existing = 0;
+  for (const LineIf& l : m_lines) existing += l.line == &line;
+  const bool several = existing + points.size() > 1;
+  for (int p : points) {
+    bool known = false;
+    for (const LineIf& l : m_lines) known |= l.line == &line && l.probe == p;
+    if (known) continue;
+    if (p >= 0 && several)
+      declare(line, p, line.name() + "@" + station_name(line, p), {});
+    else
+      declare(line, p, {}, {});
+  }
+  if (std::find(m_known_lines.begin(), m_known_lines.end(), &line) == m_known_lines.end())
+    m_known_lines.push_back(&line);
+}
+
+std::uint32_t PcapngWriter::interface_for(const bus::Line& line, int probe) {
+  if (&line == m_last_line && probe == m_last_probe) return m_last_id;
+  for (int pass = 0;; ++pass) {
+    for (const LineIf& l : m_lines)
+      if (l.line == &line && l.probe == probe) {
+        m_last_line = &line;
+        m_last_probe = probe;
+        m_last_id = l.id;
+        return l.id;
+      }
+    if (pass == 0)
+      declare_taps_of(line);  // first news from this line
+    else
+      return declare(line, probe, {}, {});  // a tap that is no longer registered
+  }
 }
 
 std::uint32_t PcapngWriter::events_interface() {
@@ -302,20 +355,64 @@ std::uint32_t PcapngWriter::events_interface() {
   return static_cast<std::uint32_t>(m_events_if);
 }
 
-void PcapngWriter::write_epb(std::uint32_t if_id, std::int64_t ts_ns,
-                             std::span<const std::uint8_t> data, std::uint32_t flags,
-                             std::string_view comment) {
+bus::Ticks PcapngWriter::earliest_in_flight() const {
+  bus::Ticks t = bus::kNever;
+  for (const bus::Line* l : m_known_lines) t = std::min(t, l->earliest_start_in_flight());
+  return t;
+}
+
+void PcapngWriter::release(bus::Ticks upto) {
+  std::size_t k = 0;
+  for (; k < m_held.size() && m_held[k].ts <= upto; ++k) {
+    const Held& h = m_held[k];
+    std::memcpy(reserve(h.len), m_hold.data() + h.off, h.len);
+    block_done();
+  }
+  if (k == 0) return;
+  m_held.erase(m_held.begin(), m_held.begin() + static_cast<std::ptrdiff_t>(k));
+  if (m_held.empty()) {
+    m_hold.clear();
+  } else if (m_hold.size() > kHoldReserve) {
+    // Records stayed held for long (a long overlap chain): keep only what is still held.
+    m_hold_spare.clear();
+    for (Held& h : m_held) {
+      const std::size_t off = m_hold_spare.size();
+      m_hold_spare.insert(m_hold_spare.end(), m_hold.begin() + static_cast<std::ptrdiff_t>(h.off),
+                          m_hold.begin() + static_cast<std::ptrdiff_t>(h.off + h.len));
+      h.off = off;
+    }
+    std::swap(m_hold, m_hold_spare);
+  }
+}
+
+void PcapngWriter::put_epb(bus::Ticks ts, bus::Ticks now, std::uint32_t if_id,
+                           std::span<const std::uint8_t> data, std::uint32_t flags,
+                           std::string_view comment) {
   const std::size_t opts =
       (flags ? option_size(4) : 0) + (comment.empty() ? 0 : option_size(comment.size()));
   const std::size_t total = 32 + pad4(data.size()) + (opts ? opts + 4 : 0);
-  std::uint8_t* p = reserve(total);
-  const auto ts = static_cast<std::uint64_t>(std::max<std::int64_t>(ts_ns, 0));
+  // Everything still to come starts at or after `safe`: no later record can go before this one.
+  const bus::Ticks safe = std::min(now, earliest_in_flight());
+  const bool direct = m_held.empty() && ts <= safe;
+  std::uint8_t* p = nullptr;
+  if (direct) {
+    p = reserve(total);
+  } else {
+    const std::size_t off = m_hold.size();
+    m_hold.resize(off + total);
+    p = m_hold.data() + off;
+    // After the records with the same or an earlier time (arrival order for equal times).
+    auto pos = m_held.end();
+    while (pos != m_held.begin() && std::prev(pos)->ts > ts) --pos;
+    m_held.insert(pos, Held{ts, off, total});
+  }
+  const auto ts_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(bus::ticks_to_ns(ts), 0));
   const auto len = static_cast<std::uint32_t>(data.size());
   put32(p, pcapng::kBlockEpb);
   put32(p + 4, static_cast<std::uint32_t>(total));
   put32(p + 8, if_id);
-  put32(p + 12, static_cast<std::uint32_t>(ts >> 32));
-  put32(p + 16, static_cast<std::uint32_t>(ts));
+  put32(p + 12, static_cast<std::uint32_t>(ts_ns >> 32));
+  put32(p + 16, static_cast<std::uint32_t>(ts_ns));
   put32(p + 20, len);
   put32(p + 24, len);
   if (!data.empty()) std::memcpy(p + 28, data.data(), data.size());
@@ -332,7 +429,10 @@ void PcapngWriter::write_epb(std::uint32_t if_id, std::int64_t ts_ns,
     o += put_option(p + o, pcapng::kOptEndOfOpt, nullptr, 0);
   }
   put32(p + o, static_cast<std::uint32_t>(total));
-  block_done();
+  if (direct)
+    block_done();
+  else
+    release(safe);
 }
 
 void PcapngWriter::write_frame(const bus::TapFrame& f) {
@@ -340,7 +440,7 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
   if (!f.line && m_unknown_if < 0)
     m_unknown_if = add_interface("unknown", "frames of no known line", m_opts.line_link_type, 0);
   const std::uint32_t id =
-      f.line ? interface_for(*f.line) : static_cast<std::uint32_t>(m_unknown_if);
+      f.line ? interface_for(*f.line, f.probe) : static_cast<std::uint32_t>(m_unknown_if);
   // Fast path: an intact frame that decodes needs neither flags nor comment.
   std::uint32_t flags = 0;
   std::string_view comment;
@@ -349,7 +449,7 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
     flags = classify_frame(f.bytes, f.flags, f.sent_len, m_comment);
     comment = m_comment;
   }
-  write_epb(id, bus::ticks_to_ns(f.start), f.bytes, flags, comment);
+  put_epb(f.start, std::max(f.start, f.end), id, f.bytes, flags, comment);
   ++m_frames;
 }
 
@@ -357,15 +457,14 @@ void PcapngWriter::write_event(bus::Ticks time, const EventRecord& e) {
   if (!m_ok) return;
   const std::uint32_t id = events_interface();
   const std::size_t n = encode_event(e, m_event_buf);
-  write_epb(id, bus::ticks_to_ns(time), std::span<const std::uint8_t>(m_event_buf.data(), n), 0,
-            {});
+  put_epb(time, time, id, std::span<const std::uint8_t>(m_event_buf.data(), n), 0, {});
   ++m_events;
 }
 
 void PcapngWriter::on_line_event(const bus::LineEvent& e) {
-  // Declare the line before the events interface, so that lines keep the low interface ids
-  // even when a fault (or the power-on at start) comes before the first frame.
-  if (e.line && m_ok) interface_for(*e.line);
+  // Declare the line's interfaces before the events interface, so that lines keep the low
+  // interface ids even when a fault (or the power-on at start) comes before the first frame.
+  if (e.line && m_ok) declare_taps_of(*e.line);
   EventRecord r;
   r.category = EventCategory::Line;
   r.code = static_cast<std::uint16_t>(e.kind);

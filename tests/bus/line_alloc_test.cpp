@@ -64,6 +64,34 @@ TEST(LineAlloc, SteadyStateTrafficDoesNotAllocate) {
   EXPECT_EQ(line.stats().collisions, 0u);
 }
 
+/// Counts what reaches it (a probe tap that keeps nothing).
+struct CountingTap final : Tap {
+  void on_frame(const TapFrame& f) override { octets += f.bytes.size(); }
+  std::uint64_t octets = 0;
+};
+
+TEST(LineAlloc, ProbeTapsDoNotAllocateEither) {
+  Scheduler sched;
+  Line line(sched, "A", Baud::k12M);
+  Master master;
+  line.attach(master);
+  std::vector<std::unique_ptr<Slave>> slaves;
+  for (int i = 0; i < 32; ++i) {
+    slaves.push_back(std::make_unique<Slave>(3 + i));
+    line.attach(*slaves.back());
+  }
+  CountingTap first, last;
+  line.add_tap(first, ProbePoint{0});
+  line.add_tap(last, ProbePoint{32});
+  line.start();
+  sched.run_until(10 * kTicksPerMs);
+  const auto allocs0 = test::allocation_count();
+  sched.run_until(110 * kTicksPerMs);
+  EXPECT_EQ(test::allocation_count() - allocs0, 0u);
+  EXPECT_EQ(first.octets, last.octets);
+  EXPECT_GT(first.octets, 5000u * 16u);
+}
+
 TEST(LineAlloc, CounterWorks) {
   const auto a = test::allocation_count();
   auto p = std::make_unique<int>(5);

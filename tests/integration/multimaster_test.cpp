@@ -1,6 +1,8 @@
 // examples/multimaster.textproto run whole in fast mode: the ring splits at the cable cut and
-// re-forms after the repair; the capture is deterministic, opens in tshark, and every frame in
-// it obeys the FDL framing and timing rules (TSYN before requests and tokens, TSDR for replies).
+// re-forms after the repair; the capture (from the default probe, next to master 1: what an
+// analyzer there sees) is deterministic, opens in tshark, and every frame in it obeys the FDL
+// framing and timing rules (TSYN before requests and tokens, TSDR for replies), the cut
+// included. capture_check_test.cpp checks the same capture with an independent program.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -130,8 +132,9 @@ TEST_F(Multimaster, RingSplitsAtTheCutAndMergesAfterTheRepair) {
   const Capture c = parse(s_run->pcap);
   // One ring 1 -> 2 -> 3 -> 1 before the cut ...
   EXPECT_EQ(token_passes(c, 1.0, 2.0), (Passes{{1, 2}, {2, 3}, {3, 1}}));
-  // ... two during it: 1 <-> 2 on one side, master 3 alone passing to itself.
-  EXPECT_EQ(token_passes(c, 2.5, 3.0), (Passes{{1, 2}, {2, 1}, {3, 3}}));
+  // ... during it, on master 1's side of the cut, 1 <-> 2 (master 3 alone passing to itself
+  // on the other side does not reach the probe).
+  EXPECT_EQ(token_passes(c, 2.5, 3.0), (Passes{{1, 2}, {2, 1}}));
   // ... and one again well after the repair.
   EXPECT_EQ(token_passes(c, 4.0, 5.0), (Passes{{1, 2}, {2, 3}, {3, 1}}));
 
@@ -204,13 +207,15 @@ TEST_F(Multimaster, EveryUnflaggedFrameIsAValidTelegram) {
       EXPECT_FALSE(f.comment.empty());
     }
   }
-  // Damaged frames only around the fault and the repair (two token holders for a moment).
+  // Damaged frames only around the repair, where two token holders meet for a moment (frames
+  // that started up to a 255-octet telegram before it, and the first few ms after it); none
+  // during the cut, which the probe's side of the cable does not notice.
   for (const auto& f : c.frames) {
     if (f.flags == 0) continue;
-    EXPECT_TRUE(f.start_ns >= 2 * kNsPerS && f.start_ns < 4 * kNsPerS)
+    EXPECT_TRUE(f.start_ns >= 3 * kNsPerS - 1'870'000 && f.start_ns < 3 * kNsPerS + 10'000'000)
         << "damaged frame at " << f.start_ns << " ns: " << f.comment;
   }
-  (void)flagged;
+  EXPECT_GT(flagged, 0u);
 }
 
 TEST_F(Multimaster, GapsRespectTsynAndTsdr) {
@@ -220,9 +225,6 @@ TEST_F(Multimaster, GapsRespectTsynAndTsdr) {
   for (std::size_t i = 1; i < c.frames.size(); ++i) {
     const WireFrame& prev = c.frames[i - 1];
     const WireFrame& f = c.frames[i];
-    // While the cable is cut the two halves talk independently: their frames interleave in the
-    // capture without being sequential on either half.
-    if (f.start_ns >= 2 * kNsPerS && f.start_ns < 3 * kNsPerS) continue;
     if (f.flags != 0 || prev.flags != 0) continue;
     fdl::Telegram t, pt;
     if (fdl::decode(f.bytes, t) != fdl::DecodeError::None) continue;

@@ -7,6 +7,9 @@
 //    is allowed (the external side then sees a very fast bus) but warned about.
 //  - `--capture -` streams pcapng to stdout; the report then goes to stderr, and --json (which
 //    would also need stdout) is refused.
+//  - `--probe first|last|ADDR` places the capture's probe on lines the scenario gives no
+//    `capture` entry (capture_probes.hpp); it needs --capture, and ADDR must be a station of
+//    every such line (exit 2 otherwise).
 //  - --quiet prints nothing but errors and the --json report.
 //  - A paced run without a duration (none in the scenario, no --duration) runs until SIGINT or
 //    SIGTERM; either signal ends any run early, and the report covers the time run so far.
@@ -59,6 +62,8 @@ constexpr const char* kUsage =
     "  --speed N[/M]     paced runs: virtual time runs N/M times as fast as the wall clock\n"
     "                    (e.g. 1/1000 to let a program behind a pty answer within TSDR)\n"
     "  --capture FILE    write a pcapng capture; '-' streams it to stdout\n"
+    "  --probe WHERE     where the capture listens on lines without a capture entry in the\n"
+    "                    scenario: first (default), last, or next to station ADDR\n"
     "  --json            print the report as JSON (schema pbvbus.run.report/1)\n"
     "  --quiet           print nothing but errors (and the --json report)\n"
     "  -h, --help        this text\n";
@@ -86,6 +91,7 @@ struct RunArgs {
   std::optional<bus::Ticks> duration;
   std::optional<std::uint64_t> seed;
   std::optional<std::string> capture;
+  std::optional<ProbeDefault> probe;
   std::optional<bus::Speed> speed;
   bool json = false;
   bool quiet = false;
@@ -146,6 +152,11 @@ std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
       auto v = value("--capture");
       if (!v || v->empty()) return "--capture needs a file name or '-'";
       out.capture = *v;
+    } else if (a == "--probe") {
+      auto v = value("--probe");
+      if (!v) return "--probe needs a value: first, last or a station address";
+      out.probe = parse_probe_default(*v);
+      if (!out.probe) return "bad probe '" + *v + "' (expected first, last or an address 0..126)";
     } else if (a.size() > 1 && a[0] == '-') {
       return "unknown option '" + a + "'";
     } else if (!out.scenario) {
@@ -155,6 +166,7 @@ std::optional<std::string> parse_args(const Args& args, RunArgs& out) {
     }
   }
   if (out.fast && out.paced) return "--fast and --paced exclude each other";
+  if (out.probe && !out.capture) return "--probe places the capture's probe; it needs --capture";
   if (out.json && out.capture && *out.capture == "-")
     return "--json and --capture - both need stdout; write the capture to a file";
   return std::nullopt;
@@ -269,6 +281,13 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   std::unique_ptr<captures::PcapngWriter> capture;
   if (ra.capture) {
     std::string why;
+    if (!plan_capture_probes(plan, ra.probe.value_or(ProbeDefault{}), &why)) {
+      err << "pbvbus run: " << why << "\n";
+      return 2;
+    }
+  }
+  if (ra.capture) {
+    std::string why;
     capture = captures::PcapngWriter::open(*ra.capture, {}, &why);
     if (!capture) {
       err << "pbvbus run: cannot write the capture " << *ra.capture << ": " << why << "\n";
@@ -280,6 +299,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   so.duration = duration;
   so.seed = ra.seed;
   so.capture = capture.get();
+  so.probe = ra.probe.value_or(ProbeDefault{});
   std::unique_ptr<Simulation> sim;
   try {
     sim = std::make_unique<Simulation>(plan, so);

@@ -168,6 +168,7 @@ class Planner {
       return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
     }, m_errors);
     plan_stations(plan);
+    plan_captures(plan);
     plan_faults(plan);
     if (!m_errors.empty()) return std::nullopt;
     return plan;
@@ -424,6 +425,39 @@ class Planner {
     error(w, std::string(what) + ": no station " + std::to_string(addr) + " on line " +
                  quoted(line.name));
     return -1;
+  }
+
+  /// Capture probes: a known line, a station of it by address (`at`), each point once.
+  void plan_captures(ScenarioPlan& plan) {
+    const auto* sd = scenario::Scenario::descriptor();
+    const auto* cd = scenario::Capture::descriptor();
+    std::map<std::pair<int, int>, Where> seen;  // (line, position or -1) -> first entry
+    for (int i = 0; i < m_proto.capture_size(); ++i) {
+      const auto& c = m_proto.capture(i);
+      const Where w = nested(m_root, sd, "capture", i);
+      const int li = line_ref(w, cd, c.line(), "capture");
+      if (li < 0) continue;
+      PlanLine& line = plan.lines[static_cast<std::size_t>(li)];
+      PlanProbe p;
+      Where pw = w;
+      if (c.has_at()) {
+        pw = at_field(w, cd, "at");
+        p.position = station_ref(plan, pw, li, c.at(), "capture");
+        if (p.position < 0) continue;
+        p.address = static_cast<std::uint8_t>(c.at());
+      }
+      auto [it, fresh] = seen.emplace(std::pair(li, p.position), pw);
+      if (!fresh) {
+        const std::string first = " (at " + std::to_string(it->second.line + 1) + ":" +
+                                  std::to_string(it->second.column + 1) + ")";
+        error(pw, p.address ? "capture: a probe at station " + std::to_string(*p.address) +
+                                  " on line " + quoted(line.name) + " is already given" + first
+                            : "capture: line " + quoted(line.name) +
+                                  " already has a probe at the default position" + first);
+        continue;
+      }
+      line.probes.push_back(p);
+    }
   }
 
   /// The DP slave faults (decisions in scenario.hpp): the slave by line and address, the module

@@ -67,6 +67,13 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
   m_duration = opts.duration ? opts.duration : plan.duration;
   m_seed = opts.seed ? *opts.seed : plan.seed;
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
+  if (m_opts.capture != nullptr) {
+    std::string why;
+    const auto probes = plan_capture_probes(m_plan, m_opts.probe, &why);
+    if (!probes) throw std::runtime_error(why);
+    for (std::size_t li = 0; li < m_lines.size(); ++li)
+      attach_capture(*m_opts.capture, *m_lines[li]->line, li, *probes);
+  }
 }
 
 Simulation::~Simulation() {
@@ -191,10 +198,6 @@ void Simulation::build_line(std::size_t li) {
     ls->stations.push_back(std::move(st));
   }
   ls->line->add_tap(ls->stats);
-  if (m_opts.capture != nullptr) {
-    m_opts.capture->add_line(*ls->line);
-    ls->line->add_tap(*m_opts.capture);
-  }
   m_lines.push_back(std::move(ls));
 }
 

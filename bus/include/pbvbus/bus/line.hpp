@@ -17,11 +17,31 @@
 // A device's own telegrams never overlap each other: if it asks for a start while its previous
 // telegram is still going out, the new one follows back to back (one UART per station).
 //
-// Taps see each transmission from its sender's side of the cable: a frame that a cable cut
-// keeps from some receivers appears whole on the taps (the far side receives it partial), while
-// a frame cut short at its source (sender's power or transceiver lost, short circuit) appears
-// partial. Transmissions that never reach the cable (short circuit, failed transceiver) are
-// counted in LineStats::lost and not tapped.
+// Taps come in two kinds (tap.hpp):
+//  - Whole-line taps (add_tap(tap)) see each transmission once, from its sender's side of the
+//    cable: a frame that a cable cut keeps from some receivers appears whole (the far side
+//    receives it partial), while a frame cut short at its source (sender's power or transceiver
+//    lost, short circuit) appears partial. Statistics (LineStats) and line tests use them.
+//  - Probe taps (add_tap(tap, ProbePoint{a})) sit at the cable position of attachment `a` and
+//    see what a receiver with a working transceiver at that position would see, whatever the
+//    state of the station attached there (powered or not, transceiver working or not):
+//      * the frames of senders on the probe's segment when the frame started, the station at
+//        the probe's own position included;
+//      * a frame whose sender a cut or short separates from the probe mid-frame ends there,
+//        partial (kRxPartial, the whole characters received until then; nothing if not one
+//        character had arrived), as do frames cut short at their source;
+//      * corrupted as its segment saw it: collisions and noise belong to the transmission, and
+//        a transmission only ever reaches its own segment, so a collision on the far side of a
+//        cut never shows at the probe, and one after a repair does (join_in_flight);
+//      * nothing while the line is shorted, nothing of a frame whose start it did not hear
+//        (a repair joining it to a frame already on the wire).
+//    A probe is a tap, not a station: it never transmits, takes no part in the idle-time
+//    bookkeeping and changes nothing that the stations observe. At most kMaxProbes per line.
+// Transmissions that never reach the cable (short circuit, failed transceiver) are counted in
+// LineStats::lost and reach no tap. Line events reach every tap once (not once per probe).
+// Taps are called at the end of a frame, so frames that overlap reach them out of start order;
+// earliest_start_in_flight() tells a tap which starts can still come (captures use it to write
+// in start order).
 //
 // Receive filters are cached: the line re-reads Device::receive_filter() after every call into
 // the device, and on DevicePort::receive_filter_changed().
@@ -44,6 +64,11 @@ namespace pbvbus::bus {
 
 using AttachmentId = int;
 
+/// Where a probe tap sits: at the cable position of attachment `at`.
+struct ProbePoint {
+  AttachmentId at = 0;
+};
+
 struct LineStats {
   std::uint64_t frames = 0;       ///< transmissions started
   std::uint64_t collisions = 0;   ///< transmissions damaged by overlap
@@ -56,6 +81,8 @@ struct LineStats {
 class Line final : private EventTarget {
  public:
   static constexpr int kMaxAttachments = 256;
+  /// Probe taps per line (each in-flight frame keeps one bit per probe).
+  static constexpr int kMaxProbes = 64;
 
   Line(Scheduler& sched, std::string name, Baud baud, std::uint64_t seed = 1);
   ~Line();
@@ -80,8 +107,26 @@ class Line final : private EventTarget {
   /// Powers every attachment that is not yet powered, at the current time.
   void start();
 
+  /// A whole-line tap: every transmission, from its sender's side (see the file comment).
   void add_tap(Tap& tap);
+  /// A probe tap at the cable position of attachment `p.at` (std::out_of_range if there is no
+  /// such attachment, std::length_error beyond kMaxProbes). One tap may sit at several points
+  /// (TapFrame::probe tells them apart) and be a whole-line tap too. A probe added while frames
+  /// are on the wire hears only frames that start later.
+  void add_tap(Tap& tap, ProbePoint p);
+  /// Removes every registration of `tap` (whole-line and probes).
   void remove_tap(Tap& tap);
+  int probe_count() const { return static_cast<int>(m_probes.size()); }
+  /// Where `tap` sits on this line: whether it is a whole-line tap, and its probe positions in
+  /// the order they were added (for a tap that declares itself lazily, e.g. a capture).
+  bool is_whole_line_tap(const Tap& tap) const;
+  std::vector<AttachmentId> probe_points(const Tap& tap) const;
+
+  /// The earliest start among the transmissions still on the wire (anywhere on the line, cut
+  /// short or not yet delivered; the one whose end the taps are being told about included), or
+  /// kNever if there is none. Every frame that a tap will still be told about starts at or after
+  /// min(this, now).
+  Ticks earliest_start_in_flight() const;
 
   // --- faults and repairs (each takes effect at the scheduler's current time) ---------------
   /// Cuts the cable between position `a` and the position after it (a, a+1). Both sides go on
@@ -144,6 +189,11 @@ class Line final : private EventTarget {
   /// Whether attachment i's (cached) filter takes a frame with destination `da` (-1: none).
   bool accepts(std::size_t i, int da) const;
   void tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end);
+  /// Hands the frame (or its first `len` octets) to the probes in `probes` (bits of m_probes).
+  void probe_frame(const Transmission& t, std::uint64_t probes, std::size_t len,
+                   std::uint16_t extra_flags, Ticks end);
+  /// Rebuilds m_probe_by_segment and m_event_taps after a change of taps or of topology.
+  void refresh_probes();
   void apply_noise(Transmission& t);
   void recompute_segments();
   /// Rebuilds m_listening after any change of power, transceiver, cut or short.
@@ -161,7 +211,17 @@ class Line final : private EventTarget {
   Baud m_baud;
   int m_index = 0;
   std::vector<std::unique_ptr<Attachment>> m_atts;
-  std::vector<Tap*> m_taps;
+  std::vector<Tap*> m_taps;  ///< whole-line taps
+  struct ProbeTap {
+    Tap* tap;
+    AttachmentId at;
+  };
+  std::vector<ProbeTap> m_probes;
+  /// Per segment: the probes (bits of m_probes) that hear it; none while the line is shorted.
+  std::vector<std::uint64_t> m_probe_by_segment;
+  std::vector<Tap*> m_event_taps;  ///< every tap once, in order of first registration
+  /// Start of the frame whose end the taps are being told about (kNever otherwise).
+  Ticks m_tapping_start = kNever;
   std::vector<std::unique_ptr<Transmission>> m_in_flight;
   std::vector<std::unique_ptr<Transmission>> m_pool;
   /// Byte buffers recycled between pending transmissions and transmissions, so that the

@@ -1,6 +1,14 @@
 #pragma once
 // Observers of a line (design.md "Taps"): captures, statistics and tests subscribe here; no
 // device or stack ever knows that it is being observed.
+//
+// Two kinds of tap (bus::Line::add_tap):
+//  - a whole-line tap sees every transmission once, from its sender's side of the cable
+//    (statistics, tests of the line model); TapFrame::probe is -1;
+//  - a probe tap sits at one cable position and sees what an analyzer clipped onto the cable
+//    there would see (captures); TapFrame::probe is that position. See line.hpp for exactly
+//    what reaches a probe.
+// Line events (faults and repairs) reach every tap once, whatever its kind or number of probes.
 
 #include <cstdint>
 #include <span>
@@ -12,7 +20,8 @@ namespace pbvbus::bus {
 
 class Line;
 
-/// A transmission as it went over the line, delivered at its end.
+/// A transmission as it went over the line (whole-line tap) or as it reached a probe, delivered at
+/// its end (or, cut short, at the moment it ended for that tap).
 struct TapFrame {
   const Line* line = nullptr;
   std::span<const std::uint8_t> bytes;  ///< octets as they were on the wire (after corruption)
@@ -20,6 +29,8 @@ struct TapFrame {
   Ticks end = 0;                        ///< end of the last character actually sent
   std::uint16_t flags = 0;              ///< RxFlag bits (collision, noise, partial, babble)
   std::uint16_t sender = 0;             ///< attachment index of the transmitter
+  /// Cable position (attachment index) of the probe that saw it; -1 for a whole-line tap.
+  std::int16_t probe = -1;
   std::uint32_t sent_len = 0;           ///< octets the transmitter intended to send
 };
 

@@ -1,17 +1,35 @@
 #pragma once
 // pcapng capture writer (design.md "Captures"; pcapng per draft-ietf-opsawg-pcapng).
 //
-// A bus::Tap: add it to lines (line.add_tap(writer)) and every frame becomes an Enhanced Packet
-// Block on the line's interface; line events and higher-layer events become records on the
-// "events" interface (USER1, event_record.hpp).
+// A bus::Tap. A capture is what an analyzer clipped onto the cable at one point sees, so the
+// usual way in is a probe: line.add_tap(writer, bus::ProbePoint{a}) (declared first with
+// add_probe() to choose its interface name); every frame that reaches that point becomes an
+// Enhanced Packet Block on the probe's interface. A whole-line tap (line.add_tap(writer),
+// declared with add_line()) records every transmission from its sender's side instead: during a
+// cable cut both partitions interleave there, which no analyzer could see. Line events and
+// higher-layer events become records on the "events" interface (USER1, event_record.hpp).
 //
 // Decisions (where the pcapng spec is silent for a bus):
-//  - One IDB per line: if_name = line name, if_description "PROFIBUS-DP <baud> bit/s",
-//    if_speed = baud, if_tsresol = 9 (ns). Link type USER0 (147) unless asked for 257.
-//  - Timestamp = virtual time of the start bit of the first character, in ns (rounded down).
-//    Frames reach taps at their end, events at their time, so timestamps in the file are not
-//    strictly increasing (an event during a frame precedes it in the file); Wireshark sorts
-//    nothing and shows them in file order, which is the order things became known.
+//  - One IDB per probe (or per whole-line tap): link type USER0 (147) unless asked for 257,
+//    if_speed = baud, if_tsresol = 9 (ns); if_name = the line's name, or what add_probe() was
+//    given (e.g. "A@14" when a line has several probes); if_description
+//    "PROFIBUS-DP 1.5 Mbit/s, probe at station 14" (the `where` given to add_probe(), else the
+//    attachment's label), "PROFIBUS-DP 1.5 Mbit/s" for a whole-line tap. Interfaces the caller
+//    did not declare are declared when the line first reports something (event or frame), all
+//    of the writer's taps on that line at once, in the order they were added; a lazily declared
+//    probe is named after the line, or "LINE@label" when the writer has other taps there.
+//  - Timestamp = virtual time of the start bit of the first character, in ns (rounded down);
+//    events at their time.
+//  - Records are written in order of timestamp (start of frame), across all interfaces, and in
+//    order of arrival for equal times. Frames reach taps at their end, so a frame that overlaps
+//    a longer one that started earlier (a collision, a babbling transmitter), and an event
+//    during a frame, are held back until every transmission still on the wire of every line
+//    the writer knows started at or after them (bus::Line::earliest_start_in_flight()). The
+//    common case — nothing else on the wire — goes straight out. flush() writes whatever is
+//    still held: call it when the run is over (a record that arrives after a flush() with an
+//    earlier start than what was flushed is written late, out of order). Declare every line
+//    before the run (add_line/add_probe): a line the writer does not know yet cannot hold
+//    records back.
 //  - epb_flags direction bits stay 0 (on a bus nothing is inbound or outbound); the
 //    link-layer error bits say what went wrong:
 //      collision                                  -> bit 24 symbol error
@@ -27,8 +45,9 @@
 //  - A partial frame's original length equals its captured length: the octets that were on
 //    the wire are all there; what the sender meant to send is in the comment.
 //  - Sinks: a file, "-" for stdout (streamed: flushed after every block so that
-//    `wireshark -k -i -` sees frames as they happen), or a callback. Otherwise blocks collect in
-//    a 1 MiB buffer that is written in one go. Nothing is allocated per frame.
+//    `wireshark -k -i -` sees frames as they happen, held records once released), or a
+//    callback. Otherwise blocks collect in a 1 MiB buffer that is written in one go. Nothing is
+//    allocated per frame once the hold-back buffers have grown to the largest overlap.
 
 #include <cstdint>
 #include <cstdio>
@@ -39,13 +58,10 @@
 #include <string_view>
 #include <vector>
 
+#include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
-
-namespace pbvbus::bus {
-class Line;
-}
 
 namespace pbvbus::captures {
 
@@ -73,26 +89,36 @@ class PcapngWriter final : public bus::Tap {
   static std::unique_ptr<PcapngWriter> open(const std::string& path, PcapngWriterOptions opts,
                                             std::string* error = nullptr);
 
-  /// Declares the interface of a line now (otherwise it is added on the line's first frame).
-  /// Returns the interface id; adding the same line again returns the same id.
+  /// Declares the whole-line interface of a line now (for line.add_tap(writer)). Returns the
+  /// interface id; adding the same line again returns the same id.
   std::uint32_t add_line(const bus::Line& line);
+  /// Declares the interface of the probe at attachment `at` of `line` (for
+  /// line.add_tap(writer, bus::ProbePoint{at})). `name` empty: the line's name; `where` empty:
+  /// the attachment's label. Adding the same probe again returns the same id.
+  std::uint32_t add_probe(const bus::Line& line, bus::AttachmentId at, std::string_view name = {},
+                          std::string_view where = {});
   /// Declares any interface. `speed` 0 = no if_speed option.
   std::uint32_t add_interface(std::string_view name, std::string_view description,
                               pcapng::LinkType type, std::uint64_t speed);
   /// The "events" interface (USER1), created on first use.
   std::uint32_t events_interface();
 
-  /// Writes one telegram as it was on the wire on `line`'s interface.
+  /// Writes one telegram as it was on the wire (or at the probe) on its interface, in start
+  /// order (held back while an earlier transmission is still on the wire).
   void write_frame(const bus::TapFrame& f);
-  /// Writes an event record at virtual time `time` on the events interface.
+  /// Writes an event record at virtual time `time` (the current time) on the events interface,
+  /// in time order with the frames.
   void write_event(bus::Ticks time, const EventRecord& e);
 
   // bus::Tap
   void on_frame(const bus::TapFrame& f) override { write_frame(f); }
   void on_line_event(const bus::LineEvent& e) override;
 
-  /// Writes buffered blocks to the sink.
+  /// Writes every held record and the buffered blocks to the sink (see "Records are written in
+  /// order" above).
   bool flush();
+  /// Records accepted but held back for start-time order.
+  std::size_t held() const { return m_held.size(); }
   /// False once the sink reported an error; nothing more is written then.
   bool ok() const { return m_ok; }
   const std::string& error() const { return m_error; }
@@ -103,22 +129,44 @@ class PcapngWriter final : public bus::Tap {
  private:
   struct LineIf {
     const bus::Line* line;
+    int probe;  ///< attachment of the probe; -1 whole-line
     std::uint32_t id;
   };
-  std::uint32_t interface_for(const bus::Line& line);
+  /// A record waiting for start-time order: its encoded block in m_hold.
+  struct Held {
+    bus::Ticks ts;
+    std::size_t off;
+    std::size_t len;
+  };
+  std::uint32_t interface_for(const bus::Line& line, int probe);
+  std::uint32_t declare(const bus::Line& line, int probe, std::string_view name,
+                        std::string_view where);
+  /// Declares the interfaces of all of this writer's taps on `line` not declared yet.
+  void declare_taps_of(const bus::Line& line);
   void write_shb();
-  void write_epb(std::uint32_t if_id, std::int64_t ts_ns, std::span<const std::uint8_t> data,
-                 std::uint32_t flags, std::string_view comment);
+  /// Encodes an EPB and writes it now or holds it back: `ts` its time, `now` the current time.
+  void put_epb(bus::Ticks ts, bus::Ticks now, std::uint32_t if_id,
+               std::span<const std::uint8_t> data, std::uint32_t flags, std::string_view comment);
+  /// Writes the held records with a time up to `upto`.
+  void release(bus::Ticks upto);
+  /// The earliest start still on the wire of the lines the writer knows.
+  bus::Ticks earliest_in_flight() const;
   void block_done();
   std::uint8_t* reserve(std::size_t n);
+  bool flush_buffer();
 
   Sink m_sink;
   PcapngWriterOptions m_opts;
   std::vector<std::uint8_t> m_buf;
   std::size_t m_len = 0;
   std::vector<LineIf> m_lines;
+  std::vector<const bus::Line*> m_known_lines;  ///< each line once
   const bus::Line* m_last_line = nullptr;
+  int m_last_probe = -2;
   std::uint32_t m_last_id = 0;
+  std::vector<Held> m_held;          ///< ordered by ts, then arrival
+  std::vector<std::uint8_t> m_hold;  ///< their blocks
+  std::vector<std::uint8_t> m_hold_spare;
   std::uint32_t m_next_if = 0;
   std::int64_t m_events_if = -1;
   std::int64_t m_unknown_if = -1;

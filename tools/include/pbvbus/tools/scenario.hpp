@@ -19,6 +19,8 @@
 //  - A fault (or repair) later than the scenario's own duration is an error (it would never
 //    happen); when the duration is overridden on the command line, faults past the end are
 //    simply not reached and the report says so.
+//  - `capture { line: "A" at: 14 }` must name a station on that line by its FDL address; two
+//    entries for the same point (or two without `at` for one line) are an error.
 
 #include <cstdint>
 #include <optional>
@@ -54,11 +56,19 @@ struct PlanStation {
   fdl::BusParams params;                ///< effective parameters (line's + a master's overrides)
 };
 
+/// A capture probe from the scenario (`capture { line: "A" at: 14 }`).
+struct PlanProbe {
+  std::optional<std::uint8_t> address;  ///< `at`; none = the run's default probe position
+  int position = -1;                    ///< cable position of `address`; -1 without one
+};
+
 struct PlanLine {
   std::string name;
   bus::Baud baud = bus::Baud::k1_5M;
   fdl::BusParams params;
   std::vector<PlanStation> stations;  ///< cable order = attachment order
+  /// Capture probes in file order (capture_probes.hpp adds the default for lines without).
+  std::vector<PlanProbe> probes;
   /// Cable position of the station with FDL address `addr`, or -1.
   int position_of(std::uint8_t addr) const;
 };

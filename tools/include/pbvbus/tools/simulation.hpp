@@ -13,6 +13,8 @@
 //  - A serial attachment opens a pseudo-terminal (bus::PtyStation); its `link`, if given, is
 //    created as a symbolic link to the pty (replacing an earlier symlink, never a file) and
 //    removed when the Simulation ends.
+//  - A capture listens at probe points (capture_probes.hpp); the constructor throws
+//    std::runtime_error if the default probe cannot be placed (cmd_run checks that first).
 //  - Faults scheduled after the end of the run (possible with a shorter --duration) are not
 //    applied and are listed in the report.
 //  - A serial attachment's slot time (bus::PtyStation reply window and Interface timing) is
@@ -27,6 +29,7 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/tools/capture_probes.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
@@ -43,8 +46,10 @@ namespace pbvbus::tools {
 struct SimulationOptions {
   std::optional<bus::Ticks> duration;  ///< overrides the scenario's
   std::optional<std::uint64_t> seed;   ///< overrides the scenario's
-  /// Tap for every line (not owned; must outlive the Simulation's runs).
+  /// The capture (not owned; must outlive the Simulation's runs): probes on every line as
+  /// capture_probes.hpp places them; `probe` is the default position.
   captures::PcapngWriter* capture = nullptr;
+  ProbeDefault probe;
 };
 
 class Simulation {

@@ -215,6 +215,11 @@ TEST(ScenarioParser, CollectsEveryError) {
                         "s.textproto:3:30: unknown line \"X\""}));
 }
 
+TEST(ScenarioParser, AnEmptyScenarioIsLocatedAtTheStartOfTheFile) {
+  EXPECT_EQ(errors_of("name: \"x\"\n"), Errs{"s.textproto:1:1: the scenario has no line"});
+  EXPECT_EQ(errors_of(""), Errs{"s.textproto:1:1: the scenario has no line"});
+}
+
 TEST(ScenarioParser, MissingFileIsAnError) {
   const auto r = load_scenario_file("/nonexistent/x.textproto");
   ASSERT_EQ(r.errors.size(), 1u);

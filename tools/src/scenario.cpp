@@ -143,6 +143,10 @@ class Planner {
           std::vector<Diagnostic>& errors)
       : m_proto(proto), m_file(std::move(file)), m_errors(errors) {
     m_root.tree = tree;
+    // An error about the file as a whole ("the scenario has no line") points at its start, so
+    // that every semantic error carries FILE:LINE:COLUMN.
+    m_root.line = 0;
+    m_root.column = 0;
   }
 
   std::optional<ScenarioPlan> run() {

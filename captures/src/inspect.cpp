@@ -6,48 +6,16 @@
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "pbvbus/fdl/telegram.hpp"
+#include "capture_names.hpp"
 
 namespace pbvbus::captures {
 
 namespace {
 __extension__ typedef __int128 i128;
 
-bool is_fdl(std::uint16_t lt) {
-  return lt == static_cast<std::uint16_t>(pcapng::LinkType::User0) ||
-         lt == static_cast<std::uint16_t>(pcapng::LinkType::ProfibusDl);
-}
-bool is_events(std::uint16_t lt) {
-  return lt == static_cast<std::uint16_t>(pcapng::LinkType::User1);
-}
-
-std::string_view sap_service(std::uint8_t sap) {
-  switch (sap) {
-    case 49:
-      return "MSAC_C2 RM";
-    case 50:
-      return "Alarm_Ack";
-    case 51:
-      return "MSAC_C1";
-    case 55:
-      return "Set_Slave_Add";
-    case 56:
-      return "Rd_Inp";
-    case 57:
-      return "Rd_Outp";
-    case 58:
-      return "Global_Control";
-    case 59:
-      return "Get_Cfg";
-    case 60:
-      return "Slave_Diag";
-    case 61:
-      return "Set_Prm";
-    case 62:
-      return "Chk_Cfg";
-    default:
-      return sap <= 48 ? "MSAC_C2" : "";
-  }
-}
+using names::is_events_link;
+using names::is_line_link;
+using names::sap_service;
 
 std::string frame_type_of(std::span<const std::uint8_t> b) {
   if (b.empty()) return "empty";
@@ -68,17 +36,7 @@ std::string frame_type_of(std::span<const std::uint8_t> b) {
 }
 
 void add_flag_reasons(std::uint32_t flags, std::vector<std::string>& out) {
-  static const std::pair<std::uint32_t, const char*> kNames[] = {
-      {pcapng::kFlagSymbolError, "symbol error"},
-      {pcapng::kFlagPreambleError, "preamble error"},
-      {pcapng::kFlagStartDelimiterError, "start delimiter error"},
-      {pcapng::kFlagUnalignedError, "unaligned frame"},
-      {pcapng::kFlagWrongIfg, "wrong inter-frame gap"},
-      {pcapng::kFlagTooShort, "packet too short"},
-      {pcapng::kFlagTooLong, "packet too long"},
-      {pcapng::kFlagCrcError, "CRC error"}};
-  for (const auto& [bit, name] : kNames)
-    if (flags & bit) out.emplace_back(name);
+  for (std::string_view r : names::flag_reasons(flags)) out.emplace_back(r);
 }
 
 std::string format_ts(std::int64_t ns) {
@@ -292,9 +250,9 @@ std::optional<CaptureSummary> summarize(PcapngReader& reader, PcapngError& error
     is.octets += r.bytes.size();
     if (!is.first_ns || r.ts_ns < *is.first_ns) is.first_ns = r.ts_ns;
     if (!is.last_ns || r.ts_ns > *is.last_ns) is.last_ns = r.ts_ns;
-    if (is_fdl(is.link_type)) {
+    if (is_line_link(is.link_type)) {
       count_frame(is, trackers[r.interface], r);
-    } else if (is_events(is.link_type)) {
+    } else if (is_events_link(is.link_type)) {
       auto e = decode_event(r.bytes);
       if (!e) {
         ++s.bad_event_records;
@@ -341,7 +299,7 @@ std::string to_text(const CaptureSummary& s) {
          std::to_string(is.octets) + " octets\n";
     if (is.first_ns)
       o += "  time span: " + format_ts(*is.first_ns) + " .. " + format_ts(*is.last_ns) + "\n";
-    if (!is_fdl(is.link_type)) continue;
+    if (!is_line_link(is.link_type)) continue;
     o += "  frame types: " + text_map(is.by_type) + "\n";
     o += "  requests: " + text_map(is.by_request) + "\n";
     o += "  responses: " + text_map(is.by_response) + "\n";
@@ -375,7 +333,7 @@ std::string to_json(const CaptureSummary& s) {
          ",\"speed\":" + std::to_string(is.speed) + ",\"records\":" + std::to_string(is.frames) +
          ",\"octets\":" + std::to_string(is.octets) + ",\"first_ns\":" + json_opt(is.first_ns) +
          ",\"last_ns\":" + json_opt(is.last_ns);
-    if (is_fdl(is.link_type)) {
+    if (is_line_link(is.link_type)) {
       o += ",\"frame_types\":" + json_map(is.by_type) + ",\"requests\":" + json_map(is.by_request) +
            ",\"responses\":" + json_map(is.by_response) +
            ",\"services\":" + json_map(is.by_service) +

@@ -10,6 +10,7 @@
 
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
+#include "capture_names.hpp"
 
 namespace pbvbus::captures {
 
@@ -30,43 +31,9 @@ std::int64_t sat_sub(std::int64_t a, std::int64_t b) {
   return saturate(static_cast<i128>(a) - static_cast<i128>(b));
 }
 
-bool is_line_link(std::uint16_t lt) {
-  return lt == static_cast<std::uint16_t>(pcapng::LinkType::User0) ||
-         lt == static_cast<std::uint16_t>(pcapng::LinkType::ProfibusDl);
-}
-bool is_events_link(std::uint16_t lt) {
-  return lt == static_cast<std::uint16_t>(pcapng::LinkType::User1);
-}
-
-// The DP service of a SAP (the same table as inspect.cpp and the Lua dissector).
-std::string_view sap_service(std::uint8_t sap) {
-  switch (sap) {
-    case 49:
-      return "MSAC_C2 RM";
-    case 50:
-      return "Alarm_Ack";
-    case 51:
-      return "MSAC_C1";
-    case 55:
-      return "Set_Slave_Add";
-    case 56:
-      return "Rd_Inp";
-    case 57:
-      return "Rd_Outp";
-    case 58:
-      return "Global_Control";
-    case 59:
-      return "Get_Cfg";
-    case 60:
-      return "Slave_Diag";
-    case 61:
-      return "Set_Prm";
-    case 62:
-      return "Chk_Cfg";
-    default:
-      return sap <= 48 ? "MSAC_C2" : "";
-  }
-}
+using names::is_events_link;
+using names::is_line_link;
+using names::sap_service;
 
 bool is_srd(const TimelineFrame& f) {
   const auto fn = fdl::fc_request_fn(f.fc);
@@ -114,19 +81,9 @@ std::optional<std::size_t> find_answer(const std::vector<TimelineFrame>& frames,
 }
 
 void flag_reasons(std::uint32_t flags, std::string& out) {
-  static const std::pair<std::uint32_t, const char*> kNames[] = {
-      {pcapng::kFlagSymbolError, "symbol error (collision)"},
-      {pcapng::kFlagPreambleError, "preamble error"},
-      {pcapng::kFlagStartDelimiterError, "start delimiter error"},
-      {pcapng::kFlagUnalignedError, "unaligned frame"},
-      {pcapng::kFlagWrongIfg, "wrong inter-frame gap"},
-      {pcapng::kFlagTooShort, "packet too short (partial)"},
-      {pcapng::kFlagTooLong, "packet too long"},
-      {pcapng::kFlagCrcError, "CRC error"}};
-  for (const auto& [bit, name] : kNames) {
-    if ((flags & bit) == 0) continue;
+  for (std::string_view r : names::flag_reasons(flags)) {
     if (!out.empty()) out += ", ";
-    out += name;
+    out += r;
   }
 }
 

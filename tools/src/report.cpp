@@ -76,6 +76,7 @@ void write_text(const Report& r, std::ostream& os) {
     const auto bit = bus::ticks_per_bit(l.baud);
     os << "\nline " << l.name << " (" << bus::baud_name(l.baud) << "bit/s, TSL " << l.params.tsl
        << ", TTR " << l.params.ttr << " bit times)\n";
+    if (!l.probe.empty()) os << "  traffic as seen at the probe next to " << l.probe << "\n";
     os << "  live list:";
     if (l.live.empty()) os << " (empty)";
     os << "\n";
@@ -168,6 +169,7 @@ void write_json(const Report& r, std::ostream& os) {
     const auto bit = bus::ticks_per_bit(l.baud);
     const auto& p = l.params;
     os << (li ? ",\n" : "\n") << "{\"name\":" << json_quote(l.name)
+       << ",\"probe\":" << (l.probe.empty() ? std::string("null") : json_quote(l.probe))
        << ",\"baud\":" << static_cast<std::uint32_t>(l.baud) << ",\n \"bus_params\":{\"tsl\":"
        << p.tsl << ",\"min_tsdr\":" << p.min_tsdr << ",\"max_tsdr\":" << p.max_tsdr
        << ",\"tqui\":" << p.tqui << ",\"tset\":" << p.tset << ",\"ttr\":" << p.ttr

@@ -59,6 +59,7 @@ struct Simulation::Station {
 struct Simulation::LineState {
   std::unique_ptr<bus::Line> line;
   LineStats stats;
+  std::string stats_probe;  ///< where the statistics tap listens ("station 1"), "" = whole line
   std::vector<Station> stations;  // cable order
 };
 
@@ -67,13 +68,29 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
   m_duration = opts.duration ? opts.duration : plan.duration;
   m_seed = opts.seed ? *opts.seed : plan.seed;
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
-  if (m_opts.capture != nullptr) {
-    std::string why;
-    const auto probes = plan_capture_probes(m_plan, m_opts.probe, &why);
-    if (!probes) throw std::runtime_error(why);
+  std::string why;
+  auto probes = plan_capture_probes(m_plan, m_opts.probe, &why);
+  if (!probes && m_opts.capture != nullptr) throw std::runtime_error(why);
+  if (!probes) probes = plan_capture_probes(m_plan, ProbeDefault{});  // --probe needs --capture
+  // The line's statistics are what an analyzer sees at the line's first probe, like the
+  // capture: during a cable cut the far side's traffic does not interleave with the near
+  // side's into phantom collisions, short idle times and unanswered requests. A line without
+  // stations has no probe; its tap hears the whole line (there is nothing to hear).
+  for (std::size_t li = 0; li < m_lines.size(); ++li) {
+    LineState& ls = *m_lines[li];
+    const auto first = probes ? std::find_if(probes->begin(), probes->end(),
+                                             [&](const CaptureProbe& p) { return p.line == li; })
+                              : std::vector<CaptureProbe>::const_iterator{};
+    if (probes && first != probes->end()) {
+      ls.line->add_tap(ls.stats, bus::ProbePoint{first->position});
+      ls.stats_probe = first->where;
+    } else {
+      ls.line->add_tap(ls.stats);
+    }
+  }
+  if (m_opts.capture != nullptr)
     for (std::size_t li = 0; li < m_lines.size(); ++li)
       attach_capture(*m_opts.capture, *m_lines[li]->line, li, *probes);
-  }
 }
 
 Simulation::~Simulation() {
@@ -197,7 +214,6 @@ void Simulation::build_line(std::size_t li) {
     }
     ls->stations.push_back(std::move(st));
   }
-  ls->line->add_tap(ls->stats);
   m_lines.push_back(std::move(ls));
 }
 
@@ -338,6 +354,7 @@ Report Simulation::report(double wall_seconds) const {
     lr.baud = pl.baud;
     lr.params = pl.params;
     lr.traffic = ls.stats;
+    lr.probe = ls.stats_probe;
     std::array<int, 128> live;
     live.fill(-1);
     for (const Station& s : ls.stations) {

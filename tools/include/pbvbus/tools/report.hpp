@@ -31,7 +31,10 @@
 //                 } ],
 //     "faults_not_reached": [ str ], // scheduled after the end of the run
 //     "lines": [ {
-//       "name": str, "baud": int,
+//       "name": str,
+//       "probe": str|null,   // "station 1": frames, errors and the wire's live list are what
+//                            // an analyzer next to that station sees (the capture's default)
+//       "baud": int,
 //       "bus_params": { "tsl","min_tsdr","max_tsdr","tqui","tset","ttr","gap_factor","hsa",
 //                       "max_retry": int },
 //       "live_list": [ { "address": int, "type": "master_in_ring"|"master_ready"|
@@ -160,6 +163,10 @@ struct LineReport {
   bus::Baud baud = bus::Baud::k1_5M;
   fdl::BusParams params;
   std::vector<LiveEntry> live;
+  /// Where the statistics tap listens: "station 1" (a probe next to it, the same default as
+  /// the capture), or "" for the whole line. Frame counts, errors, the wire's live list and
+  /// its no-response/retry/short-idle counts are what reaches that point.
+  std::string probe;
   LineStats traffic;  ///< a copy of the line's statistics tap
   std::uint64_t tsyn_drops = 0;  ///< requests the line's passive stations dropped (TSYN)
   std::vector<MasterReport> masters;

@@ -146,6 +146,12 @@ class PacedPtyTeardown : public ::testing::Test {
     const auto cap = pbvbus::captures::read_pcapng_file(m_capture, error);
     ASSERT_TRUE(cap.has_value()) << error.to_string();
     EXPECT_GT(cap->records.size(), 100u);
+    // `pbvbus inspect` reads it to its end (exit 2 and an offset if the file were cut short).
+    Child inspect = spawn({kBinary, "inspect", m_capture});
+    ASSERT_GT(inspect.pid, 0);
+    EXPECT_EQ(inspect.wait_exit(std::chrono::seconds(60)), 0) << inspect.stderr_text;
+    EXPECT_NE(inspect.stdout_text.find(std::to_string(cap->records.size())), std::string::npos)
+        << inspect.stdout_text;
     if (pbvbus::test::tshark_available()) {
       const auto r = pbvbus::test::tshark(m_capture, {"-T", "fields", "-e", "frame.number"});
       EXPECT_EQ(r.exit_code, 0) << r.err;

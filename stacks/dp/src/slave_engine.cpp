@@ -220,6 +220,24 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
   }
 
   const SlaveFeatures& f = m_cfg.features;
+  // A pure PrmCmd from the owner of a parameterised slave: only the block counts (§G.2).
+  if (ind.data.size() == kPrmLenPureCmd && ind.sa == m_master && f.prm_cmd && f.prm_structure &&
+      (m_state == SlaveState::WaitCfg || m_state == SlaveState::DataExch)) {
+    const Dpv1Status pd = pv.dpv1();
+    const auto block = pv.user_prm.subspan(3);
+    if (pd.prm_cmd() && pd.prm_structure() && block[0] == kPrmCmdBlockLen &&
+        block[1] == kPrmBlockPrmCmd) {
+      const PrmCmdResult r = m_cfg.on_prm_cmd
+                                 ? m_cfg.on_prm_cmd(PrmCmdView{ind.now, ind.sa, true, block})
+                                 : PrmCmdResult::Accept;
+      if (r == PrmCmdResult::Reject) {
+        ++m_stats.prm_faults;
+        go_wait_prm();
+        m_prm_fault = true;
+      }
+      return;
+    }
+  }
   bool fault = false;
   bool not_supported = false;
   if (h.ident != m_cfg.ident) fault = true;
@@ -228,6 +246,7 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
   const std::size_t up = pv.user_prm.size();
   if (up < m_cfg.min_user_prm_len || up > m_cfg.max_user_prm_len) fault = true;
   Dpv1Status d;
+  std::vector<PrmBlock> blocks;  // not on the cyclic path
   if (f.dpv1 && up >= 3) {
     d = pv.dpv1();
     if (d.fail_safe() && !f.fail_safe) fault = true;
@@ -241,12 +260,23 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
     if (d.isom_req()) fault = true;
     if (d.prm_cmd() && !f.prm_cmd) fault = true;
     if (d.prm_structure()) {
-      std::vector<PrmBlock> blocks;  // not on the cyclic path
       if (!f.prm_structure || !split_prm_blocks(pv.user_prm.subspan(3), blocks)) fault = true;
+      // A PrmCmd block needs the PrmCmd bit and has exactly 8 octets; at most one per Set_Prm.
+      std::size_t n_cmd = 0;
+      for (const auto& b : blocks) {
+        if (b.type != kPrmBlockPrmCmd) continue;
+        ++n_cmd;
+        if (!d.prm_cmd() || b.bytes.size() != kPrmCmdBlockLen || n_cmd > 1) fault = true;
+      }
     }
     if (!d.dpv1_enable() && (d.alarm_enables() != 0 || d.check_cfg_mode())) fault = true;
   }
   if (!fault && m_cfg.check_user_prm && !m_cfg.check_user_prm(pv.user_prm)) fault = true;
+  if (!fault && !not_supported && m_cfg.on_prm_cmd)
+    for (const auto& b : blocks)
+      if (b.type == kPrmBlockPrmCmd &&
+          m_cfg.on_prm_cmd(PrmCmdView{ind.now, ind.sa, false, b.bytes}) == PrmCmdResult::Reject)
+        fault = true;
 
   if (fault || not_supported) {
     ++m_stats.prm_faults;

@@ -45,6 +45,10 @@ inline constexpr std::uint8_t kAlarmModeMask = 0x07;
 inline constexpr std::size_t kPrmLenNorm = 7;   ///< DP-V0 header
 inline constexpr std::size_t kPrmLenDpv1 = 10;  ///< header + DPV1_Status_1..3
 inline constexpr std::size_t kMaxUserPrmLen = 237;
+/// A "pure PrmCmd" Set_Prm (§G.2, VPC3 PRM_CMD_LENGTH, value decided here): the DP-V1 header
+/// and one 8-octet PrmCmd block, 7 + 3 + 8 octets.
+inline constexpr std::size_t kPrmLenPureCmd = 18;
+inline constexpr std::size_t kPrmCmdBlockLen = 8;
 
 /// Alarms in total that Alarm_Mode 0..7 allows outstanding (0 = one of each type).
 constexpr unsigned alarm_mode_limit(std::uint8_t alarm_mode) {

@@ -117,6 +117,9 @@ class SlaveApplication {
   bool set_status(std::uint8_t status_type, std::uint8_t slot, std::uint8_t specifier,
                   std::span<const std::uint8_t> data = {});
   void clear_status(std::uint8_t status_type, std::uint8_t slot);
+  /// Makes the owner's next Data_Exchange replies high priority (DH) until it reads Slave_Diag,
+  /// without changing the diagnosis (e.g. a redundancy state change the master must fetch).
+  void request_diag_read() { diag_changed(); }
 
   // --- DP-V1 alarms (any thread) ---
   /// Queues an alarm; its Seq_Nr is returned in *seq_nr.

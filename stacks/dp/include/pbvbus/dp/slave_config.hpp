@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "pbvbus/bus/time.hpp"
 #include "pbvbus/dp/cfg_identifier.hpp"
 
 namespace pbvbus::dp {
@@ -52,6 +53,24 @@ using UserPrmCheck = std::function<bool(std::span<const std::uint8_t> user_prm)>
 /// User check of a Chk_Cfg in Check_Cfg_Mode (DPV1_Status_2 bit 0); true = accepted.
 using UserCfgCheck = std::function<bool(std::span<const std::uint8_t> chk_cfg)>;
 
+/// A PrmCmd block (PI 2.212 slave redundancy, protocol-facts.md §G.2) that a Set_Prm carried,
+/// handed to SlaveConfig::on_prm_cmd. The dp layer only checks the block's frame (a structured
+/// block of type 0x02, 8 octets); its meaning is for the redundancy layer above.
+struct PrmCmdView {
+  bus::Ticks now = 0;
+  std::uint8_t master = 0;  ///< FDL address of the master that sent it
+  /// A "pure PrmCmd" Set_Prm (slave_engine.hpp): it changes nothing else, the slave stays in
+  /// its state (Data_Exch included). False: part of a full parameterisation.
+  bool pure = false;
+  std::span<const std::uint8_t> block;  ///< the 8 octets, header included
+};
+enum class PrmCmdResult : std::uint8_t {
+  Accept,
+  Reject,  ///< the Set_Prm is a parameterisation error (Prm_Fault)
+};
+/// Called on the bus thread inside the Set_Prm, after every other check has passed.
+using PrmCmdHandler = std::function<PrmCmdResult(const PrmCmdView&)>;
+
 struct SlaveConfig {
   std::uint16_t ident = 0;
   SlaveFeatures features;
@@ -59,6 +78,9 @@ struct SlaveConfig {
   std::size_t max_user_prm_len = 0;
   UserPrmCheck check_user_prm;       ///< optional
   UserCfgCheck check_cfg_user;       ///< optional; used only in Check_Cfg_Mode
+  /// Optional; PrmCmd blocks (features.prm_cmd and prm_structure) go here. Without it they are
+  /// accepted and ignored.
+  PrmCmdHandler on_prm_cmd;
   std::vector<SlaveModule> modules;  ///< the real configuration, in Get_Cfg order
   std::uint16_t min_slave_interval = 1;  ///< 100 us units (GSD Min_Slave_Intervall)
   std::size_t max_diag_len = 244;        ///< GSD Max_Diag_Data_Len (6..244)

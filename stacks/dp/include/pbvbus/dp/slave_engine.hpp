@@ -20,6 +20,16 @@
 //   user prm length/content, DPV1_Status bits the slave does not support) sets Prm_Fault; an
 //   unsupported Sync_Req/Freeze_Req sets Not_Supported; either way the slave is in Wait_Prm,
 //   unlocked. Fault flags are cleared by the next good Set_Prm (Cfg_Fault too).
+// - PrmCmd (PI 2.212 slave redundancy, §G.2; needs SlaveFeatures::prm_cmd and prm_structure):
+//   a structured block of type 0x02 must be exactly 8 octets, at most one per Set_Prm, and
+//   needs DPV1_Status_3 PrmCmd; otherwise Prm_Fault. After every other check has passed the
+//   block goes to SlaveConfig::on_prm_cmd (Reject = Prm_Fault). A "pure PrmCmd" is a Set_Prm
+//   of exactly 18 octets (7 + DPV1_Status_1..3 + one PrmCmd block; the VPC3 PRM_CMD_LENGTH,
+//   whose value the sources do not give) with Lock_Req, PrmCmd and Prm_Structure, from the
+//   owner of a slave in Wait_Cfg or Data_Exch: the header and DPV1_Status octets are not
+//   evaluated again, the state, outputs and watchdog factors stay, and only the block goes to
+//   on_prm_cmd (PrmCmdView::pure). The same 18 octets to an unparameterised slave are an
+//   ordinary Set_Prm. The engine never interprets the block; a redundancy layer does.
 // - Chk_Cfg is accepted in Wait_Cfg and Data_Exch (RS in Power_On/Wait_Prm). Identifiers are
 //   compared by meaning (cfg_identifier.hpp). A mismatch sets Cfg_Fault, lists the faulty
 //   modules in an identifier-related block, and returns the slave to Wait_Prm, unlocked.
@@ -30,7 +40,8 @@
 // - Clear_Data sets the outputs to the safe state and holds them there until a Global_Control
 //   without Clear_Data; received outputs are still stored (Rd_Outp shows them).
 // - DH is answered to the owner's Data_Exchange while a diagnosis change made by the application
-//   (or a new alarm) has not yet been read by the owner with Slave_Diag. State changes the master
+//   (or a new alarm, a status PDU, SlaveApplication::request_diag_read()) has not yet been read
+//   by the owner with Slave_Diag. State changes the master
 //   caused itself (Set_Prm, Chk_Cfg, Global_Control) do not count as new diagnosis.
 // - Ext_Diag is set while the application says so, or channel diagnoses, module faults or a
 //   Cfg_Fault identifier block are present. Alarm and status PDUs alone do not set it.

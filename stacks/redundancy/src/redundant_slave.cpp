@@ -1,0 +1,366 @@
+// Switched station, slave side (protocol-facts.md §G); decisions in redundant_slave.hpp.
+#include "pbvbus/redundancy/redundant_slave.hpp"
+
+#include <algorithm>
+
+namespace pbvbus::redundancy {
+
+std::string_view to_string(Role r) {
+  switch (r) {
+    case Role::SWaiting: return "S_WAITING";
+    case Role::SPrimary: return "S_PRIMARY";
+    case Role::Primary: return "PRIMARY";
+    case Role::Backup: return "BACKUP";
+    case Role::BpSwitchover: return "BP_SWITCHOVER";
+    case Role::Failed: return "FAILED";
+  }
+  return "?";
+}
+
+/// One interface as seen by its FDL station: the engine, silenced when failed, with the
+/// redundancy bookkeeping around each request.
+class RedundantSlave::Port final : public fdl::ResponderUser {
+ public:
+  Port(RedundantSlave& rs, int i) : m_rs(rs), m_i(i) {}
+  void on_power_on(bus::Ticks now) override {
+    m_rs.m_if[m_i].engine->on_power_on(now);
+    if (!m_rs.m_powered) m_rs.power_on(now);
+  }
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override {
+    m_rs.on_time(ind.now);
+    if (!m_rs.alive(m_i)) {
+      reply.none();
+      return;
+    }
+    auto& e = *m_rs.m_if[m_i].engine;
+    const auto dx = e.stats().data_exchange;
+    const auto rs = e.stats().refused;
+    m_rs.before_request(m_i, ind.now);
+    e.on_request(ind, reply);
+    m_rs.after_request(m_i, ind.now, dx, rs);
+  }
+  bus::Ticks next_deadline() const override { return m_rs.next_deadline(); }
+  void on_time(bus::Ticks now) override { m_rs.on_time(now); }
+
+ private:
+  RedundantSlave& m_rs;
+  int m_i;
+};
+
+RedundantSlave::RedundantSlave(dp::SlaveConfig cfg, RedundantSlaveParams p)
+    : m_p(p), m_hold_time(p.output_hold) {
+  cfg.features.dpv1 = true;
+  cfg.features.prm_cmd = cfg.features.prm_structure = true;
+  for (int i = 0; i < 2; ++i) {
+    dp::SlaveConfig c = cfg;
+    c.on_prm_cmd = [this, i](const dp::PrmCmdView& v) { return handle_prm_cmd(i, v); };
+    m_if[i].engine = std::make_unique<dp::SlaveEngine>(std::move(c));
+    m_if[i].port = std::make_unique<Port>(*this, i);
+  }
+  m_out.assign(m_if[0].engine->layout().outputs, 0);
+  m_scratch.assign(m_out.size(), 0);
+}
+
+RedundantSlave::~RedundantSlave() = default;
+
+fdl::ResponderUser& RedundantSlave::interface(int i) { return *m_if[i].port; }
+
+int RedundantSlave::primary() const {
+  for (int i = 0; i < 2; ++i)
+    if (m_if[i].role == Role::Primary) return i;
+  return -1;
+}
+
+RedState RedundantSlave::red_state(int i) const {
+  const Iface& f = m_if[i];
+  RedState s;
+  if (f.role == Role::Failed) {  // a failed interface is known only as defective
+    s.hardware_defective = true;
+    return s;
+  }
+  s.primary = f.role == Role::Primary || f.role == Role::SPrimary;
+  s.backup = f.role == Role::Backup || f.role == Role::BpSwitchover;
+  s.hardware_defective = f.role == Role::Failed;
+  s.data_exchange = f.role != Role::Failed && f.engine->state() == dp::SlaveState::DataExch;
+  s.master_state_clear = f.master_state_clear;
+  s.baudrate_found = f.baudrate_found;
+  s.output_hold_started = s.primary && outputs_held();
+  return s;
+}
+
+bool RedundantSlave::write_inputs(std::size_t module, std::span<const std::uint8_t> data) {
+  bool ok = true;
+  for (auto& f : m_if) ok = f.engine->application().write_inputs(module, data) && ok;
+  return ok;
+}
+
+void RedundantSlave::emit(RedEvent::Kind k, bus::Ticks at, int iface, Role from, Role to) {
+  if (m_cb) m_cb(RedEvent{k, at, iface, from, to});
+}
+
+// --- time -------------------------------------------------------------------------------------
+
+void RedundantSlave::power_on(bus::Ticks now) {
+  m_powered = true;
+  for (int i = 0; i < 2; ++i) {
+    m_if[i].role = i == 0 ? Role::SPrimary : Role::SWaiting;
+    m_if[i].last_heard = now;
+    m_if[i].next_heartbeat = now;
+    m_if[i].partner_lost = false;
+  }
+  m_decided = false;
+  m_tsprimary = m_p.tsprimary_start;
+  m_alternate_at = now + m_tsprimary;
+  refresh_status();
+}
+
+bus::Ticks RedundantSlave::next_deadline() const {
+  if (!m_powered) return bus::kNever;
+  bus::Ticks t = std::min(m_alternate_at, m_hold_deadline);
+  if (!m_link.empty()) t = std::min(t, m_link.front().at);
+  for (const auto& f : m_if) {
+    t = std::min(t, f.engine->next_deadline());
+    if (f.role == Role::Failed) continue;
+    t = std::min(t, f.next_heartbeat);
+    if (!f.partner_lost) t = std::min(t, f.last_heard + m_p.supervision);
+  }
+  return t;
+}
+
+void RedundantSlave::on_time(bus::Ticks now) {
+  if (!m_powered) return;
+  for (;;) {
+    const bus::Ticks t = next_deadline();
+    if (t > now) break;
+    // Engines (watchdogs) first, then the link, heartbeats, supervision, alternation, hold.
+    for (auto& f : m_if)
+      if (f.engine->next_deadline() <= t) f.engine->on_time(t);
+    check_primary_lost_master(t);
+    while (!m_link.empty() && m_link.front().at <= t) {
+      const LinkMsg m = m_link.front();
+      m_link.erase(m_link.begin());
+      deliver(m, t);
+    }
+    for (int i = 0; i < 2; ++i) {
+      Iface& f = m_if[i];
+      if (f.role == Role::Failed) continue;
+      if (f.next_heartbeat <= t) {
+        send(i, Msg::Heartbeat, f.next_heartbeat);
+        f.next_heartbeat += m_p.heartbeat_period;
+      }
+      if (!f.partner_lost && f.last_heard + m_p.supervision <= t) {
+        f.partner_lost = true;
+        emit(RedEvent::Kind::PartnerLost, f.last_heard + m_p.supervision, i);
+        if (f.role == Role::Backup || f.role == Role::BpSwitchover) {
+          if (f.role == Role::BpSwitchover) f.ack_pending = true;
+          set_role(i, Role::Primary, t);
+        }
+      }
+    }
+    if (m_alternate_at <= t) {
+      for (int i = 0; i < 2; ++i) {
+        if (m_if[i].role == Role::SPrimary) set_role(i, Role::SWaiting, t);
+        else if (m_if[i].role == Role::SWaiting) set_role(i, Role::SPrimary, t);
+      }
+      m_tsprimary = std::min(2 * m_tsprimary, m_p.tsprimary_max);
+      m_alternate_at = t + m_tsprimary;
+    }
+    if (m_hold_deadline <= t) {
+      m_hold_deadline = bus::kNever;
+      std::fill(m_out.begin(), m_out.end(), 0);
+      emit(RedEvent::Kind::OutputHoldExpired, t, std::max(primary(), 0));
+    }
+    refresh_status();
+  }
+}
+
+// --- link ---------------------------------------------------------------------------------------
+
+void RedundantSlave::send(int from, Msg m, bus::Ticks now) {
+  if (!alive(from)) return;
+  const LinkMsg lm{now + m_p.link_delay, 1 - from, m, m_if[from].role};
+  const auto it = std::upper_bound(m_link.begin(), m_link.end(), lm,
+                                   [](const LinkMsg& a, const LinkMsg& b) { return a.at < b.at; });
+  m_link.insert(it, lm);
+}
+
+void RedundantSlave::deliver(const LinkMsg& m, bus::Ticks now) {
+  const int i = m.to;
+  Iface& f = m_if[i];
+  if (!alive(i)) return;  // lost
+  f.last_heard = now;
+  if (f.partner_lost) {
+    f.partner_lost = false;
+    emit(RedEvent::Kind::PartnerBack, now, i);
+  }
+  switch (m.msg) {
+    case Msg::Heartbeat:
+      // A (re)started partner while this one is primary: no switch back, it becomes backup.
+      if (f.role == Role::Primary &&
+          (m.sender_role == Role::SWaiting || m.sender_role == Role::SPrimary))
+        send(i, Msg::BecomeBackup, now);
+      break;
+    case Msg::SwitchReq:
+      if (f.role == Role::Primary) {
+        set_role(i, Role::Backup, now);
+        send(i, Msg::TakeOver, now);
+      }
+      break;
+    case Msg::TakeOver:
+      if (f.role == Role::Backup || f.role == Role::BpSwitchover) set_role(i, Role::Primary, now);
+      break;
+    case Msg::BecomeBackup:
+      if (f.role != Role::Primary) set_role(i, Role::Backup, now);
+      break;
+  }
+}
+
+// --- roles ----------------------------------------------------------------------------------------
+
+void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
+  Iface& f = m_if[i];
+  const Role from = f.role;
+  if (from == r) return;
+  f.role = r;
+  if (from == Role::Primary) lose_primary(now);
+  if (r == Role::Primary) {
+    m_decided = true;
+    m_alternate_at = bus::kNever;
+    if (m_if[1 - i].role == Role::SPrimary || m_if[1 - i].role == Role::SWaiting)
+      send(i, Msg::BecomeBackup, now);
+    if (f.ack_pending) set_ack(i);
+    // Outputs come from this interface's next accepted Data_Exchange.
+  }
+  if (r == Role::Backup && f.ack_pending) set_ack(i);
+  emit(RedEvent::Kind::RoleChanged, now, i, from, r);
+  refresh_status();
+}
+
+void RedundantSlave::lose_primary(bus::Ticks now) {
+  if (m_hold_deadline == bus::kNever) m_hold_deadline = now + m_hold_time;
+}
+
+void RedundantSlave::take_outputs(int i) {
+  auto& app = m_if[i].engine->application();
+  for (std::size_t m = 0; m < app.modules(); ++m) {
+    const auto& ml = app.module(m);
+    if (ml.out_len == 0) continue;
+    app.read_outputs(m, std::span(m_scratch).subspan(ml.out_offset, ml.out_len));
+  }
+  std::copy(m_scratch.begin(), m_scratch.end(), m_out.begin());
+  m_hold_deadline = bus::kNever;
+}
+
+bool RedundantSlave::partner_in_dx(int i) const {
+  const int p = 1 - i;
+  return alive(p) && !m_if[i].partner_lost &&
+         m_if[p].engine->state() == dp::SlaveState::DataExch;
+}
+
+void RedundantSlave::check_primary_lost_master(bus::Ticks now) {
+  for (int i = 0; i < 2; ++i) {
+    Iface& f = m_if[i];
+    const bool dx = f.engine->state() == dp::SlaveState::DataExch;
+    if (f.role == Role::Primary && f.was_data_exch && !dx) {
+      lose_primary(now);  // the primary's engine has set its own image safe; hold the backplane
+      if (m_p.autonomous_switchover && partner_in_dx(i) && m_if[1 - i].role == Role::Backup) {
+        set_role(i, Role::Backup, now);
+        send(i, Msg::TakeOver, now);
+      }
+    }
+    f.was_data_exch = dx;
+  }
+}
+
+// --- requests ---------------------------------------------------------------------------------------
+
+void RedundantSlave::before_request(int i, bus::Ticks /*now*/) { m_if[i].baudrate_found = true; }
+
+void RedundantSlave::after_request(int i, bus::Ticks now, std::uint64_t dx_before,
+                                   std::uint64_t rs_before) {
+  Iface& f = m_if[i];
+  const auto& st = f.engine->stats();
+  const bool dx_ok = st.data_exchange != dx_before && st.refused == rs_before &&
+                     f.engine->state() == dp::SlaveState::DataExch;
+  if (dx_ok && f.role == Role::Primary) take_outputs(i);
+  check_primary_lost_master(now);
+  refresh_status();
+}
+
+dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) {
+  PrmCmd c;
+  if (decode_prm_cmd(v.block, c) != PrmCmdError::None) return dp::PrmCmdResult::Reject;
+  Iface& f = m_if[i];
+  f.cmd_spec = c.specifier_octet();
+  f.cmd_function = c.function();
+  f.master_state_clear = c.master_state_clear;
+  m_hold_time = c.output_hold_ticks();
+  f.ack_pending = true;
+  if (c.primary_request) {
+    switch (f.role) {
+      case Role::Primary: set_ack(i); break;
+      case Role::Backup:
+        if (alive(1 - i) && !f.partner_lost && m_if[1 - i].role == Role::Primary) {
+          set_role(i, Role::BpSwitchover, v.now);
+          send(i, Msg::SwitchReq, v.now);
+        } else {
+          set_role(i, Role::Primary, v.now);
+        }
+        break;
+      case Role::SWaiting:
+      case Role::SPrimary:
+        set_role(i, Role::Primary, v.now);
+        break;
+      case Role::BpSwitchover:
+      case Role::Failed: break;
+    }
+  } else {
+    set_ack(i);
+  }
+  refresh_status();
+  return dp::PrmCmdResult::Accept;
+}
+
+void RedundantSlave::set_ack(int i) {
+  Iface& f = m_if[i];
+  f.ack_pending = false;
+  const std::array<std::uint8_t, 4> d{f.cmd_function, red_state(i).octet(),
+                                      red_state(1 - i).octet(), 0};
+  f.engine->application().set_status(kStatusPrmCmdAck, 0, f.cmd_spec, d);
+}
+
+void RedundantSlave::refresh_status() {
+  for (int i = 0; i < 2; ++i) {
+    Iface& f = m_if[i];
+    const std::uint8_t own = red_state(i).octet();
+    const std::uint8_t partner = red_state(1 - i).octet();
+    const std::int32_t key = (f.cmd_spec << 16) | (own << 8) | partner;
+    if (key == f.status_cache) continue;
+    f.status_cache = key;
+    const std::array<std::uint8_t, 4> d{0, own, partner, 0};
+    f.engine->application().set_status(kStatusRedStatus, 0,
+                                       static_cast<std::uint8_t>(f.cmd_spec & 0xF8), d);
+  }
+}
+
+// --- faults ------------------------------------------------------------------------------------------
+
+void RedundantSlave::fail_interface(int i, bus::Ticks now) {
+  on_time(now);
+  set_role(i, Role::Failed, now);
+  m_if[i].was_data_exch = false;
+}
+
+void RedundantSlave::repair_interface(int i, bus::Ticks now) {
+  on_time(now);
+  Iface& f = m_if[i];
+  if (f.role != Role::Failed) return;
+  f.engine->on_power_on(now);  // the interface restarts: Wait_Prm
+  f.baudrate_found = f.master_state_clear = f.ack_pending = false;
+  f.last_heard = now;
+  f.partner_lost = false;
+  f.next_heartbeat = now;
+  set_role(i, Role::SWaiting, now);
+}
+
+}  // namespace pbvbus::redundancy

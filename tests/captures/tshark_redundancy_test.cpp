@@ -230,3 +230,59 @@ TEST_F(TsharkRedundancy, NoLuaErrors) {
 
 }  // namespace
 }  // namespace pbvbus::captures
+
+namespace pbvbus::captures {
+namespace {
+
+// The redundancy goldens cut, bit-flipped and extended at random (FDL header kept plausible so
+// the DP decoders see odd block lengths): tshark must never report a Lua error.
+TEST(TsharkRedundancyRobustness, MutatedRedundancyFramesDecodeWithoutLuaErrors) {
+  if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  const auto path = test::temp_capture_path("pbvbus_tshark_red_garbage");
+  const std::vector<const Bytes*> goldens = {&kSetPrmPrmCmd, &kPurePrmCmd, &kDiagRed, &kPrmCmdCut,
+                                             &kRedCut, &kPrmCmdNoStructure, &kRedShortHeader};
+  std::uint64_t rng = 0xA5A5'0212'0000'0001ULL;
+  auto next = [&] {
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return rng;
+  };
+  {
+    bus::Scheduler sched;
+    bus::Line line(sched, "dpA", bus::Baud::k12M);
+    auto w = PcapngWriter::open(path, {});
+    ASSERT_TRUE(w);
+    for (int i = 0; i < 400; ++i) {
+      Bytes b = *goldens[next() % goldens.size()];
+      // Mutate only the DU (after DSAP/SSAP, before FCS), where the blocks are.
+      const std::size_t du = 9, end = b.size() - 2;
+      switch (next() % 3) {
+        case 0:
+          b.erase(b.begin() + static_cast<std::ptrdiff_t>(du + next() % (end - du)), b.begin() + static_cast<std::ptrdiff_t>(end));
+          break;
+        case 1:
+          for (int k = 0; k < 3; ++k) b[du + next() % (end - du)] = static_cast<std::uint8_t>(next());
+          break;
+        default:
+          b.insert(b.begin() + static_cast<std::ptrdiff_t>(end), static_cast<std::uint8_t>(next()));
+          break;
+      }
+      // Keep LE and the FCS right so every frame reaches the DP decoders.
+      b[1] = b[2] = static_cast<std::uint8_t>(b.size() - 6);
+      unsigned sum = 0;
+      for (std::size_t k = 4; k + 2 < b.size(); ++k) sum += b[k];
+      b[b.size() - 2] = static_cast<std::uint8_t>(sum);
+      w->on_frame(test::tap_frame(line, b, (i + 1) * 1000));
+    }
+  }
+  const auto r = ts::tshark(path, {"-V"});
+  std::filesystem::remove(path);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const auto at = r.out.find("Lua Error");
+  EXPECT_EQ(at, std::string::npos) << r.out.substr(at > 1500 ? at - 1500 : 0, 2000);
+  EXPECT_EQ(r.err.find("Lua"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace pbvbus::captures

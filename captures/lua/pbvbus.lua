@@ -11,6 +11,8 @@
 --   Data_Exchange, Rd_Inp, Rd_Outp, Set_Slave_Add.                               fields pbdp.*
 --   DP-V1 (§E): MSAC_C1 read/write/Alarm_Ack, MSAC_C2 initiate/abort/idle/data transport,
 --   resource manager, negative responses.                                       fields pbdpv1.*
+--   Slave redundancy (PI 2.212, §G.2/G.3): the PrmCmd block in Set_Prm        fields pbdp.prmcmd.*
+--   and the Prm_Cmd_Ack/Red_Status status blocks in Slave_Diag.                fields pbdp.red.*
 -- and on USER1 (148) pbvbus event records (captures/include/pbvbus/captures/event_record.hpp).
 --                                                                               fields pbevent.*
 --
@@ -20,6 +22,10 @@
 --     for a DP-V0 slave they are really its first User_Prm_Data octets (the GSD would tell).
 --   * A device-related diagnosis block whose second octet is a known DP-V1 alarm or status type
 --     and which is at least 4 octets long is decoded as a DP-V1 alarm/status block.
+--   * Redundancy: a Set_Prm with PrmCmd but without Prm_Structure is still read as structured
+--     blocks (with a warning); a pure PrmCmd is a Set_Prm of exactly 7 + 3 + 8 octets with one
+--     PrmCmd block (§G.2 [I]). The Specifier octet is read as Seq_Nr in bits 7..3 and the
+--     specifier in bits 1..0, the PrmCmd Properties bits in the AUMA order (both [U]).
 --   * SAPs 0..48 with the class-2 master SAP 50 on the other side are MSAC_C2 connections; other
 --     SAP pairs (MPI among them) are shown as FDL data and not decoded further.
 
@@ -81,7 +87,7 @@ local alarm_spec_names = {
 }
 local status_types = {
   [0x81] = "Status_Message", [0x82] = "Module_Status", [0x83] = "DXB_Link_Status",
-  [0x9E] = "Prm_Cmd_Ack", [0x9F] = "Red_State",
+  [0x9E] = "Prm_Cmd_Ack", [0x9F] = "Red_Status",
 }
 local status_spec_names = { [0] = "none", [1] = "status appears", [2] = "status disappears", [3] = "reserved" }
 local channel_errors = {
@@ -98,13 +104,28 @@ local prm_block_types = {
   [0x02] = "PrmCmd", [0x03] = "DXB link table", [0x04] = "Isochronous mode",
   [0x07] = "DXB subscriber table", [0x08] = "Time AR", [0x81] = "User prm data",
 }
+-- Slave redundancy (PI 2.212 as pieced together in protocol-facts.md §G.2/G.3; the AUMA layout).
+-- Red_State_1/2 bits: { mask, name, field suffix, short name for the info column }.
 local red_state_bits = {
-  { 0x01, "Backup" }, { 0x02, "Primary" }, { 0x04, "Hardware_defective" }, { 0x08, "Data_Exchange" },
-  { 0x10, "Master_State_Clear" }, { 0x20, "Baudrate_found" }, { 0x40, "Output_Hold_Time_started" },
+  { 0x01, "Backup", "backup", "Backup" },
+  { 0x02, "Primary", "primary", "Primary" },
+  { 0x04, "Hardware_defective", "hardware_defective", "HWdefect" },
+  { 0x08, "Data_Exchange", "data_exchange", "DX" },
+  { 0x10, "Master_State_Clear", "master_state_clear", "MSC" },
+  { 0x20, "Baudrate_found", "baudrate_found", "Baud" },
+  { 0x40, "Output_Hold_Time_started", "output_hold_time_started", "OHT" },
 }
+-- PrmCmd Function octet (block octet 5); echoed in Prm_Cmd_Ack/Red_Status octet 5.
 local red_function_bits = {
-  { 0x02, "Primary_Request" }, { 0x04, "Stop_MSAC1S" }, { 0x08, "Start_MSAC1S" },
-  { 0x10, "Check_Properties" }, { 0x40, "Master_State_Clear" },
+  { 0x02, "Primary_Request", "primary_request" }, { 0x04, "Stop_MSAC1S", "stop_msac1s" },
+  { 0x08, "Start_MSAC1S", "start_msac1s" }, { 0x10, "Check_Properties", "check_properties" },
+  { 0x40, "Master_State_Clear", "master_state_clear" },
+}
+-- PrmCmd Properties octet (block octet 6) [U: AUMA column order, bit positions probable].
+local prmcmd_property_bits = {
+  { 0x01, "Primary_Req_MS0_MS1_used", "primary_req_ms0_ms1_used" },
+  { 0x02, "Start_Stop_MSAC1S_used", "start_stop_msac1s_used" },
+  { 0x04, "Address_Change", "address_change" }, { 0x08, "Address_Offset64", "address_offset64" },
 }
 local abort_subnets = { [0] = "none", [1] = "local", [2] = "remote" }
 local abort_instances = { [0] = "FDL", [1] = "MSAC_C2", [2] = "user" }
@@ -172,11 +193,14 @@ local E = {
   ext = ProtoExpert.new("pbfdl.ext_bad", "Bad address extension chain", expert.group.MALFORMED, expert.severity.ERROR),
   addr = ProtoExpert.new("pbfdl.addr_bad", "Invalid address", expert.group.PROTOCOL, expert.severity.WARN),
   dp = ProtoExpert.new("pbdp.malformed", "DP PDU shorter than its service requires", expert.group.MALFORMED, expert.severity.WARN),
+  prmcmd = ProtoExpert.new("pbdp.prmcmd.malformed", "PrmCmd block malformed", expert.group.MALFORMED, expert.severity.WARN),
+  prmcmd_bits = ProtoExpert.new("pbdp.prmcmd.inconsistent", "PrmCmd and DPV1_Status_3 disagree", expert.group.PROTOCOL, expert.severity.WARN),
+  red = ProtoExpert.new("pbdp.red.malformed", "Redundancy status block malformed", expert.group.MALFORMED, expert.severity.WARN),
   dpv1_neg = ProtoExpert.new("pbdpv1.negative", "DP-V1 negative response", expert.group.RESPONSE_CODE, expert.severity.NOTE),
   event = ProtoExpert.new("pbevent.malformed", "Event record malformed", expert.group.MALFORMED, expert.severity.ERROR),
 }
 fdl.experts = { E.fcs, E.truncated, E.trailing, E.le, E.ed, E.sd, E.fc, E.ext, E.addr }
-dp.experts = { E.dp }
+dp.experts = { E.dp, E.prmcmd, E.prmcmd_bits, E.red }
 dpv1.experts = { E.dpv1_neg }
 ev.experts = { E.event }
 
@@ -223,19 +247,33 @@ local D = {
   blk_slot = ProtoField.uint8("pbdp.prm.block_slot", "Slot_Number", base.DEC),
   blk_spec = ProtoField.uint8("pbdp.prm.block_specifier", "Index/Specifier", base.HEX),
   blk_data = ProtoField.bytes("pbdp.prm.block_data", "Structure data"),
-  -- Slave redundancy (PI 2.212, protocol-facts.md §G.2/G.3)
+  -- Slave redundancy: the PrmCmd block in Set_Prm (§G.2) ...
+  prmcmd = ProtoField.bytes("pbdp.prmcmd", "PrmCmd block"),
+  prmcmd_len = ProtoField.uint8("pbdp.prmcmd.structure_length", "Structure_Length", base.DEC),
+  prmcmd_type = ProtoField.uint8("pbdp.prmcmd.structure_type", "Structure_Type", base.HEX, prm_block_types),
+  prmcmd_slot = ProtoField.uint8("pbdp.prmcmd.slot", "Slot_Number", base.DEC),
+  prmcmd_spec = ProtoField.uint8("pbdp.prmcmd.specifier", "Specifier/Seq_Nr", base.HEX),
+  prmcmd_seq = ProtoField.uint8("pbdp.prmcmd.seq_nr", "Seq_Nr", base.DEC, nil, 0xF8),
+  prmcmd_spec_bits = ProtoField.uint8("pbdp.prmcmd.specifier_bits", "Specifier", base.DEC, nil, 0x03),
+  prmcmd_function = ProtoField.uint8("pbdp.prmcmd.function", "Function", base.HEX),
+  prmcmd_functions = ProtoField.string("pbdp.prmcmd.functions", "Functions requested"),
+  prmcmd_properties = ProtoField.uint8("pbdp.prmcmd.properties", "Properties", base.HEX),
+  prmcmd_hold = ProtoField.uint16("pbdp.prmcmd.output_hold_time", "Output_Hold_Time (10 ms)", base.DEC),
+  prmcmd_hold_ms = ProtoField.uint32("pbdp.prmcmd.output_hold_time_ms", "Output_Hold_Time (ms)", base.DEC),
+  prmcmd_pure = ProtoField.bool("pbdp.prmcmd.pure", "Pure PrmCmd (Set_Prm = header, DPV1_Status, PrmCmd block only)"),
+  -- ... and the Prm_Cmd_Ack (0x9E) / Red_Status (0x9F) status blocks in the diagnosis (§G.3).
+  red_status_type = ProtoField.uint8("pbdp.red.status_type", "Status_Type", base.HEX, status_types),
+  red_slot = ProtoField.uint8("pbdp.red.slot", "Slot_Number", base.DEC),
+  red_spec = ProtoField.uint8("pbdp.red.specifier", "Specifier/Seq_Nr", base.HEX),
   red_seq = ProtoField.uint8("pbdp.red.seq_nr", "Seq_Nr", base.DEC, nil, 0xF8),
-  red_function = ProtoField.uint8("pbdp.red.function", "Function", base.HEX),
-  red_primary_req = ProtoField.bool("pbdp.red.primary_request", "Primary_Request", 8, nil, 0x02),
-  red_stop_msac1s = ProtoField.bool("pbdp.red.stop_msac1s", "Stop_MSAC1S", 8, nil, 0x04),
-  red_start_msac1s = ProtoField.bool("pbdp.red.start_msac1s", "Start_MSAC1S", 8, nil, 0x08),
-  red_check_props = ProtoField.bool("pbdp.red.check_properties", "Check_Properties", 8, nil, 0x10),
-  red_msc = ProtoField.bool("pbdp.red.master_state_clear", "Master_State_Clear", 8, nil, 0x40),
-  red_properties = ProtoField.uint8("pbdp.red.properties", "Properties", base.HEX),
-  red_hold = ProtoField.uint16("pbdp.red.output_hold_time", "Output_Hold_Time (10 ms)", base.DEC),
+  red_spec_bits = ProtoField.uint8("pbdp.red.specifier_bits", "Status_Specifier", base.DEC, status_spec_names, 0x03),
+  red_function = ProtoField.uint8("pbdp.red.function", "Function (echo)", base.HEX),
+  red_functions = ProtoField.string("pbdp.red.functions", "Functions echoed"),
   red_state_1 = ProtoField.uint8("pbdp.red.state_1", "Red_State_1 (this interface)", base.HEX),
   red_state_2 = ProtoField.uint8("pbdp.red.state_2", "Red_State_2 (partner)", base.HEX),
   red_state_3 = ProtoField.uint8("pbdp.red.state_3", "Red_State_3", base.HEX),
+  red_own = ProtoField.string("pbdp.red.own", "This interface"),
+  red_partner = ProtoField.string("pbdp.red.partner", "Partner interface"),
   red_state_text = ProtoField.string("pbdp.red.state", "Redundancy state"),
   -- Chk_Cfg / Get_Cfg
   cfg_id = ProtoField.uint8("pbdp.cfg.id", "Identifier", base.HEX),
@@ -296,6 +334,24 @@ local D = {
   new_address = ProtoField.uint8("pbdp.ssa.new_address", "New_Slave_Address", base.DEC),
   no_add_chg = ProtoField.uint8("pbdp.ssa.no_add_chg", "No_Add_Chg", base.HEX),
   rem_data = ProtoField.bytes("pbdp.ssa.rem_slave_data", "Rem_Slave_Data"),
+}
+-- Bit fields of the redundancy octets: pbdp.prmcmd.<bit>, pbdp.prmcmd.properties.<bit>,
+-- pbdp.red.function.<bit>, pbdp.red.state_1.<bit>, pbdp.red.state_2.<bit>.
+local function bit_fields(prefix, bits)
+  local out = {}
+  for _, b in ipairs(bits) do
+    local f = ProtoField.bool(prefix .. "." .. b[3], b[2], 8, nil, b[1])
+    table.insert(out, f)
+    D[prefix .. "." .. b[3]] = f
+  end
+  return out
+end
+local RB = {
+  prmcmd_function = bit_fields("pbdp.prmcmd", red_function_bits),
+  prmcmd_properties = bit_fields("pbdp.prmcmd.properties", prmcmd_property_bits),
+  red_function = bit_fields("pbdp.red.function", red_function_bits),
+  red_state_1 = bit_fields("pbdp.red.state_1", red_state_bits),
+  red_state_2 = bit_fields("pbdp.red.state_2", red_state_bits),
 }
 dp.fields = {}
 for _, f in pairs(D) do table.insert(dp.fields, f) end
@@ -386,6 +442,130 @@ local function short(tree, need, have)
 end
 
 ------------------------------------------------------------------------------------------------
+-- Slave redundancy (§G.2/G.3)
+
+-- Names of the bits set in v, joined with sep; `col` picks the name column (2 = full name).
+local prmcmd_block, red_status_block
+
+local function bit_names(v, bits, sep, col)
+  local out = {}
+  for _, b in ipairs(bits) do
+    if bit.band(v, b[1]) ~= 0 then table.insert(out, b[col or 2]) end
+  end
+  return table.concat(out, sep)
+end
+
+local function add_bits(item, fields, range)
+  for _, f in ipairs(fields) do item:add(f, range) end
+end
+
+-- The PrmCmd structured block in Set_Prm (§G.2), `blen` octets declared at `pos`, `have`
+-- present. Returns the info text, e.g. "PrmCmd Primary_Request".
+function prmcmd_block(tvb, pos, blen, have, tree)
+  local b = tree:add(D.prmcmd, tvb(pos, have))
+  b:add(D.prmcmd_len, tvb(pos, 1))
+  b:add(D.prmcmd_type, tvb(pos + 1, 1))
+  local fn = ""
+  if have >= 3 then
+    b:add(D.prmcmd_slot, tvb(pos + 2, 1))
+    local slot = tvb(pos + 2, 1):uint()
+    if slot ~= 0 then b:add_proto_expert_info(E.prmcmd, string.format("Slot_Number %d, a PrmCmd has slot 0", slot)) end
+  end
+  if have >= 4 then
+    local sp = b:add(D.prmcmd_spec, tvb(pos + 3, 1))
+    sp:add(D.prmcmd_seq, tvb(pos + 3, 1))
+    sp:add(D.prmcmd_spec_bits, tvb(pos + 3, 1))
+  end
+  if have >= 5 then
+    local v = tvb(pos + 4, 1):uint()
+    local fi = b:add(D.prmcmd_function, tvb(pos + 4, 1))
+    add_bits(fi, RB.prmcmd_function, tvb(pos + 4, 1))
+    fn = bit_names(v, red_function_bits, "+")
+    b:add(D.prmcmd_functions, tvb(pos + 4, 1), fn ~= "" and fn or "none")
+  end
+  if have >= 6 then
+    local pr = b:add(D.prmcmd_properties, tvb(pos + 5, 1))
+    add_bits(pr, RB.prmcmd_properties, tvb(pos + 5, 1))
+  end
+  local hold_ms
+  if have >= 8 then
+    b:add(D.prmcmd_hold, tvb(pos + 6, 2))
+    hold_ms = tvb(pos + 6, 2):uint() * 10
+    b:add(D.prmcmd_hold_ms, tvb(pos + 6, 2), hold_ms):set_generated()
+  end
+  if blen ~= 8 then
+    b:add_proto_expert_info(E.prmcmd, string.format("Structure_Length %d, a PrmCmd block has 8 octets", blen))
+  end
+  if have < blen then
+    b:add_proto_expert_info(E.prmcmd, string.format("PrmCmd block cut short: %d of %d octets", have, blen))
+  elseif have > 8 then
+    b:add(D.blk_data, tvb(pos + 8, have - 8))
+  end
+  b:set_text(string.format("PrmCmd block: %s%s", fn ~= "" and fn or "no function",
+    hold_ms and string.format(", Output_Hold_Time %d ms", hold_ms) or ""))
+  return "PrmCmd" .. (fn ~= "" and (" " .. fn) or "")
+end
+
+-- One Red_State octet: its field with the bit subfields, and the short names ("Primary+DX").
+local function red_state(tree, field, bitfields, range)
+  local it = tree:add(field, range)
+  add_bits(it, bitfields, range)
+  local short = bit_names(range:uint(), red_state_bits, "+", 4)
+  it:append_text(" (" .. (short ~= "" and short or "none") .. ")")
+  return short ~= "" and short or "none", bit_names(range:uint(), red_state_bits, ", ")
+end
+
+-- A Prm_Cmd_Ack (0x9E) or Red_Status (0x9F) status block in the diagnosis (§G.3): `blen`
+-- octets declared at `off` (the header), `have` present. Returns the info text.
+function red_status_block(tvb, off, blen, have, tree)
+  local t = tvb(off + 1, 1):uint()
+  local name = status_types[t]
+  tree:add(D.red_status_type, tvb(off + 1, 1))
+  if have >= 3 then tree:add(D.red_slot, tvb(off + 2, 1)) end
+  if have >= 4 then
+    local sp = tree:add(D.red_spec, tvb(off + 3, 1))
+    sp:add(D.red_seq, tvb(off + 3, 1))
+    sp:add(D.red_spec_bits, tvb(off + 3, 1))
+  end
+  local fn = ""
+  if have >= 5 then
+    local fi = tree:add(D.red_function, tvb(off + 4, 1))
+    add_bits(fi, RB.red_function, tvb(off + 4, 1))
+    fn = bit_names(tvb(off + 4, 1):uint(), red_function_bits, "+")
+    tree:add(D.red_functions, tvb(off + 4, 1), fn ~= "" and fn or "none")
+  end
+  local own, partner, own_long, partner_long
+  if have >= 6 then
+    own, own_long = red_state(tree, D.red_state_1, RB.red_state_1, tvb(off + 5, 1))
+    tree:add(D.red_own, tvb(off + 5, 1), own_long ~= "" and own_long or "none")
+  end
+  if have >= 7 then
+    partner, partner_long = red_state(tree, D.red_state_2, RB.red_state_2, tvb(off + 6, 1))
+    tree:add(D.red_partner, tvb(off + 6, 1), partner_long ~= "" and partner_long or "none")
+  end
+  if have >= 8 then tree:add(D.red_state_3, tvb(off + 7, 1)) end
+  if have > 8 then tree:add(V.diag_data, tvb(off + 8, have - 8)) end
+  if blen ~= 8 then
+    tree:add_proto_expert_info(E.red, string.format("%s block of %d octets, expected 8", name, blen))
+  end
+  if have < math.min(blen, 8) then
+    tree:add_proto_expert_info(E.red, string.format("%s block cut short: %d of %d octets", name, have, blen))
+  end
+  local text = name
+  if t == 0x9E and fn ~= "" then text = text .. " " .. fn end
+  if own then
+    text = text .. " own " .. own
+    if partner then text = text .. ", partner " .. partner end
+    tree:add(D.red_state_text, tvb(off + 5, partner and 2 or 1),
+      "own " .. (own_long ~= "" and own_long or "none") ..
+      (partner and ("; partner " .. (partner_long ~= "" and partner_long or "none")) or ""))
+  else
+    text = text .. " (cut short)"
+  end
+  return text
+end
+
+------------------------------------------------------------------------------------------------
 -- DP decoders; each returns a short text for the info column (may be "").
 local function dp_set_prm(tvb, off, len, tree)
   if short(tree, 7, len) then return "" end
@@ -415,36 +595,51 @@ local function dp_set_prm(tvb, off, len, tree)
     user = off + 10
   end
   local extra = ""
-  if len >= 10 and bit.band(tvb(off + 9, 1):uint(), 0x08) ~= 0 then
-    -- Prm_Structure: the rest is a sequence of structured blocks (§D.2, §G.2).
+  local s3 = (len >= 10) and tvb(off + 9, 1):uint() or 0
+  local prmcmd_bit = bit.band(s3, 0x80) ~= 0
+  local structured = bit.band(s3, 0x08) ~= 0
+  if len >= 10 and (structured or prmcmd_bit) then
+    -- Prm_Structure: the rest is a sequence of structured blocks (§D.2, §G.2). PrmCmd without
+    -- Prm_Structure still means a PrmCmd block follows: decoded, with a warning.
+    if prmcmd_bit and not structured then
+      tree:add_proto_expert_info(E.prmcmd_bits, "DPV1_Status_3 has PrmCmd but not Prm_Structure; blocks decoded anyway")
+    end
     local pos, stop = user, off + len
+    local nblocks, prmcmds = 0, 0
     while pos < stop do
+      local remain = stop - pos
       local blen = tvb(pos, 1):uint()
-      if blen < 4 or pos + blen > stop then
+      local btype = (remain >= 2) and tvb(pos + 1, 1):uint() or -1
+      nblocks = nblocks + 1
+      if btype == 0x02 and blen >= 2 then
+        prmcmds = prmcmds + 1
+        extra = extra .. " " .. prmcmd_block(tvb, pos, blen, math.min(blen, remain), tree)
+        if blen > remain then break end
+        pos = pos + blen
+      elseif blen < 4 or blen > remain then
         tree:add_proto_expert_info(E.dp, string.format("structured block of length %d at octet %d does not fit", blen, pos - off + 1))
-        tree:add(D.user_prm_data, tvb(pos, stop - pos))
+        tree:add(D.user_prm_data, tvb(pos, remain))
         break
+      else
+        local b = tree:add(D.blk_type, tvb(pos + 1, 1))
+        b:set_text(string.format("Structured block: %s, %d octets", prm_block_types[btype] or string.format("type 0x%02X", btype), blen))
+        b:add(D.blk_len, tvb(pos, 1))
+        b:add(D.blk_slot, tvb(pos + 2, 1))
+        b:add(D.blk_spec, tvb(pos + 3, 1))
+        if blen > 4 then b:add(D.blk_data, tvb(pos + 4, blen - 4)) end
+        pos = pos + blen
       end
-      local btype = tvb(pos + 1, 1):uint()
-      local b = tree:add(D.blk_type, tvb(pos + 1, 1))
-      b:set_text(string.format("Structured block: %s, %d octets", prm_block_types[btype] or string.format("type 0x%02X", btype), blen))
-      b:add(D.blk_len, tvb(pos, 1))
-      b:add(D.blk_slot, tvb(pos + 2, 1))
-      b:add(D.blk_spec, tvb(pos + 3, 1))
-      if btype == 0x02 and blen >= 8 then
-        b:add(D.red_seq, tvb(pos + 3, 1))
-        local fi = b:add(D.red_function, tvb(pos + 4, 1))
-        for _, f in ipairs({ D.red_primary_req, D.red_stop_msac1s, D.red_start_msac1s, D.red_check_props, D.red_msc }) do
-          fi:add(f, tvb(pos + 4, 1))
-        end
-        b:add(D.red_properties, tvb(pos + 5, 1))
-        b:add(D.red_hold, tvb(pos + 6, 2))
-        local fn = bits_set(tvb(pos + 4, 1):uint(), red_function_bits)
-        extra = extra .. " PrmCmd" .. (fn ~= "" and (" " .. fn) or "")
-      elseif blen > 4 then
-        b:add(D.blk_data, tvb(pos + 4, blen - 4))
-      end
-      pos = pos + blen
+    end
+    if prmcmd_bit and prmcmds == 0 then
+      tree:add_proto_expert_info(E.prmcmd_bits, "DPV1_Status_3 has PrmCmd but no PrmCmd block (type 0x02) follows")
+    elseif prmcmds > 0 and not prmcmd_bit then
+      tree:add_proto_expert_info(E.prmcmd_bits, "PrmCmd block without the PrmCmd bit in DPV1_Status_3")
+    end
+    -- A pure PrmCmd: nothing but the DP header, the DPV1_Status octets and one 8-octet block
+    -- (§G.2: 7 + 3 + 8 = 18 octets; the VPC3 skips its normal parameter check for it).
+    if prmcmds == 1 and nblocks == 1 and len == 18 and tvb(user, 1):uint() == 8 then
+      tree:add(D.prmcmd_pure, tvb(off, len), true):set_generated()
+      extra = " pure" .. extra
     end
   elseif off + len > user then
     tree:add(D.user_prm_data, tvb(user, off + len - user))
@@ -540,7 +735,7 @@ local s2_bits = {
 }
 
 -- DP-V1 alarm or status PDU inside a device-related block (§D.5, §E.5).
-local function dpv1_diag_block(tvb, off, blen, tree)
+local function dpv1_diag_block(tvb, off, blen, tree, declared)
   local t = tvb(off + 1, 1):uint()
   local sub = tree:add(dpv1, tvb(off, blen))
   if bit.band(t, 0x80) == 0 then
@@ -553,27 +748,16 @@ local function dpv1_diag_block(tvb, off, blen, tree)
     sp:add(V.spec, tvb(off + 3, 1))
     if blen > 4 then sub:add(V.diag_data, tvb(off + 4, blen - 4)) end
     return "alarm " .. (alarm_types[t] or tostring(t))
+  elseif t == 0x9E or t == 0x9F then
+    -- Slave redundancy status (§G.3).
+    local what = red_status_block(tvb, off, declared or blen, blen, sub)
+    sub:set_text("DP-V1 status (slave redundancy): " .. what)
+    return what
   else
     sub:set_text(string.format("DP-V1 status: %s, slot %d", status_types[t] or string.format("0x%02X", t), tvb(off + 2, 1):uint()))
     sub:add(V.status_type, tvb(off + 1, 1))
     sub:add(V.slot, tvb(off + 2, 1))
     sub:add(V.status_spec, tvb(off + 3, 1))
-    if (t == 0x9E or t == 0x9F) and blen >= 7 then
-      -- Slave redundancy status (§G.3): function echo, own and partner Red_State.
-      sub:add(D.red_seq, tvb(off + 3, 1))
-      local fi = sub:add(D.red_function, tvb(off + 4, 1))
-      for _, f in ipairs({ D.red_primary_req, D.red_stop_msac1s, D.red_start_msac1s, D.red_check_props, D.red_msc }) do
-        fi:add(f, tvb(off + 4, 1))
-      end
-      sub:add(D.red_state_1, tvb(off + 5, 1))
-      sub:add(D.red_state_2, tvb(off + 6, 1))
-      if blen >= 8 then sub:add(D.red_state_3, tvb(off + 7, 1)) end
-      local own = bits_set(tvb(off + 5, 1):uint(), red_state_bits)
-      local partner = bits_set(tvb(off + 6, 1):uint(), red_state_bits)
-      local text = string.format("own %s; partner %s", own ~= "" and own or "-", partner ~= "" and partner or "-")
-      sub:add(D.red_state_text, tvb(off + 5, 2), text)
-      return status_types[t] .. " (" .. text .. ")"
-    end
     if blen > 4 then sub:add(V.diag_data, tvb(off + 4, blen - 4)) end
     return "status " .. (status_types[t] or string.format("0x%02X", t))
   end
@@ -599,8 +783,9 @@ local function dp_ext_diag(tvb, off, len, tree)
     if kind == 0 then
       b:add(D.ext_type, tvb(pos, 1), "device-related")
       b:add(D.ext_len, tvb(pos, 1), blen)
-      if have >= 4 and is_dpv1_type(tvb(pos + 1, 1):uint()) then
-        local what = dpv1_diag_block(tvb, pos, have, b)
+      local t2 = (have >= 2) and tvb(pos + 1, 1):uint() or 0
+      if (have >= 4 and is_dpv1_type(t2)) or (have >= 2 and (t2 == 0x9E or t2 == 0x9F)) then
+        local what = dpv1_diag_block(tvb, pos, have, b, blen)
         b:set_text("Device-related block: " .. what)
         table.insert(notes, what)
       else

@@ -8,6 +8,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -1547,6 +1548,23 @@ void GsdParser::finish() {
     warning(seen("dpv1_slave").value_or(m_section_line),
             "DPV1_Slave = 1 but User_Prm_Data has fewer than 3 bytes (DPV1_Status_1..3); "
             "missing status bytes assembled as 80 00 00");
+
+  // Slave redundancy (§G.7; bit meanings and unit are our decisions, gsd.hpp GsdRedundancy).
+  const auto& red = f.m_redundancy;
+  if (auto l = seen("slave_redundancy_supp"); l && red.reserved_redundancy_bits() != 0) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(red.slave_redundancy_supp));
+    warning(*l, std::string("Slave_Redundancy_supp ") + hex +
+                    " sets reserved bits (bit 0 = System Redundancy, bit 1 = Flying Redundancy); kept");
+  }
+  if (auto l = seen("slave_redundancy_supp"); l && red.slave_redundancy() && !red.prm_cmd_supp)
+    warning(*l, "Slave_Redundancy_supp without PrmCmd_supp = 1: a master cannot choose the primary");
+  if (auto l = seen("prmcmd_supp"); l && red.prm_cmd_supp) {
+    if (!f.m_dpv1.dpv1_slave)
+      warning(*l, "PrmCmd_supp = 1 without DPV1_Slave = 1 (the PrmCmd bit is in DPV1_Status_3)");
+    else if (!f.m_dpv1.prm_block_structure_supp && !f.m_dpv1.prm_block_structure_req)
+      warning(*l, "PrmCmd_supp = 1 without Prm_Block_Structure_supp = 1 (PrmCmd is a structured block)");
+  }
 
   for (const auto& slot : f.m_slots)
     if (!f.find_module_by_reference(slot.default_ref))

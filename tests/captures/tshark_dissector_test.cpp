@@ -327,7 +327,7 @@ TEST(TsharkDissectorMore, SegmentsPartialFramesAndPolls) {
 
 // Slave redundancy (protocol-facts.md §G.2/G.3): a Set_Prm with DPV1_Status_3 = PrmCmd |
 // Prm_Structure and an 8-octet PrmCmd block (Seq_Nr 1, Primary_Request, Output_Hold_Time 10 x
-// 10 ms), and a diagnosis with a Red_State status block (own: Primary + Data_Exchange; partner:
+// 10 ms), and a diagnosis with a Red_Status status block (own: Primary + Data_Exchange; partner:
 // Backup).
 TEST(TsharkDissectorMore, SlaveRedundancyBlocks) {
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
@@ -342,20 +342,17 @@ TEST(TsharkDissectorMore, SlaveRedundancyBlocks) {
   }
   using R = std::vector<std::string>;
   const auto rows = ts::tshark_fields(
-      path, {"_ws.col.Info", "pbdp.prm.prmcmd", "pbdp.prm.block_type", "pbdp.red.seq_nr",
-             "pbdp.red.primary_request", "pbdp.red.output_hold_time", "pbdp.red.state_1",
-             "pbdp.red.state_2", "pbdp.red.state"});
+      path, {"_ws.col.Info", "pbdp.prm.prmcmd", "pbdp.prmcmd.structure_type", "pbdp.prmcmd.seq_nr",
+             "pbdp.prmcmd.primary_request", "pbdp.prmcmd.output_hold_time", "pbdp.red.seq_nr",
+             "pbdp.red.state_1", "pbdp.red.state_2", "pbdp.red.state"});
   std::filesystem::remove(path);
   ASSERT_EQ(rows.size(), 2u);
-  EXPECT_EQ(
-      rows[0],
-      (R{"SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms PrmCmd Primary_Request FCB=0 FCV=1",
-         "1", "0x02", "1", "1", "10", "", "", ""}));
-  EXPECT_EQ(
-      rows[1],
-      (R{"10→1 DL Slave_Diag.res ident 0x1234 master 1 [Ext_Diag, WD_On] ext: Red_State "
-         "(own Primary, Data_Exchange; partner Backup)",
-         "", "", "1", "1", "", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
+  // More cases in tshark_redundancy_test.cpp.
+  EXPECT_EQ(rows[0], (R{"SRD_high 1→10 Set_Prm.req ident 0x1234 WD 1000 ms pure PrmCmd Primary_Request FCB=0 FCV=1",
+                        "1", "0x02", "1", "1", "10", "", "", "", ""}));
+  EXPECT_EQ(rows[1], (R{"10→1 DL Slave_Diag.res ident 0x1234 master 1 [Ext_Diag, WD_On] ext: Red_Status "
+                        "own Primary+DX, partner Backup",
+                        "", "", "", "", "", "1", "0x0a", "0x01", "own Primary, Data_Exchange; partner Backup"}));
 }
 
 // MSAC_C2 (protocol-facts.md §E.6): Initiate.req to the resource manager (SAP 49) from the

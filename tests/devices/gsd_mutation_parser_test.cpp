@@ -134,7 +134,7 @@ TEST(GsdMutation, NeverCrashesAndAlwaysLocatesErrors) {
   const std::vector<std::string> seeds = {
       read("examples/gsd/PBVB0A01.gsd"), read("examples/gsd/PBVB0A02.gsd"),
       read("examples/gsd/PBVB0A03.gsd"), read("tests/data/gsd/VNDR4711.gsd"),
-      read("tests/data/gsd/vendor-quirks/profisafe-module.gsd")};
+      read("tests/data/gsd/vendor-quirks/profisafe-module.gsd"), read("examples/gsd/PBVB0A10.gsd")};
   for (const auto& s : seeds) ASSERT_FALSE(s.empty());
 
   SplitMix64 rng{0x5EED'0000'0122ULL};

@@ -73,7 +73,8 @@ TEST(Gsd, EveryGsdFileInTheRepositoryParses) {
 }
 
 TEST(Gsd, ShippedFilesHaveNoWarnings) {
-  for (const char* f : {"examples/gsd/PBVB0A01.gsd", "examples/gsd/PBVB0A02.gsd", "examples/gsd/PBVB0A03.gsd"}) {
+  for (const char* f : {"examples/gsd/PBVB0A01.gsd", "examples/gsd/PBVB0A02.gsd", "examples/gsd/PBVB0A03.gsd",
+                        "examples/gsd/PBVB0A10.gsd", "examples/gsd/PBVB0A11.gsd"}) {
     GsdParseResult r = load_gsd(src(f));
     ASSERT_TRUE(r.ok()) << f;
     for (const auto& w : r.warnings) ADD_FAILURE() << w.to_string();

@@ -318,3 +318,68 @@ TEST(CmdGsd, ReadsEveryGsdFileOfTheRepository) {
     EXPECT_EQ(python_on_json(r.out, "d['file']"), file + "\n");
   }
 }
+
+// The shipped switched stations (PI 2.212 slave redundancy, §G.7): the redundancy keywords, and
+// what pbvbus reads them as (bit 0 System, bit 1 Flying Redundancy; 10 ms units), in text and
+// JSON. A file without them says "not supported".
+TEST(CmdGsd, SwitchedStationRedundancyText) {
+  GsdRun r = run({src("examples/gsd/PBVB0A10.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(has_line(r.out, "Ident_Number:       0x0A10"));
+  EXPECT_TRUE(has_line(r.out, "Redundancy:         Redundancy 0, PrmCmd_supp 1, Slave_Redundancy_supp 1, "
+                              "Slave_Max_Switch_Over_Time 3"))
+      << r.out;
+  EXPECT_TRUE(has_line(r.out, "  slave redundancy: System 1, Flying 0; max switchover 30 ms"));
+  EXPECT_TRUE(has_line(r.out, "  Prm_Block_Structure_supp 1, Prm_Block_Structure_req 0, Fail_Safe_required 0"));
+  EXPECT_TRUE(has_line(r.out, "  [2] \"4AI U/I 13 bit\" ref 3: cfg 0xD3, in 8, out 0, consistent"));
+  EXPECT_TRUE(has_line(r.out, "  12M     MaxTsdr 800"));
+
+  r = run({src("examples/gsd/PBVB0A11.gsd")});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_TRUE(has_line(r.out, "Redundancy:         Redundancy 0, PrmCmd_supp 1, Slave_Redundancy_supp 3, "
+                              "Slave_Max_Switch_Over_Time 82"));
+  EXPECT_TRUE(has_line(r.out, "  slave redundancy: System 1, Flying 1; max switchover 820 ms"));
+  EXPECT_TRUE(has_line(r.out, "  1.5M    MaxTsdr 300"));
+  EXPECT_FALSE(has_line(r.out, "  12M     MaxTsdr 800"));
+
+  r = run({src("examples/gsd/PBVB0A01.gsd")});
+  EXPECT_TRUE(has_line(r.out, "  slave redundancy: not supported"));
+  // Reserved bits are named; the warning goes to stderr.
+  r = run({src("tests/data/gsd/VNDR4711.gsd")});
+  EXPECT_TRUE(has_line(r.out, "  slave redundancy: System 0, Flying 0, reserved bits 0x08; max switchover 1000 ms"));
+  EXPECT_TRUE(has_line(r.err, src("tests/data/gsd/VNDR4711.gsd") +
+                                  ":45: warning: Slave_Redundancy_supp 0x08 sets reserved bits (bit 0 = System "
+                                  "Redundancy, bit 1 = Flying Redundancy); kept"))
+      << r.err;
+}
+
+TEST(CmdGsd, SwitchedStationRedundancyJson) {
+  GsdRun r = run({src("examples/gsd/PBVB0A10.gsd"), "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(python_on_json(r.out, sorted_items("d['redundancy']")),
+            "flying_redundancy=false\n"
+            "prm_cmd_supp=true\n"
+            "redundancy=false\n"
+            "slave_max_switch_over_time=3\n"
+            "slave_redundancy_supp=1\n"
+            "switch_over_time_ms=30\n"
+            "system_redundancy=true\n");
+  EXPECT_EQ(python_on_json(r.out, "d['ident_number'], len(d['modules']), d['baud_rates'][0]['max_tsdr']"),
+            "2576 3 60\n");
+  r = run({src("examples/gsd/PBVB0A11.gsd"), "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(python_on_json(r.out, sorted_items("d['redundancy']")),
+            "flying_redundancy=true\n"
+            "prm_cmd_supp=true\n"
+            "redundancy=false\n"
+            "slave_max_switch_over_time=82\n"
+            "slave_redundancy_supp=3\n"
+            "switch_over_time_ms=820\n"
+            "system_redundancy=true\n");
+  r = run({src("examples/gsd/PBVB0A01.gsd"), "--json"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_EQ(python_on_json(r.out, "d['redundancy']['switch_over_time_ms'], d['redundancy']['system_redundancy']"),
+            "None False\n");
+}

@@ -222,6 +222,19 @@ void print_text(const GsdFile& f, std::ostream& out) {
   out << "\nRedundancy:         Redundancy " << yn(r.redundancy) << ", PrmCmd_supp " << yn(r.prm_cmd_supp)
       << ", Slave_Redundancy_supp " << int(r.slave_redundancy_supp)
       << ", Slave_Max_Switch_Over_Time " << r.slave_max_switch_over_time << "\n";
+  // Bit meanings and unit are pbvbus's reading (gsd.hpp GsdRedundancy).
+  if (!r.prm_cmd_supp && r.slave_redundancy_supp == 0 && r.slave_max_switch_over_time == 0) {
+    out << "  slave redundancy: not supported\n";
+  } else {
+    out << "  slave redundancy: System " << yn(r.system_redundancy()) << ", Flying " << yn(r.flying_redundancy());
+    if (r.reserved_redundancy_bits() != 0) out << ", reserved bits " << hex_byte(r.reserved_redundancy_bits());
+    out << "; max switchover ";
+    if (auto ms = r.switch_over_time_ms())
+      out << *ms << " ms";
+    else
+      out << "not stated";
+    out << "\n";
+  }
 }
 
 // --- JSON output -------------------------------------------------------------------------------
@@ -359,7 +372,11 @@ void print_json(const GsdFile& f, const std::vector<devices::GsdMessage>& warnin
   const auto& r = f.redundancy();
   out << "  \"redundancy\": {\"redundancy\": " << jb(r.redundancy) << ", \"prm_cmd_supp\": " << jb(r.prm_cmd_supp)
       << ", \"slave_redundancy_supp\": " << int(r.slave_redundancy_supp)
-      << ", \"slave_max_switch_over_time\": " << r.slave_max_switch_over_time << "},\n";
+      << ", \"slave_max_switch_over_time\": " << r.slave_max_switch_over_time
+      << ", \"system_redundancy\": " << jb(r.system_redundancy())
+      << ", \"flying_redundancy\": " << jb(r.flying_redundancy())
+      << ", \"switch_over_time_ms\": "
+      << (r.switch_over_time_ms() ? std::to_string(*r.switch_over_time_ms()) : std::string("null")) << "},\n";
   const auto& m = f.master();
   auto opt = [](const auto& o) { return o ? std::to_string(*o) : std::string("null"); };
   auto per_baud = [](const std::map<bus::Baud, std::uint16_t>& mp) {

@@ -293,12 +293,56 @@ struct GsdDpv1Features {
   bool operator==(const GsdDpv1Features&) const = default;
 };
 
-/// Redundancy keywords (§G.7).
+/// Redundancy keywords (§G.7): the redundant medium and slave redundancy (PI 2.212).
+///
+/// A keyword that is missing means "not supported": PrmCmd_supp 0, Slave_Redundancy_supp 0,
+/// Slave_Max_Switch_Over_Time not stated (0). Values outside Boolean / Unsigned8 / Unsigned16 are
+/// errors ("file:line: ..."); the raw values are kept as the file writes them.
+///
+/// Decisions where our sources are silent (protocol-facts.md §G.7 marks both [U]; PI 2.212 and
+/// the redundancy part of PI 2.122 were not consulted):
+/// - Slave_Redundancy_supp is a bit set of the redundancy types of PI 2.212 (§G.1): bit 0 (0x01)
+///   = System Redundancy (two lines, same address), bit 1 (0x02) = Flying Redundancy (one line,
+///   backup at address + 64). Bits 2..7 are taken as reserved: kept, and the reader warns.
+///   [assumption: the order follows the order in which PI 2.212 and the device manuals (Stahl,
+///   AUMA) introduce the two types; the value 0 = no slave redundancy is certain]
+/// - Slave_Max_Switch_Over_Time is in units of 10 ms, 0 = not stated. [assumption: every time in
+///   a DP GSD or telegram that is not a bit time is in 10 ms (C1/C2_Response_Timeout,
+///   Min_Poll_Timeout, the watchdog base), and above all the PrmCmd Output_Hold_Time (§G.2) that
+///   a master derives from this value is in 10 ms; with 10 ms, Unsigned16 reaches 655 s, while the
+///   device figures of §G.5 (tens of ms up to about 1 s) would leave 1 ms or 100 us units
+///   needlessly fine and 100 ms too coarse for a fast interface module]
+/// - The reader also warns when the keywords contradict each other: slave redundancy without
+///   PrmCmd_supp (the master could not choose the primary), PrmCmd_supp without DPV1_Slave
+///   (the PrmCmd bit is in DPV1_Status_3) or without Prm_Block_Structure_supp (the PrmCmd is a
+///   structured parameter block, §D.2/§G.2).
+/// Nothing here drives behaviour by itself: the redundancy layer reads these values.
 struct GsdRedundancy {
-  bool redundancy = false;  ///< redundant transmission medium, not slave redundancy
-  bool prm_cmd_supp = false;
-  std::uint8_t slave_redundancy_supp = 0;
-  std::uint16_t slave_max_switch_over_time = 0;
+  static constexpr std::uint8_t kSystemRedundancy = 0x01;  ///< Slave_Redundancy_supp bit 0 [U]
+  static constexpr std::uint8_t kFlyingRedundancy = 0x02;  ///< Slave_Redundancy_supp bit 1 [U]
+  static constexpr std::uint8_t kReservedBits = 0xFC;
+  static constexpr std::uint32_t kSwitchOverUnitMs = 10;  ///< Slave_Max_Switch_Over_Time unit [U]
+
+  bool redundancy = false;  ///< `Redundancy`: redundant transmission medium, not slave redundancy
+  bool prm_cmd_supp = false;  ///< PrmCmd_supp: understands the PrmCmd block in Set_Prm (§G.2)
+  std::uint8_t slave_redundancy_supp = 0;  ///< raw bit set, see above
+  std::uint16_t slave_max_switch_over_time = 0;  ///< raw, unit 10 ms; 0 = not stated
+
+  bool system_redundancy() const { return (slave_redundancy_supp & kSystemRedundancy) != 0; }
+  bool flying_redundancy() const { return (slave_redundancy_supp & kFlyingRedundancy) != 0; }
+  std::uint8_t reserved_redundancy_bits() const { return slave_redundancy_supp & kReservedBits; }
+  /// Any slave redundancy type declared (System or Flying).
+  bool slave_redundancy() const { return system_redundancy() || flying_redundancy(); }
+  /// The station's own switchover time T_SLAVE_UM in ms, nullopt when the file does not state it.
+  std::optional<std::uint32_t> switch_over_time_ms() const {
+    if (slave_max_switch_over_time == 0) return std::nullopt;
+    return std::uint32_t{slave_max_switch_over_time} * kSwitchOverUnitMs;
+  }
+  /// The same in scheduler ticks (0 when not stated).
+  bus::Ticks switch_over_time() const {
+    return static_cast<bus::Ticks>(slave_max_switch_over_time) * kSwitchOverUnitMs * bus::kTicksPerMs;
+  }
+  bool operator==(const GsdRedundancy&) const = default;
 };
 
 /// Master GSD keywords (Station_Type = 1), §I.2.

@@ -172,9 +172,9 @@ GsdOutcome<dp::SlaveParams> master_slave_params(const GsdFile& gsd,
   return out;
 }
 
-SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleChoice>& modules,
-                                  SlaveModelOptions options) {
-  SlaveModelBuild r;
+SlaveSetup derive_slave_setup(const GsdFile& gsd, const std::vector<ModuleChoice>& modules,
+                              const SlaveModelOptions& options) {
+  SlaveSetup r;
   const fdl::BusParams& bp = options.bus_params;
   if (gsd.is_master()) r.errors.push_back(short_name(gsd) + " describes a DP master, not a slave");
   if (options.address > 126)
@@ -280,6 +280,26 @@ SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleCh
   for (std::size_t i : chosen) cfg.modules.push_back({gsd.modules()[i].config, gsd.modules()[i].name});
   cfg.min_slave_interval = std::max<std::uint16_t>(1, sf.min_slave_intervall);
   cfg.max_diag_len = std::clamp<std::size_t>(sf.max_diag_data_len, dp::kStdDiagLen, dp::kMaxDiagLen);
+  r.modules = std::move(chosen);
+  r.user_prm = std::move(prm);
+  r.tsdr = tsdr;
+  r.config = std::move(cfg);
+  return r;
+}
+
+SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleChoice>& modules,
+                                  SlaveModelOptions options) {
+  SlaveModelBuild r;
+  SlaveSetup s = derive_slave_setup(gsd, modules, options);
+  r.errors = std::move(s.errors);
+  r.notes = std::move(s.notes);
+  if (!r.errors.empty()) return r;
+  const fdl::BusParams& bp = options.bus_params;
+  const GsdDpv1Features& v1 = gsd.dpv1();
+  const std::uint32_t tsdr = s.tsdr;
+  const std::vector<std::size_t>& chosen = s.modules;
+  dp::SlaveConfig cfg = std::move(s.config);
+  GsdBytes prm = std::move(s.user_prm);
 
   std::unique_ptr<SlaveModel> m(new SlaveModel());
   try {
@@ -321,28 +341,64 @@ std::string SlaveModel::set_behaviour(std::size_t module, IoBehaviour b) {
   if (module >= m_modules.size()) return "module " + std::to_string(module) + " does not exist";
   const std::size_t len = m_engine->layout().modules[module].in_len;
   if (len == 0) return "module " + std::to_string(module) + " has no inputs";
-  std::vector<Channel> keep;
+  std::vector<ChannelBehaviour> keep;
   keep.swap(m_modules[module].channels);
   std::string err = add_channel_behaviour(module, 0, len, std::move(b));
   if (!err.empty()) keep.swap(m_modules[module].channels);
   return err;
 }
 
-std::string SlaveModel::add_channel_behaviour(std::size_t module, std::size_t offset, std::size_t width,
-                                              IoBehaviour b) {
-  if (module >= m_modules.size()) return "module " + std::to_string(module) + " does not exist";
-  const std::size_t len = m_engine->layout().modules[module].in_len;
+std::string check_channel_behaviour(const dp::SlaveLayout& layout, std::size_t module,
+                                    std::size_t offset, std::size_t width, const IoBehaviour& b) {
+  if (module >= layout.modules.size()) return "module " + std::to_string(module) + " does not exist";
+  const std::size_t len = layout.modules[module].in_len;
   if (width == 0 || offset + width > len)
     return "module " + std::to_string(module) + ": channel octets " + std::to_string(offset) + "+" +
            std::to_string(width) + " outside its " + std::to_string(len) + " input octets";
-  if (std::string e = check_behaviour(b, m_modules.size()); !e.empty())
+  if (std::string e = check_behaviour(b, layout.modules.size()); !e.empty())
     return "module " + std::to_string(module) + ": " + e;
   if (b.kind == IoBehaviour::Kind::Echo) {
     const std::size_t src = b.source_module.value_or(module);
-    if (m_engine->layout().modules[src].out_len == 0)
+    if (layout.modules[src].out_len == 0)
       return "module " + std::to_string(module) + ": echo source module " + std::to_string(src) +
              " has no outputs";
   }
+  return {};
+}
+
+void apply_channel_behaviours(std::span<std::uint8_t> buf, std::size_t module,
+                              const std::vector<ChannelBehaviour>& channels, bus::Ticks now,
+                              std::uint64_t cycles, const EchoSource& outputs) {
+  for (const ChannelBehaviour& c : channels) {
+    auto dst = buf.begin() + static_cast<std::ptrdiff_t>(c.offset);
+    const IoBehaviour& b = c.behaviour;
+    switch (b.kind) {
+      case IoBehaviour::Kind::Constant:
+        for (std::size_t i = 0; i < c.width; ++i)
+          dst[static_cast<std::ptrdiff_t>(i)] = i < b.constant.size() ? b.constant[i] : 0;
+        break;
+      case IoBehaviour::Kind::Echo: {
+        const std::span<const std::uint8_t> ob = outputs(b.source_module.value_or(module));
+        for (std::size_t i = 0; i < c.width; ++i)
+          dst[static_cast<std::ptrdiff_t>(i)] = i < ob.size() ? ob[i] : 0;
+        break;
+      }
+      default: {
+        auto u = static_cast<std::uint64_t>(behaviour_value(b, now, cycles));
+        for (std::size_t i = c.width; i-- > 0;) {  // as put_big_endian()
+          dst[static_cast<std::ptrdiff_t>(i)] = static_cast<std::uint8_t>(u & 0xFF);
+          u >>= 8;
+        }
+        break;
+      }
+    }
+  }
+}
+
+std::string SlaveModel::add_channel_behaviour(std::size_t module, std::size_t offset, std::size_t width,
+                                              IoBehaviour b) {
+  if (std::string e = check_channel_behaviour(m_engine->layout(), module, offset, width, b); !e.empty())
+    return e;
   m_modules[module].channels.push_back({offset, width, std::move(b)});
   return {};
 }
@@ -358,26 +414,11 @@ void SlaveModel::refresh_inputs(bus::Ticks now) {
       std::fill(buf.begin(), buf.end(), std::uint8_t{0});
     } else {
       app.image().inputs(m).read(buf);
-      for (const Channel& c : mod.channels) {
-        auto dst = m_scratch.begin() + static_cast<std::ptrdiff_t>(c.offset);
-        const IoBehaviour& b = c.behaviour;
-        switch (b.kind) {
-          case IoBehaviour::Kind::Constant:
-            for (std::size_t i = 0; i < c.width; ++i)
-              dst[static_cast<std::ptrdiff_t>(i)] = i < b.constant.size() ? b.constant[i] : 0;
-            break;
-          case IoBehaviour::Kind::Echo: {
-            const std::size_t src = b.source_module.value_or(m);
-            const std::size_t olen = app.module(src).out_len;
-            std::span<std::uint8_t> ob(m_out_scratch.data(), olen);
-            app.read_outputs(src, ob);
-            for (std::size_t i = 0; i < c.width; ++i)
-              dst[static_cast<std::ptrdiff_t>(i)] = i < olen ? ob[i] : 0;
-            break;
-          }
-          default: put_big_endian(behaviour_value(b, now, m_dp_cycles), dst, c.width); break;
-        }
-      }
+      apply_channel_behaviours(buf, m, mod.channels, now, m_dp_cycles, [&](std::size_t src) {
+        std::span<std::uint8_t> ob(m_out_scratch.data(), app.module(src).out_len);
+        app.read_outputs(src, ob);
+        return std::span<const std::uint8_t>(ob);
+      });
     }
     app.write_inputs(m, buf);
   }

@@ -49,6 +49,8 @@
 //   time are known in advance and survive power cycles.
 
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <memory>
 #include <optional>
 #include <string>
@@ -83,6 +85,23 @@ struct SlaveModelOptions {
 };
 
 class SlaveModel;
+
+/// An I/O behaviour for input octets [offset, offset + width) of one module (a channel).
+struct ChannelBehaviour {
+  std::size_t offset = 0;
+  std::size_t width = 0;
+  IoBehaviour behaviour;
+};
+/// Why a channel behaviour does not fit module `module` of `layout`; empty = it fits.
+std::string check_channel_behaviour(const dp::SlaveLayout& layout, std::size_t module,
+                                    std::size_t offset, std::size_t width, const IoBehaviour& b);
+/// The output octets of a module, for Echo behaviours.
+using EchoSource = std::function<std::span<const std::uint8_t>(std::size_t module)>;
+/// Writes the channels' values into `buf` (module `module`'s input octets, read beforehand from
+/// the image) at virtual time `now` after `cycles` DP cycles; later channels win on overlap.
+void apply_channel_behaviours(std::span<std::uint8_t> buf, std::size_t module,
+                              const std::vector<ChannelBehaviour>& channels, bus::Ticks now,
+                              std::uint64_t cycles, const EchoSource& outputs);
 /// What SlaveModel::build() returns: a model, or every reason it cannot be built.
 struct SlaveModelBuild {
   std::unique_ptr<SlaveModel> model;
@@ -102,6 +121,23 @@ GsdOutcome<dp::SlaveParams> master_slave_params(const GsdFile& gsd,
                                                 const std::vector<ModuleChoice>& modules,
                                                 std::uint8_t address,
                                                 const std::vector<GsdPrmSetting>& settings = {});
+
+/// Everything a GSD and a module list say about a slave, checked against the options (address,
+/// baud, TSDR): the chosen module indices, the User_Prm_Data the slave expects (defaults), its
+/// station delay and its dp::SlaveConfig (features, prm length and content check, real
+/// configuration, Min_Slave_Intervall, Max_Diag_Data_Len, PrmCmd_supp). Shared by SlaveModel and
+/// SwitchedStationModel; errors name every reason it cannot be built.
+struct SlaveSetup {
+  std::vector<std::size_t> modules;
+  GsdBytes user_prm;
+  std::uint32_t tsdr = 0;
+  dp::SlaveConfig config;
+  std::vector<std::string> errors;
+  std::vector<std::string> notes;
+  bool ok() const { return errors.empty(); }
+};
+SlaveSetup derive_slave_setup(const GsdFile& gsd, const std::vector<ModuleChoice>& modules,
+                              const SlaveModelOptions& options);
 
 class SlaveModel final : public bus::Device {
  public:
@@ -151,14 +187,9 @@ class SlaveModel final : public bus::Device {
  private:
   class User;
   class Port;
-  struct Channel {
-    std::size_t offset = 0;
-    std::size_t width = 0;
-    IoBehaviour behaviour;
-  };
   struct Module {
     std::size_t gsd_index = 0;
-    std::vector<Channel> channels;
+    std::vector<ChannelBehaviour> channels;
     bool pulled = false;
   };
   struct Scheduled {

@@ -1,0 +1,247 @@
+// A switched station on two lines (switched_station.hpp).
+#include "pbvbus/devices/switched_station.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <stdexcept>
+
+namespace pbvbus::devices {
+
+// --- the FDL station's user: inputs, DP cycle count, then the RedundantSlave's interface -------
+
+class SwitchedStationModel::User final : public fdl::ResponderUser {
+ public:
+  User(SwitchedStationModel& m, int i) : m_model(m), m_i(i) {}
+  void on_power_on(bus::Ticks now) override { m_model.m_rs->interface(m_i).on_power_on(now); }
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override {
+    redundancy::RedundantSlave& rs = *m_model.m_rs;
+    dp::SlaveEngine& e = rs.engine(m_i);
+    const bool dx = !ind.dsap && !ind.ssap && !ind.broadcast() &&
+                    (ind.fn == fdl::RequestFn::SrdHigh || ind.fn == fdl::RequestFn::SrdLow) &&
+                    e.state() == dp::SlaveState::DataExch && ind.sa == e.master_address();
+    m_model.refresh_inputs(ind.now);
+    rs.interface(m_i).on_request(ind, reply);
+    if (dx && rs.role(m_i) == redundancy::Role::Primary) ++m_model.m_dp_cycles;
+  }
+  // The model drives the RedundantSlave's deadline itself, on both lines (rearm_all()).
+  bus::Ticks next_deadline() const override { return bus::kNever; }
+  void on_time(bus::Ticks) override {}
+
+ private:
+  SwitchedStationModel& m_model;
+  int m_i;
+};
+
+// --- the FDL station's port: forwards to the interface device's port, multiplexes the timer ----
+
+class SwitchedStationModel::Port final : public bus::DevicePort {
+ public:
+  Port(SwitchedStationModel& m, Iface& f) : m_model(m), m_if(f) {}
+  bus::Ticks now() const override;
+  bus::Baud baud() const override;
+  void transmit(bus::Ticks start, std::span<const std::uint8_t> bytes) override;
+  void set_timer(bus::Ticks at) override;
+  bool receiving() const override;
+  void receive_filter_changed() override;
+
+ private:
+  SwitchedStationModel& m_model;
+  Iface& m_if;
+};
+
+class SwitchedStationModel::Iface final : public bus::Device {
+ public:
+  Iface(SwitchedStationModel& m, int i, const fdl::BusParams& bp)
+      : m_model(m), m_user(m, i), m_port(m, *this),
+        m_station(m.m_address, bp, m_user, m.m_tsdr) {
+    m_station.bind(m_port);
+  }
+  void on_power_on(bus::Ticks now) override {
+    m_powered = true;
+    m_station_timer = bus::kNever;
+    m_armed = bus::kNever;
+    m_station.on_power_on(now);
+    m_model.rearm_all();
+  }
+  void on_power_off(bus::Ticks now) override {
+    m_powered = false;
+    m_station_timer = bus::kNever;
+    m_armed = bus::kNever;
+    m_station.on_power_off(now);
+  }
+  void on_frame(const bus::RxFrame& frame) override {
+    if (!m_powered) return;
+    m_station.on_frame(frame);
+    m_model.rearm_all();
+  }
+  void on_timer(bus::Ticks now) override {
+    if (!m_powered) return;
+    m_armed = bus::kNever;  // this wake-up is spent
+    if (m_station_timer <= now) {
+      m_station_timer = bus::kNever;
+      m_station.on_timer(now);
+    }
+    m_model.m_rs->on_time(now);
+    m_model.rearm_all();
+  }
+  int receive_filter() const override { return m_station.receive_filter(); }
+  const char* kind() const override { return "DP slave (switched)"; }
+
+  void rearm() {
+    if (!bound() || !m_powered) return;
+    const bus::Ticks at = std::min(m_station_timer, m_model.m_rs->next_deadline());
+    if (at == m_armed) return;
+    m_armed = at;
+    port().set_timer(at);
+  }
+  bus::DevicePort& outer() { return port(); }
+  const bus::DevicePort& outer() const { return port(); }
+
+  SwitchedStationModel& m_model;
+  User m_user;
+  Port m_port;
+  fdl::PassiveStation m_station;
+  bus::Ticks m_station_timer = bus::kNever;
+  bus::Ticks m_armed = bus::kNever;
+  bool m_powered = false;
+  bus::Line* m_line = nullptr;
+  bus::AttachmentId m_att = -1;
+};
+
+bus::Ticks SwitchedStationModel::Port::now() const { return m_if.outer().now(); }
+bus::Baud SwitchedStationModel::Port::baud() const { return m_if.outer().baud(); }
+void SwitchedStationModel::Port::transmit(bus::Ticks start, std::span<const std::uint8_t> bytes) {
+  m_if.outer().transmit(start, bytes);
+}
+void SwitchedStationModel::Port::set_timer(bus::Ticks at) {
+  m_if.m_station_timer = at;
+  m_model.rearm_all();
+}
+bool SwitchedStationModel::Port::receiving() const { return m_if.outer().receiving(); }
+void SwitchedStationModel::Port::receive_filter_changed() { m_if.outer().receive_filter_changed(); }
+
+// --- building ---------------------------------------------------------------------------------
+
+SwitchedStationBuild SwitchedStationModel::build(const GsdFile& gsd,
+                                                 const std::vector<ModuleChoice>& modules,
+                                                 SwitchedStationOptions options) {
+  SwitchedStationBuild r;
+  const std::string file = std::filesystem::path(gsd.file_name()).filename().string();
+  const GsdRedundancy& red = gsd.redundancy();
+  if (!red.system_redundancy())
+    r.errors.push_back(file + " does not declare System Redundancy (Slave_Redundancy_supp bit 0)");
+  if (!red.prm_cmd_supp) r.errors.push_back(file + " does not declare PrmCmd_supp = 1");
+  if (!gsd.dpv1().dpv1_slave || !gsd.dpv1().prm_block_structure_supp)
+    r.errors.push_back(file + " is not a DP-V1 slave with Prm_Block_Structure_supp (the PrmCmd "
+                              "block is a structured parameter block)");
+  SlaveModelOptions so;
+  so.address = options.address;
+  so.bus_params = options.bus_params;
+  so.tsdr = options.tsdr;
+  SlaveSetup s = derive_slave_setup(gsd, modules, so);
+  r.errors.insert(r.errors.end(), s.errors.begin(), s.errors.end());
+  r.notes = std::move(s.notes);
+  if (!r.errors.empty()) return r;
+
+  std::unique_ptr<SwitchedStationModel> m(new SwitchedStationModel());
+  try {
+    m->m_rs = std::make_unique<redundancy::RedundantSlave>(std::move(s.config), options.redundancy);
+  } catch (const std::invalid_argument& e) {
+    r.errors.push_back(std::string("unusable configuration: ") + e.what());
+    return r;
+  }
+  m->m_name = options.name.empty()
+                  ? gsd.info().model_name + " @" + std::to_string(options.address)
+                  : options.name;
+  m->m_address = options.address;
+  m->m_tsdr = s.tsdr;
+  m->m_default_prm = std::move(s.user_prm);
+  if (auto ms = red.switch_over_time_ms()) m->m_t_slave_um = bus::Ticks{*ms} * bus::kTicksPerMs;
+  SwitchedStationModel* raw = m.get();
+  m->m_rs->on_event([raw](const redundancy::RedEvent& e) { raw->m_events.push_back(e); });
+  for (int i = 0; i < 2; ++i) m->m_if[i] = std::make_unique<Iface>(*m, i, options.bus_params);
+  const auto& layout = m->m_rs->engine(0).layout();
+  m->m_channels.resize(layout.modules.size());
+  std::size_t max_in = 0;
+  for (const auto& ml : layout.modules) max_in = std::max(max_in, ml.in_len);
+  m->m_scratch.resize(max_in);
+  r.model = std::move(m);
+  return r;
+}
+
+SwitchedStationModel::~SwitchedStationModel() = default;
+
+bus::Device& SwitchedStationModel::interface_device(int i) { return *m_if[i]; }
+
+bus::AttachmentId SwitchedStationModel::attach(int i, bus::Line& line, std::string label) {
+  if (label.empty()) label = m_name + (i == 0 ? " A" : " B");
+  m_if[i]->m_line = &line;
+  m_if[i]->m_att = line.attach(*m_if[i], std::move(label));
+  return m_if[i]->m_att;
+}
+
+// --- behaviours -------------------------------------------------------------------------------
+
+std::string SwitchedStationModel::set_behaviour(std::size_t module, IoBehaviour b) {
+  const auto& layout = m_rs->engine(0).layout();
+  if (module >= layout.modules.size()) return "module " + std::to_string(module) + " does not exist";
+  const std::size_t len = layout.modules[module].in_len;
+  if (len == 0) return "module " + std::to_string(module) + " has no inputs";
+  if (std::string e = check_channel_behaviour(layout, module, 0, len, b); !e.empty()) return e;
+  m_channels[module].clear();
+  m_channels[module].push_back({0, len, std::move(b)});
+  return {};
+}
+
+std::string SwitchedStationModel::add_channel_behaviour(std::size_t module, std::size_t offset,
+                                                        std::size_t width, IoBehaviour b) {
+  if (std::string e = check_channel_behaviour(m_rs->engine(0).layout(), module, offset, width, b);
+      !e.empty())
+    return e;
+  m_channels[module].push_back({offset, width, std::move(b)});
+  return {};
+}
+
+void SwitchedStationModel::refresh_inputs(bus::Ticks now) {
+  const auto& layout = m_rs->engine(0).layout();
+  dp::SlaveApplication& app = m_rs->engine(0).application();  // both images hold the same inputs
+  const std::span<const std::uint8_t> out = m_rs->outputs();
+  for (std::size_t m = 0; m < m_channels.size(); ++m) {
+    const std::size_t len = layout.modules[m].in_len;
+    if (len == 0 || m_channels[m].empty()) continue;
+    std::span<std::uint8_t> buf(m_scratch.data(), len);
+    app.image().inputs(m).read(buf);
+    apply_channel_behaviours(buf, m, m_channels[m], now, m_dp_cycles, [&](std::size_t src) {
+      const auto& ml = layout.modules[src];
+      return out.subspan(ml.out_offset, ml.out_len);  // the backplane, not an interface's image
+    });
+    m_rs->write_inputs(m, buf);
+  }
+}
+
+// --- timers and faults --------------------------------------------------------------------------
+
+void SwitchedStationModel::rearm_all() {
+  for (auto& f : m_if)
+    if (f) f->rearm();
+}
+
+bus::Ticks SwitchedStationModel::now() const {
+  for (const auto& f : m_if)
+    if (f && f->bound()) return f->outer().now();
+  throw std::logic_error("switched station: no interface is attached to a line");
+}
+
+void SwitchedStationModel::fail_interface(int i) {
+  m_rs->fail_interface(i, now());
+  if (m_if[i]->m_line) m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, false);
+  rearm_all();
+}
+
+void SwitchedStationModel::repair_interface(int i) {
+  m_rs->repair_interface(i, now());
+  if (m_if[i]->m_line) m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, true);
+  rearm_all();
+}
+
+}  // namespace pbvbus::devices

@@ -1,0 +1,417 @@
+// SwitchedStationModel (devices/switched_station.hpp): the switched station from PBVB0A10.gsd on
+// two bus::Lines at 1.5 Mbit/s, one class-1 dp::Master per line. The redundant start-up is
+// asserted telegram by telegram on each line, with the PrmCmd block (protocol-facts.md §G.2) and
+// the Red_Status block (§G.3) written out by hand; then the active/passive channel and a
+// switchover on a transceiver failure of the primary interface, sampling the backplane outputs
+// after every DP cycle (no pulse).
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "frame_recorder.hpp"
+#include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/dp/master.hpp"
+#include "pbvbus/fdl/active_station.hpp"
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::devices {
+namespace {
+
+using pbvbus::test::FrameRecorder;
+using Bytes = std::vector<std::uint8_t>;
+using redundancy::Role;
+
+constexpr bus::Baud kBaud = bus::Baud::k1_5M;
+constexpr bus::Ticks kMs = bus::kTicksPerMs;
+constexpr std::uint8_t kAddr = 5;
+
+GsdFile load(const char* name) {
+  auto r = load_gsd(std::string(PBVBUS_SOURCE_DIR) + "/examples/gsd/" + name);
+  EXPECT_TRUE(r.ok()) << name;
+  return *r.file;
+}
+
+std::vector<ModuleChoice> modules() {
+  return {ModuleChoice::named("16DI DC24V"), ModuleChoice::named("16DO DC24V/0.5A")};
+}
+
+/// Frames to or from the station (SD1/SD2 with DA or SA = the station, and SC), without tokens.
+std::vector<std::string> dialogue(const FrameRecorder& rec, std::vector<std::size_t>* idx = nullptr) {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& b = rec.frame(i).bytes;
+    bool ours = false;
+    if (b.size() == 1 && b[0] == 0xE5) ours = true;
+    if (b.size() >= 6 && b[0] == 0x68) ours = (b[4] & 0x7F) == kAddr || (b[5] & 0x7F) == kAddr;
+    if (b.size() >= 3 && b[0] == 0x10) ours = (b[1] & 0x7F) == kAddr || (b[2] & 0x7F) == kAddr;
+    if (!ours) continue;
+    out.push_back(rec.hex(i));
+    if (idx) idx->push_back(i);
+  }
+  return out;
+}
+
+struct TwoLines {
+  bus::Scheduler sched;
+  bus::Line line[2] = {bus::Line{sched, "A", kBaud}, bus::Line{sched, "B", kBaud}};
+  FrameRecorder rec[2];
+  fdl::BusParams bp;
+  std::unique_ptr<dp::Master> master[2];
+  std::unique_ptr<fdl::ActiveStation> station[2];
+  std::unique_ptr<SwitchedStationModel> model;
+  bus::AttachmentId att[2] = {-1, -1};
+
+  /// Master on line A asks for Primary_Request, line B's master does not; Output_Hold_Time
+  /// `hold_10ms`.
+  explicit TwoLines(std::uint16_t hold_10ms = 100, bool master_on_b = true) {
+    const GsdFile gsd = load("PBVB0A10.gsd");
+    bp = fdl::BusParams::defaults(kBaud);
+    bp.hsa = 12;
+    for (int i = 0; i < 2; ++i) {
+      line[i].add_tap(rec[i]);
+      if (i == 1 && !master_on_b) break;
+      auto sp = master_slave_params(gsd, modules(), kAddr);
+      EXPECT_TRUE(sp.ok());
+      dp::SlaveParams p = *sp.value;
+      // DPV1_Status_3: PrmCmd | Prm_Structure; then the 8-octet PrmCmd block (§G.2).
+      p.user_prm[2] |= 0x88;
+      const std::uint8_t fn = i == 0 ? 0x02 : 0x00;  // Primary_Request on line A only
+      const Bytes block{0x08, 0x02, 0x00, 0x08, fn, 0x04,  // Seq_Nr 1; Address_Change
+                        static_cast<std::uint8_t>(hold_10ms >> 8),
+                        static_cast<std::uint8_t>(hold_10ms & 0xFF)};
+      p.user_prm.insert(p.user_prm.end(), block.begin(), block.end());
+      master[i] = std::make_unique<dp::Master>(dp::MasterParams{}, std::vector<dp::SlaveParams>{p});
+      station[i] = std::make_unique<fdl::ActiveStation>(1, bp, *master[i]);
+      line[i].attach(*station[i], "master 1");
+    }
+    SwitchedStationOptions o;
+    o.address = kAddr;
+    o.bus_params = bp;
+    auto b = SwitchedStationModel::build(gsd, modules(), o);
+    EXPECT_TRUE(b.ok()) << (b.errors.empty() ? "" : b.errors[0]);
+    model = std::move(b.model);
+    for (int i = 0; i < 2; ++i) att[i] = model->attach(i, line[i]);
+  }
+  /// Line B may have no master (a silent line): only master A's image is then usable.
+  void start() {
+    line[0].start();
+    line[1].start();
+  }
+  void run_until(bus::Ticks t) { sched.run_until(t); }
+};
+
+/// Samples the backplane outputs at the end of every frame on the lines it taps (finer than
+/// one DP cycle: each cycle is a request and its reply).
+struct OutputSampler final : bus::Tap {
+  explicit OutputSampler(const SwitchedStationModel& m) : model(m) {}
+  void on_frame(const bus::TapFrame& f) override {
+    samples.push_back({f.end, Bytes(model.outputs().begin(), model.outputs().end())});
+  }
+  struct Sample {
+    bus::Ticks at;
+    Bytes out;
+  };
+  const SwitchedStationModel& model;
+  std::vector<Sample> samples;
+};
+
+const Bytes kOutA{0xA5, 0x5A};  // what master A writes to the 16DO module
+const Bytes kOutB{0x0F, 0xF0};  // what master B writes (different, to see whose reach the modules)
+
+void set_up_io(TwoLines& t) {
+  ASSERT_EQ(t.model->set_behaviour(0, IoBehaviour::constant_value({0x12, 0x34})), "");
+  ASSERT_EQ(t.master[0]->image(kAddr).write_outputs(1, kOutA), dp::ImageAccess::Ok);
+  if (t.master[1]) {
+    ASSERT_EQ(t.master[1]->image(kAddr).write_outputs(1, kOutB), dp::ImageAccess::Ok);
+  }
+}
+
+// --- the redundant start-up, telegram by telegram on each line ---------------------------------
+
+TEST(SwitchedStation, BuildsFromTheRedundancyGsd) {
+  TwoLines t;
+  ASSERT_TRUE(t.model);
+  EXPECT_EQ(t.model->config().ident, 0x0A10);
+  EXPECT_TRUE(t.model->config().features.prm_cmd);
+  EXPECT_TRUE(t.model->config().features.prm_structure);
+  EXPECT_EQ(t.model->default_user_prm(), (Bytes{0x80, 0x20, 0x00}));
+  // Slave_Max_Switch_Over_Time = 3 (× 10 ms) → T_SLAVE_UM 30 ms; PBVB0A11: 82 → 820 ms.
+  ASSERT_TRUE(t.model->t_slave_um());
+  EXPECT_EQ(*t.model->t_slave_um(), 30 * kMs);
+  SwitchedStationOptions o;
+  o.address = kAddr;
+  o.bus_params = t.bp;
+  auto slow = SwitchedStationModel::build(load("PBVB0A11.gsd"), modules(), o);
+  ASSERT_TRUE(slow.ok()) << (slow.errors.empty() ? "" : slow.errors[0]);
+  EXPECT_EQ(*slow.model->t_slave_um(), 820 * kMs);
+  // A GSD without slave redundancy is refused.
+  auto plain = SwitchedStationModel::build(load("PBVB0A02.gsd"), {ModuleChoice::at(0)}, o);
+  EXPECT_FALSE(plain.ok());
+  EXPECT_FALSE(plain.errors.empty());
+}
+
+TEST(SwitchedStation, RedundantStartUpOnEachLine) {
+  TwoLines t(100);  // Output_Hold_Time 100 × 10 ms
+  set_up_io(t);
+  t.start();
+  t.run_until(30 * kMs);
+
+  // Set_Prm DU (18 octets, §D.2 + §G.2): 88 Lock_Req|WD_On, WD 0A 0A, min TSDR 0B, ident 0A 10,
+  // group 00, DPV1_Status 80 20 88 (DPV1_Enable; diagnostic alarm; PrmCmd|Prm_Structure), then
+  // the PrmCmd block 08 02 00 (length 8, type PrmCmd, slot 0), 08 (Seq_Nr 1 in bits 7..3),
+  // Function (02 = Primary_Request on line A, 00 on line B), Properties 04 (Address_Change:
+  // System Redundancy), Output_Hold_Time 00 64 (100 × 10 ms).
+  // Red_State bits (§G.3, AUMA): 01 Backup, 02 Primary, 08 Data_Exchange, 20 Baudrate_found.
+  const std::vector<std::string> want_a = {
+      "68 05 05 68 85 81 6D 3C 3E ED 16",  // Slave_Diag
+      // 02 05 00 FF 0A 10: Not_Ready, Prm_Req; Red_Status 08 9F 00 00 00, own 22 (S_PRIMARY:
+      // Primary + Baudrate_found), partner 20 (S_WAITING, Baudrate_found), 00.
+      "68 13 13 68 81 85 08 3E 3C 02 05 00 FF 0A 10 08 9F 00 00 00 22 20 00 91 16",
+      "68 17 17 68 85 81 5D 3D 3E 88 0A 0A 0B 0A 10 00 80 20 88 08 02 00 08 02 04 00 64 43 16",
+      "E5",
+      "68 07 07 68 85 81 7D 3E 3E 11 21 31 16",  // Chk_Cfg 11 (2 B in) 21 (2 B out)
+      "E5",
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // 00 0C 00 01: ready, WD_On, master 1. Red_Status with Seq_Nr 1 (08): own 2A (Primary, DX,
+      // Baudrate), partner 28 (still S_WAITING, in DX); Prm_Cmd_Ack 08 9E 00 08 02 (echo of
+      // Primary_Request), own 22, partner 20 (when the command was carried out, before DX).
+      "68 1B 1B 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 2A 28 00 08 9E 00 08 02 22 20 00 A2 16",
+      "10 05 01 49 4F 16",  // the master's GAP poll: Request FDL Status to address 5 ...
+      "10 01 05 00 06 16",  // ... answered by the interface's FDL station: passive
+      "68 05 05 68 05 01 7D A5 5A 82 16",  // Data_Exchange, outputs A5 5A
+      // DH (FC 0A): the partner became BACKUP (link message), inputs 12 34.
+      "68 05 05 68 01 05 0A 12 34 56 16",
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // Red_Status: partner now 29 (Backup, DX, Baudrate).
+      "68 1B 1B 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 2A 29 00 08 9E 00 08 02 22 20 00 A3 16",
+      "68 05 05 68 05 01 7D A5 5A 82 16",
+      "68 05 05 68 01 05 08 12 34 54 16",  // DL: nothing new
+  };
+  const std::vector<std::string> want_b = {
+      "68 05 05 68 85 81 6D 3C 3E ED 16",
+      // own 20 (S_WAITING), partner 22 (S_PRIMARY)
+      "68 13 13 68 81 85 08 3E 3C 02 05 00 FF 0A 10 08 9F 00 00 00 20 22 00 91 16",
+      // Function 00: no Primary_Request
+      "68 17 17 68 85 81 5D 3D 3E 88 0A 0A 0B 0A 10 00 80 20 88 08 02 00 08 00 04 00 64 41 16",
+      "E5",
+      "68 07 07 68 85 81 7D 3E 3E 11 21 31 16",
+      "E5",
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // Red_Status own 28 (S_WAITING in DX), partner 2A (PRIMARY in DX); Prm_Cmd_Ack function 00,
+      // own 20, partner 22 (acknowledged at once, no role change).
+      "68 1B 1B 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 28 2A 00 08 9E 00 08 00 20 22 00 A0 16",
+      "10 05 01 49 4F 16",
+      "10 01 05 00 06 16",
+      "68 05 05 68 05 01 7D 0F F0 82 16",  // Data_Exchange, outputs 0F F0 (not evaluated)
+      "68 05 05 68 01 05 0A 12 34 56 16",  // DH: this interface became BACKUP
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // own 29 (Backup, DX, Baudrate), partner 2A
+      "68 1B 1B 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 29 2A 00 08 9E 00 08 00 20 22 00 A1 16",
+      "68 05 05 68 05 01 7D 0F F0 82 16",
+      "68 05 05 68 01 05 08 12 34 54 16",
+  };
+  std::vector<std::size_t> idx[2];
+  const auto da = dialogue(t.rec[0], &idx[0]);
+  const auto db = dialogue(t.rec[1], &idx[1]);
+  ASSERT_GE(da.size(), want_a.size());
+  ASSERT_GE(db.size(), want_b.size());
+  for (std::size_t k = 0; k < want_a.size(); ++k) EXPECT_EQ(da[k], want_a[k]) << "line A #" << k;
+  for (std::size_t k = 0; k < want_b.size(); ++k) EXPECT_EQ(db[k], want_b[k]) << "line B #" << k;
+
+  EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(t.model->role(0), Role::Primary);
+  EXPECT_EQ(t.model->role(1), Role::Backup);
+  EXPECT_EQ(t.model->primary(), 0);
+  EXPECT_EQ(t.model->output_hold_time(), 1000 * kMs);
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutA);
+
+  // Interface A becomes PRIMARY at the end of its Set_Prm (last stop bit), B BACKUP one link
+  // delay (1 ms) later.
+  const bus::Ticks prm_end = t.rec[0].frame(idx[0][2]).end;
+  ASSERT_EQ(t.model->events().size(), 2u);
+  const auto& e0 = t.model->events()[0];
+  EXPECT_EQ(e0.kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(e0.iface, 0);
+  EXPECT_EQ(e0.from, Role::SPrimary);
+  EXPECT_EQ(e0.to, Role::Primary);
+  EXPECT_EQ(e0.at, prm_end);
+  // 29 octets × 11 bits × 2424 ticks/bit after the Set_Prm's first start bit.
+  EXPECT_EQ(e0.at, t.rec[0].frame(idx[0][2]).start + 29 * 11 * 2424);
+  const auto& e1 = t.model->events()[1];
+  EXPECT_EQ(e1.iface, 1);
+  EXPECT_EQ(e1.from, Role::SWaiting);
+  EXPECT_EQ(e1.to, Role::Backup);
+  EXPECT_EQ(e1.at, prm_end + 1 * kMs);
+}
+
+// --- active and passive channel -------------------------------------------------------------------
+
+TEST(SwitchedStation, OnlyThePrimaryOutputsReachTheBackplane) {
+  TwoLines t;
+  set_up_io(t);
+  OutputSampler s(*t.model);
+  t.line[0].add_tap(s);
+  t.line[1].add_tap(s);
+  t.start();
+  t.run_until(30 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // Master B writes new outputs: they go over line B but never reach the modules.
+  ASSERT_EQ(t.master[1]->image(kAddr).write_outputs(1, Bytes{0x11, 0x22}), dp::ImageAccess::Ok);
+  s.samples.clear();
+  t.run_until(60 * kMs);
+  for (const auto& x : s.samples) EXPECT_EQ(x.out, kOutA) << x.at;
+  // Master A's new outputs do, at its next Data_Exchange.
+  ASSERT_EQ(t.master[0]->image(kAddr).write_outputs(1, Bytes{0x33, 0x44}), dp::ImageAccess::Ok);
+  t.run_until(70 * kMs);
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), (Bytes{0x33, 0x44}));
+  // Both interfaces stay in data exchange; the inputs are the same on both lines.
+  EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  for (int i = 0; i < 2; ++i) {
+    Bytes in(2);
+    ASSERT_EQ(t.master[i]->image(kAddr).read_inputs(0, in), dp::ImageAccess::Ok);
+    EXPECT_EQ(in, (Bytes{0x12, 0x34})) << i;
+  }
+  // One DP cycle of the station = one Data_Exchange accepted by the primary interface.
+  EXPECT_EQ(t.model->dp_cycles(), t.master[0]->slave_stats(kAddr).data_exchanges);
+}
+
+// --- switchover on a transceiver failure of the primary interface ----------------------------------
+
+TEST(SwitchedStation, PrimaryTransceiverFailureSwitchesToBWithoutPulse) {
+  TwoLines t(100);  // Output_Hold_Time 1 s
+  set_up_io(t);
+  OutputSampler s(*t.model);
+  t.line[0].add_tap(s);
+  t.line[1].add_tap(s);
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  const std::size_t first = s.samples.size();
+  t.model->fail_interface(0);  // the interface and its transceiver on line A
+  EXPECT_EQ(t.model->role(0), Role::Failed);
+  EXPECT_TRUE(t.model->outputs_held());
+  t.run_until(600 * kMs);
+
+  EXPECT_EQ(t.model->role(1), Role::Primary);
+  EXPECT_FALSE(t.model->outputs_held());
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutB);
+  EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  EXPECT_NE(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+
+  // Events: A FAILED at 150 ms; B hears nothing after A's heartbeat of 100 ms (arrived at
+  // 101 ms, link delay 1 ms) and counts it lost after the 300 ms supervision: PRIMARY at 401 ms.
+  const auto& ev = t.model->events();
+  ASSERT_EQ(ev.size(), 5u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[2].iface, 0);
+  EXPECT_EQ(ev[2].to, Role::Failed);
+  EXPECT_EQ(ev[2].at, 150 * kMs);
+  EXPECT_EQ(ev[3].kind, redundancy::RedEvent::Kind::PartnerLost);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].at, 401 * kMs);
+  EXPECT_EQ(ev[4].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[4].iface, 1);
+  EXPECT_EQ(ev[4].from, Role::Backup);
+  EXPECT_EQ(ev[4].to, Role::Primary);
+  EXPECT_EQ(ev[4].at, 401 * kMs);
+
+  // No pulse: every sample after the failure is A's last value or B's, never zero, and once B's
+  // value is there A's never comes back. B's first arrives with B's first Data_Exchange after
+  // 401 ms, within one DP cycle on line B.
+  bool fresh = false;
+  bus::Ticks fresh_at = bus::kNever;
+  for (std::size_t k = first; k < s.samples.size(); ++k) {
+    const auto& x = s.samples[k];
+    if (x.out == kOutB) {
+      if (!fresh) fresh_at = x.at;
+      fresh = true;
+    } else {
+      ASSERT_EQ(x.out, kOutA) << x.at;
+      ASSERT_FALSE(fresh) << "older value after the fresh one at " << x.at;
+    }
+  }
+  ASSERT_TRUE(fresh);
+  EXPECT_GT(fresh_at, 401 * kMs);
+  EXPECT_LT(fresh_at, 401 * kMs + 5 * kMs);
+  EXPECT_LT(fresh_at, 150 * kMs + t.model->output_hold_time());
+  // Line A: nothing from the station after the failure (FDL Status included).
+  for (std::size_t i = 0; i < t.rec[0].size(); ++i) {
+    const auto& f = t.rec[0].frame(i);
+    if (f.start < 150 * kMs) continue;
+    const auto& b = f.bytes;
+    const bool from_station = (b.size() >= 6 && b[0] == 0x68 && (b[5] & 0x7F) == kAddr) ||
+                              (b.size() >= 3 && b[0] == 0x10 && (b[2] & 0x7F) == kAddr) ||
+                              (b.size() == 1 && b[0] == 0xE5);
+    EXPECT_FALSE(from_station) << t.rec[0].hex(i);
+  }
+}
+
+// --- the timer gap: the station runs on one line's timer alone --------------------------------------
+
+TEST(SwitchedStation, LinkAndWatchdogRunWhenOnlyLineBDrivesTheTimer) {
+  TwoLines t(100);
+  set_up_io(t);
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // Power off interface A's attachment: its device gets no more timers or frames, but the
+  // backplane and interface A's slave engine keep running. A's watchdog (WD 10 × 10 × 10 ms =
+  // 1 s after its last Data_Exchange) must expire on line B's timer, and the station switches
+  // over autonomously one link delay later.
+  bus::Ticks last_dx_a = 0;
+  for (std::size_t i = 0; i < t.rec[0].size(); ++i) {
+    const auto& b = t.rec[0].frame(i).bytes;
+    if (t.rec[0].frame(i).start < 150 * kMs && b.size() == 11 && b[0] == 0x68 && b[4] == kAddr)
+      last_dx_a = t.rec[0].frame(i).end;  // a Data_Exchange request (no SAPs) to the station
+  }
+  t.line[0].set_power(t.att[0], false);
+  t.run_until(1300 * kMs);
+  EXPECT_EQ(t.model->role(1), Role::Primary);
+  EXPECT_EQ(t.model->role(0), Role::Backup);
+  const auto& ev = t.model->events();
+  ASSERT_GE(ev.size(), 4u);
+  EXPECT_EQ(ev[2].iface, 0);
+  EXPECT_EQ(ev[2].from, Role::Primary);
+  EXPECT_EQ(ev[2].to, Role::Backup);
+  EXPECT_EQ(ev[2].at, last_dx_a + 1000 * kMs);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].to, Role::Primary);
+  EXPECT_EQ(ev[3].at, last_dx_a + 1000 * kMs + 1 * kMs);
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutB);
+}
+
+TEST(SwitchedStation, ChangeThroughLineAWakesTheStationOnSilentLineB) {
+  // Line B has no master at all: its device gets no frame after power-on. Master A's Set_Prm
+  // makes interface A PRIMARY and sends become-backup over the internal link (1 ms); A's
+  // attachment loses power before that message is due, so only line B's timer can deliver it.
+  // A model that re-armed only the line the change came through would deliver it at B's next
+  // heartbeat (100 ms) instead.
+  TwoLines t(100, false);
+  set_up_io(t);
+  t.start();
+  std::vector<std::size_t> idx;
+  while (t.model->role(0) != Role::Primary) {
+    ASSERT_LT(t.sched.now(), 20 * kMs);
+    t.run_until(t.sched.now() + kMs / 10);
+  }
+  const bus::Ticks primary_at = t.model->events().at(0).at;
+  t.line[0].set_power(t.att[0], false);
+  EXPECT_EQ(t.model->role(1), Role::SWaiting);
+  t.run_until(primary_at + 50 * kMs);
+  EXPECT_TRUE(dialogue(t.rec[1]).empty());  // line B stayed silent
+  ASSERT_EQ(t.model->events().size(), 2u);
+  EXPECT_EQ(t.model->events()[1].iface, 1);
+  EXPECT_EQ(t.model->events()[1].to, Role::Backup);
+  EXPECT_EQ(t.model->events()[1].at, primary_at + 1 * kMs);
+  EXPECT_EQ(t.model->role(1), Role::Backup);
+}
+
+}  // namespace
+}  // namespace pbvbus::devices

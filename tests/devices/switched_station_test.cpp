@@ -68,7 +68,8 @@ struct TwoLines {
 
   /// Master on line A asks for Primary_Request, line B's master does not; Output_Hold_Time
   /// `hold_10ms`.
-  explicit TwoLines(std::uint16_t hold_10ms = 100, bool master_on_b = true) {
+  explicit TwoLines(std::uint16_t hold_10ms = 100, bool master_on_b = true,
+                    bool primary_request_on_b = false) {
     const GsdFile gsd = load("PBVB0A10.gsd");
     bp = fdl::BusParams::defaults(kBaud);
     bp.hsa = 12;
@@ -80,7 +81,8 @@ struct TwoLines {
       dp::SlaveParams p = *sp.value;
       // DPV1_Status_3: PrmCmd | Prm_Structure; then the 8-octet PrmCmd block (§G.2).
       p.user_prm[2] |= 0x88;
-      const std::uint8_t fn = i == 0 ? 0x02 : 0x00;  // Primary_Request on line A only
+      // Primary_Request on line A only (unless asked for on B too)
+      const std::uint8_t fn = i == 0 || primary_request_on_b ? 0x02 : 0x00;
       const Bytes block{0x08, 0x02, 0x00, 0x08, fn, 0x04,  // Seq_Nr 1; Address_Change
                         static_cast<std::uint8_t>(hold_10ms >> 8),
                         static_cast<std::uint8_t>(hold_10ms & 0xFF)};
@@ -504,6 +506,96 @@ TEST(SwitchedStation, DISABLED_PrimaryRequestToARepairedInterfaceIsACommandedSwi
     else {
       ASSERT_EQ(s.samples[k].out, kOutB) << s.samples[k].at;
       ASSERT_FALSE(fresh) << "older value after the fresh one at " << s.samples[k].at;
+    }
+  }
+  EXPECT_TRUE(fresh);
+}
+
+// --- commanded switchover: line B's master starts later and sends Primary_Request ---------------
+
+TEST(SwitchedStation, CommandedSwitchoverByPrimaryRequestOnLineB) {
+  TwoLines t(100, true, /*primary_request_on_b=*/true);
+  set_up_io(t);
+  OutputSampler s(*t.model);
+  t.line[0].add_tap(s);
+  t.line[1].add_tap(s);
+  t.line[0].start();
+  t.run_until(50 * kMs);  // A PRIMARY, B BACKUP (its line is not started: no master yet)
+  ASSERT_EQ(t.model->role(0), Role::Primary);
+  ASSERT_EQ(t.model->role(1), Role::Backup);
+  const std::size_t first = s.samples.size();
+  t.line[1].start();
+  t.run_until(100 * kMs);
+
+  // Line B, octet by octet. Red_State bits: 01 Backup, 02 Primary, 08 DX, 20 Baudrate_found,
+  // 40 Output_Hold_Time started.
+  const std::vector<std::string> want_b = {
+      "68 05 05 68 85 81 6D 3C 3E ED 16",
+      // Not_Ready, Prm_Req; Red_Status Seq_Nr 0 (no PrmCmd yet): own 21 (BACKUP), partner 2A.
+      "68 13 13 68 81 85 08 3E 3C 02 05 00 FF 0A 10 08 9F 00 00 00 21 2A 00 9A 16",
+      // Set_Prm with PrmCmd Seq_Nr 1, Function 02 Primary_Request, Properties 04, hold 00 64.
+      "68 17 17 68 85 81 5D 3D 3E 88 0A 0A 0B 0A 10 00 80 20 88 08 02 00 08 02 04 00 64 43 16",
+      "E5",
+      "68 07 07 68 85 81 7D 3E 3E 11 21 31 16",
+      "E5",
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // BP_SWITCHOVER shows as Backup: own 29, partner 2A (still PRIMARY); no Prm_Cmd_Ack yet.
+      "68 13 13 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 29 2A 00 B1 16",
+      "10 05 01 49 4F 16",
+      "10 01 05 00 06 16",
+      "68 05 05 68 05 01 7D 0F F0 82 16",
+      "68 05 05 68 01 05 0A 12 34 56 16",  // DH: the partner handed over (BACKUP)
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      "68 13 13 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 29 29 00 B0 16",  // both backup
+      "68 05 05 68 05 01 7D 0F F0 82 16",
+      "68 05 05 68 01 05 0A 12 34 56 16",  // DH: this interface took over (PRIMARY)
+      "68 05 05 68 85 81 5D 3C 3E DD 16",
+      // Red_Status own 2A, partner 29; Prm_Cmd_Ack 08 9E 00 08 02, own 6A (PRIMARY, DX,
+      // Baudrate, Output_Hold_Time started: the backplane holds A's outputs), partner 29.
+      "68 1B 1B 68 81 85 08 3E 3C 00 0C 00 01 0A 10 08 9F 00 08 00 2A 29 00 08 9E 00 08 02 6A 29 00 F4 16",
+      "68 05 05 68 05 01 7D 0F F0 82 16",
+      "68 05 05 68 01 05 08 12 34 54 16",
+  };
+  std::vector<std::size_t> idx;
+  const auto db = dialogue(t.rec[1], &idx);
+  ASSERT_GE(db.size(), want_b.size());
+  for (std::size_t k = 0; k < want_b.size(); ++k) EXPECT_EQ(db[k], want_b[k]) << "line B #" << k;
+
+  // BP_SWITCHOVER at the end of B's Set_Prm; the switchover request reaches A 1 ms later (A
+  // BACKUP), the take-over reaches B 1 ms after that (B PRIMARY).
+  const bus::Ticks prm_end = t.rec[1].frame(idx[2]).end;
+  const auto& ev = t.model->events();
+  ASSERT_EQ(ev.size(), 5u);
+  EXPECT_EQ(ev[2].iface, 1);
+  EXPECT_EQ(ev[2].to, Role::BpSwitchover);
+  EXPECT_EQ(ev[2].at, prm_end);
+  EXPECT_EQ(ev[3].iface, 0);
+  EXPECT_EQ(ev[3].from, Role::Primary);
+  EXPECT_EQ(ev[3].to, Role::Backup);
+  EXPECT_EQ(ev[3].at, prm_end + 1 * kMs);
+  EXPECT_EQ(ev[4].iface, 1);
+  EXPECT_EQ(ev[4].to, Role::Primary);
+  EXPECT_EQ(ev[4].at, prm_end + 2 * kMs);
+  EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+
+  // No pulse: A's outputs until B's first Data_Exchange as PRIMARY (dialogue #14, the request
+  // that ends after prm_end + 2 ms), B's from then on.
+  const auto& req = t.rec[1].frame(idx[14]);
+  const auto& rep = t.rec[1].frame(idx[15]);
+  ASSERT_GT(req.end, prm_end + 2 * kMs);
+  bool fresh = false;
+  for (std::size_t k = first; k < s.samples.size(); ++k) {
+    const auto& x = s.samples[k];
+    if (x.out == kOutB) {
+      if (!fresh) {
+        EXPECT_GE(x.at, req.end);
+        EXPECT_LE(x.at, rep.end);
+      }
+      fresh = true;
+    } else {
+      ASSERT_EQ(x.out, kOutA) << x.at;
+      ASSERT_FALSE(fresh) << "older value after the fresh one at " << x.at;
     }
   }
   EXPECT_TRUE(fresh);

@@ -476,7 +476,7 @@ TEST(SwitchedStation, BackupFailureAndRepairLeaveTheOutputsAlone) {
 // Expected (as for a Primary_Request to the BACKUP): BP_SWITCHOVER, switchover request to the
 // partner (1 ms), partner BACKUP, take-over (1 ms), A PRIMARY; outputs held in between, no
 // alternation. Enable when the RedundantSlave handles it.
-TEST(SwitchedStation, DISABLED_PrimaryRequestToARepairedInterfaceIsACommandedSwitchover) {
+TEST(SwitchedStation, PrimaryRequestToARepairedInterfaceIsACommandedSwitchover) {
   TwoLines t(100);
   set_up_io(t);
   OutputSampler s(*t.model);

@@ -300,16 +300,17 @@ dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) 
     switch (f.role) {
       case Role::Primary: set_ack(i); break;
       case Role::Backup:
+      case Role::SWaiting:
+      case Role::SPrimary:
+        // With a live PRIMARY partner (e.g. this interface was just repaired and restarts in
+        // S_WAITING while the other carries the process), Primary_Request is a commanded
+        // switchover through the partner, never a second primary.
         if (alive(1 - i) && !f.partner_lost && m_if[1 - i].role == Role::Primary) {
           set_role(i, Role::BpSwitchover, v.now);
           send(i, Msg::SwitchReq, v.now);
         } else {
           set_role(i, Role::Primary, v.now);
         }
-        break;
-      case Role::SWaiting:
-      case Role::SPrimary:
-        set_role(i, Role::Primary, v.now);
         break;
       case Role::BpSwitchover:
       case Role::Failed: break;

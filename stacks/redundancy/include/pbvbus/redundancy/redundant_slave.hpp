@@ -8,7 +8,8 @@
 // public. Sans-I/O: no threads, no clock. Whoever owns it calls on_time(now) at next_deadline()
 // (each interface's ResponderUser reports the same deadline, so the station on either line can
 // drive it, but a change made through one interface does not re-arm the other line's timer:
-// a device model should drive next_deadline() itself); tests call it by hand.
+// devices::SwitchedStationModel re-arms both lines' ports after every call); tests call it by
+// hand.
 //
 // Decisions (docs/redundancy.md has the state machine):
 // - Internal link: messages (heartbeat with the sender's role, switchover request, take-over,

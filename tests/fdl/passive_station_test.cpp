@@ -290,6 +290,44 @@ TEST_F(PassiveDelayTest, OwnTsdrClampedToMaxTsdr) {
   EXPECT_EQ(rec.start_bits(1), 566 + 150);
 }
 
+TEST(PassiveStationSetAddress, RunTimeChangeMovesTheFilterAndForgetsTheFcbs) {
+  // set_address() at run time (the Flying Redundancy address swap): the line's cached receive
+  // filter follows at once, and the FCB stored for master 1 under the old address does not make
+  // the first request to the new address a repeat.
+  const BusParams params = BusParams::defaults(bus::Baud::k1_5M);
+  TestUser user;
+  user.handler = [](const Indication&, Reply& r) { r.short_ack(); };
+  bus::Scheduler sched;
+  bus::Line line{sched, "dp", bus::Baud::k1_5M};
+  FrameRecorder rec;
+  ScriptDevice m;
+  PassiveStation slave(10, params, user);
+  line.add_tap(rec);
+  line.attach(m);
+  line.attach(slave);
+  line.start();
+  auto at = [](std::int64_t b) { return bus::bits_to_ticks(b, bus::Baud::k1_5M); };
+  m.send(at(500), bytes_from_hex("10 0A 01 7D 88 16"));  // SRD_HIGH FCV=1 FCB=1 to 10
+  sched.run_until(at(1000));
+  slave.set_address(74);
+  EXPECT_EQ(slave.address(), 74);
+  m.send(at(1500), bytes_from_hex("10 0A 01 49 54 16"));  // FDL Status to 10: nobody
+  m.send(at(2500), bytes_from_hex("10 4A 01 49 94 16"));  // FDL Status to 74
+  m.send(at(3500), bytes_from_hex("10 4A 01 7D C8 16"));  // FCB=1 again, now to 74: executed
+  m.send(at(4500), bytes_from_hex("10 4A 01 7D C8 16"));  // same FCB: a repeat
+  sched.run_until(at(6000));
+  ASSERT_EQ(rec.size(), 9u);
+  EXPECT_EQ(rec.hex(1), "E5");
+  EXPECT_EQ(rec.hex(2), "10 0A 01 49 54 16");
+  EXPECT_EQ(rec.hex(4), "10 01 4A 00 4B 16");
+  EXPECT_EQ(rec.hex(6), "E5");
+  EXPECT_EQ(rec.hex(8), "E5");
+  ASSERT_EQ(user.seen.size(), 2u);
+  EXPECT_EQ(user.seen[0].da, 10);
+  EXPECT_EQ(user.seen[1].da, 74);
+  EXPECT_EQ(slave.stats().repeats, 1u);
+}
+
 TEST(PassiveStationSetPrm, NewMinTsdrAndAddressApplyAfterTheReply) {
   const BusParams params = BusParams::defaults(bus::Baud::k1_5M);
   TestUser user;

@@ -52,8 +52,12 @@ class PassiveStation final : public bus::Device {
   const char* kind() const override { return "passive station"; }
 
   std::uint8_t address() const { return m_address; }
-  /// Changes the station address at once (management; Set_Slave_Add goes through Reply).
+  /// Changes the station address at once (management, the Flying Redundancy address swap;
+  /// Set_Slave_Add goes through Reply). A new address forgets the stored FCBs and reply: the
+  /// masters' FCB sequences were kept for the old address, so the first request to the new one
+  /// is executed whatever its FCB (as after power-on).
   void set_address(std::uint8_t address) {
+    if (address != m_address) m_responder.reset();
     m_address = address;
     if (bound()) port().receive_filter_changed();  // the line caches receive filters
   }

@@ -5,6 +5,7 @@
 // by hand through each interface's ResponderUser, one DP cycle every 10 ms on each line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <optional>
 
 #include "../dp/slave_harness.hpp"
@@ -188,6 +189,53 @@ TEST(RedundantSlave, CommandedSwitchoverBytesTimesAndNoPulse) {
     return e.kind == RedEvent::Kind::RoleChanged;
   });
   EXPECT_GE(roles, 4);  // start-up and the PB/BP sequence
+}
+
+TEST(RedundantSlave, FlyingAddressesFollowThePrimaryRole) {
+  // Flying Redundancy: interface 0 starts at A (offset 0), interface 1 at A + 64; the offsets
+  // swap exactly when the interface at A + 64 becomes PRIMARY (commanded: at the take-over,
+  // 2 ms after the Primary_Request; autonomous: when the backup counts the primary lost).
+  RedundantSlaveParams p;
+  p.mode = RedundancyMode::Flying;
+  Rig r(p);
+  EXPECT_EQ(r.rs.address_offset(0), 0);
+  EXPECT_EQ(r.rs.address_offset(1), 64);
+  redundant_start(r, 100);
+  EXPECT_EQ(r.rs.address_offset(0), 0);  // interface 0 became PRIMARY where it was: no swap
+  for (bus::Ticks t = 1000 * kMs; t < 1200 * kMs; t += 10 * kMs) r.cycle(t, 1);
+  const bus::Ticks tc = 1205 * kMs;
+  EXPECT_EQ(r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)), Bytes{0xE5});
+  r.run_to(tc + 2 * kMs - 1);
+  EXPECT_EQ(r.rs.role(0), Role::Backup);  // handed over at tc + 1 ms, still at A
+  EXPECT_EQ(r.rs.address_offset(0), 0);
+  EXPECT_EQ(r.rs.address_offset(1), 64);
+  r.run_to(tc + 2 * kMs);
+  EXPECT_EQ(r.rs.role(1), Role::Primary);
+  EXPECT_EQ(r.rs.address_offset(0), 64);
+  EXPECT_EQ(r.rs.address_offset(1), 0);
+  ASSERT_GE(r.events.size(), 2u);
+  EXPECT_EQ(r.events.back().kind, RedEvent::Kind::AddressSwap);
+  EXPECT_EQ(r.events.back().iface, 1);
+  EXPECT_EQ(r.events.back().at, tc + 2 * kMs);
+  // The new primary fails at 1215 ms; interface 0 last heard it at 1206 ms (the switchover
+  // request), counts it lost 300 ms later and takes over, and the addresses swap back.
+  r.line_up[1] = false;
+  for (bus::Ticks t = 1210 * kMs; t < 1600 * kMs; t += 10 * kMs) {
+    if (t == 1220 * kMs) r.rs.fail_interface(1, 1215 * kMs);
+    r.cycle(t, 2);
+  }
+  EXPECT_EQ(r.rs.role(0), Role::Primary);
+  EXPECT_EQ(r.rs.address_offset(0), 0);
+  EXPECT_EQ(r.rs.address_offset(1), 64);
+  const auto swap = std::find_if(r.events.rbegin(), r.events.rend(), [](const RedEvent& e) {
+    return e.kind == RedEvent::Kind::AddressSwap;
+  });
+  ASSERT_NE(swap, r.events.rend());
+  EXPECT_EQ(swap->iface, 0);
+  EXPECT_EQ(swap->at, 1506 * kMs);
+  // System Redundancy: always offset 0.
+  Rig sys;
+  EXPECT_EQ(sys.rs.address_offset(1), 0);
 }
 
 TEST(RedundantSlave, PrimaryInterfaceFailureNoticedBySupervisionNoPulse) {

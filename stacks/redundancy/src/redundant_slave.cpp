@@ -17,6 +17,10 @@ std::string_view to_string(Role r) {
   return "?";
 }
 
+std::string_view to_string(RedundancyMode m) {
+  return m == RedundancyMode::Flying ? "flying" : "system";
+}
+
 /// One interface as seen by its FDL station: the engine, silenced when failed, with the
 /// redundancy bookkeeping around each request.
 class RedundantSlave::Port final : public fdl::ResponderUser {
@@ -109,6 +113,7 @@ void RedundantSlave::power_on(bus::Ticks now) {
     m_if[i].partner_lost = false;
   }
   m_decided = false;
+  m_swapped = false;
   m_tsprimary = m_p.tsprimary_start;
   m_alternate_at = now + m_tsprimary;
   refresh_status();
@@ -222,9 +227,15 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
   const Role from = f.role;
   if (from == r) return;
   f.role = r;
+  bool swapped = false;
   if (from == Role::Primary) lose_primary(now);
   if (r == Role::Primary) {
     m_decided = true;
+    if (address_offset(i) != 0) {
+      // Flying Redundancy: the primary address follows the PRIMARY role, at this instant.
+      m_swapped = !m_swapped;
+      swapped = true;
+    }
     m_alternate_at = bus::kNever;
     if (m_if[1 - i].role == Role::SPrimary || m_if[1 - i].role == Role::SWaiting)
       send(i, Msg::BecomeBackup, now);
@@ -233,6 +244,7 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
   }
   if (r == Role::Backup && f.ack_pending) set_ack(i);
   emit(RedEvent::Kind::RoleChanged, now, i, from, r);
+  if (swapped) emit(RedEvent::Kind::AddressSwap, now, i);
   refresh_status();
 }
 

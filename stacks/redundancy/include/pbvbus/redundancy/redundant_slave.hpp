@@ -44,6 +44,15 @@
 //   own, Red_State_2 the partner's as the station knows it now, without a link delay); every
 //   change makes the next Data_Exchange DH. Prm_Cmd_Ack (0x9E) echoes the last PrmCmd's Seq_Nr
 //   and Function once the command is carried out.
+// - Flying Redundancy (params.mode = Flying; §G.1): both interfaces on ONE line, the primary
+//   address A and the backup address A + 64 (A <= 61, checked by whoever sets the addresses:
+//   devices::SwitchedStationModel). address_offset(i) says which one interface i answers at:
+//   interface 0 starts at A, interface 1 at A + 64. The addresses follow the PRIMARY role: when an
+//   interface that sits at A + 64 becomes PRIMARY (commanded: at the take-over, 2 × link_delay
+//   after the Primary_Request; autonomous: at the take-over or when the backup notices the
+//   primary lost) the two interfaces swap addresses at that instant (event AddressSwap, iface =
+//   the new primary). Between the old primary's hand-over and the take-over both are BACKUP at
+//   their old addresses. Roles, link, PrmCmd and outputs as in System Redundancy.
 
 #include <array>
 #include <cstdint>
@@ -70,7 +79,17 @@ enum class Role : std::uint8_t {
 };
 std::string_view to_string(Role r);
 
+enum class RedundancyMode : std::uint8_t {
+  System,  ///< two lines, the same address on both interfaces
+  Flying,  ///< one line, primary at A, backup at A + 64, swapped on switchover
+};
+std::string_view to_string(RedundancyMode m);
+inline constexpr std::uint8_t kFlyingAddressOffset = 64;
+/// Highest primary address A with Flying Redundancy (A + 64 must be a slave address <= 125).
+inline constexpr std::uint8_t kFlyingMaxAddress = 61;
+
 struct RedundantSlaveParams {
+  RedundancyMode mode = RedundancyMode::System;
   bus::Ticks link_delay = bus::kTicksPerMs;
   bus::Ticks heartbeat_period = 100 * bus::kTicksPerMs;
   bus::Ticks supervision = 300 * bus::kTicksPerMs;
@@ -81,7 +100,7 @@ struct RedundantSlaveParams {
 };
 
 struct RedEvent {
-  enum class Kind : std::uint8_t { RoleChanged, PartnerLost, PartnerBack, OutputHoldExpired };
+  enum class Kind : std::uint8_t { RoleChanged, PartnerLost, PartnerBack, OutputHoldExpired, AddressSwap };
   Kind kind = Kind::RoleChanged;
   bus::Ticks at = 0;
   int iface = 0;  ///< the interface concerned (for PartnerLost/Back: the one that noticed)
@@ -107,6 +126,12 @@ class RedundantSlave {
   /// The PRIMARY interface, or -1.
   int primary() const;
   const RedundantSlaveParams& params() const { return m_p; }
+  /// Flying Redundancy: 0 if interface i answers at the primary address A, 64 if at A + 64.
+  /// Always 0 with System Redundancy.
+  std::uint8_t address_offset(int i) const {
+    if (m_p.mode != RedundancyMode::Flying) return 0;
+    return (i == 1) != m_swapped ? kFlyingAddressOffset : 0;
+  }
 
   // Backplane (bus thread).
   bool write_inputs(std::size_t module, std::span<const std::uint8_t> data);
@@ -177,6 +202,7 @@ class RedundantSlave {
   bus::Ticks m_tsprimary = 0;
   bus::Ticks m_alternate_at = bus::kNever;
   bool m_powered = false;
+  bool m_swapped = false;  ///< Flying: interface 1 at A, interface 0 at A + 64
   std::function<void(const RedEvent&)> m_cb;
 };
 

@@ -61,7 +61,7 @@ class SwitchedStationModel::Iface final : public bus::Device {
     m_station_timer = bus::kNever;
     m_armed = bus::kNever;
     m_station.on_power_on(now);
-    m_model.rearm_all();
+    m_model.after_call();
   }
   void on_power_off(bus::Ticks now) override {
     m_powered = false;
@@ -72,7 +72,7 @@ class SwitchedStationModel::Iface final : public bus::Device {
   void on_frame(const bus::RxFrame& frame) override {
     if (!m_powered) return;
     m_station.on_frame(frame);
-    m_model.rearm_all();
+    m_model.after_call();
   }
   void on_timer(bus::Ticks now) override {
     if (!m_powered) return;
@@ -82,7 +82,7 @@ class SwitchedStationModel::Iface final : public bus::Device {
       m_station.on_timer(now);
     }
     m_model.m_rs->on_time(now);
-    m_model.rearm_all();
+    m_model.after_call();
   }
   int receive_filter() const override { return m_station.receive_filter(); }
   const char* kind() const override { return "DP slave (switched)"; }
@@ -118,7 +118,9 @@ void SwitchedStationModel::Port::set_timer(bus::Ticks at) {
   m_model.rearm_all();
 }
 bool SwitchedStationModel::Port::receiving() const { return m_if.outer().receiving(); }
-void SwitchedStationModel::Port::receive_filter_changed() { m_if.outer().receive_filter_changed(); }
+void SwitchedStationModel::Port::receive_filter_changed() {
+  if (m_if.bound()) m_if.outer().receive_filter_changed();  // unattached: the line reads it later
+}
 
 // --- building ---------------------------------------------------------------------------------
 
@@ -128,8 +130,17 @@ SwitchedStationBuild SwitchedStationModel::build(const GsdFile& gsd,
   SwitchedStationBuild r;
   const std::string file = std::filesystem::path(gsd.file_name()).filename().string();
   const GsdRedundancy& red = gsd.redundancy();
-  if (!red.system_redundancy())
+  const bool flying = options.redundancy.mode == redundancy::RedundancyMode::Flying;
+  if (flying) {
+    if (!red.flying_redundancy())
+      r.errors.push_back(file +
+                         " does not declare Flying Redundancy (Slave_Redundancy_supp bit 1)");
+    if (options.address > redundancy::kFlyingMaxAddress)
+      r.errors.push_back("Flying Redundancy needs a primary address <= 61 (backup = address + "
+                         "64), not " + std::to_string(options.address));
+  } else if (!red.system_redundancy()) {
     r.errors.push_back(file + " does not declare System Redundancy (Slave_Redundancy_supp bit 0)");
+  }
   if (!red.prm_cmd_supp) r.errors.push_back(file + " does not declare PrmCmd_supp = 1");
   if (!gsd.dpv1().dpv1_slave || !gsd.dpv1().prm_block_structure_supp)
     r.errors.push_back(file + " is not a DP-V1 slave with Prm_Block_Structure_supp (the PrmCmd "
@@ -160,6 +171,7 @@ SwitchedStationBuild SwitchedStationModel::build(const GsdFile& gsd,
   SwitchedStationModel* raw = m.get();
   m->m_rs->on_event([raw](const redundancy::RedEvent& e) { raw->m_events.push_back(e); });
   for (int i = 0; i < 2; ++i) m->m_if[i] = std::make_unique<Iface>(*m, i, options.bus_params);
+  m->sync_addresses();  // Flying: interface 1 at A + 64
   const auto& layout = m->m_rs->engine(0).layout();
   m->m_channels.resize(layout.modules.size());
   std::size_t max_in = 0;
@@ -226,6 +238,18 @@ void SwitchedStationModel::rearm_all() {
     if (f) f->rearm();
 }
 
+void SwitchedStationModel::sync_addresses() {
+  for (int i = 0; i < 2; ++i) {
+    if (!m_if[i]) continue;
+    const auto a = static_cast<std::uint8_t>(m_address + m_rs->address_offset(i));
+    if (m_if[i]->m_station.address() != a) m_if[i]->m_station.set_address(a);
+  }
+}
+
+std::uint8_t SwitchedStationModel::interface_address(int i) const {
+  return m_if[i]->m_station.address();
+}
+
 bus::Ticks SwitchedStationModel::now() const {
   for (const auto& f : m_if)
     if (f && f->bound()) return f->outer().now();
@@ -235,13 +259,13 @@ bus::Ticks SwitchedStationModel::now() const {
 void SwitchedStationModel::fail_interface(int i) {
   m_rs->fail_interface(i, now());
   if (m_if[i]->m_line) m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, false);
-  rearm_all();
+  after_call();
 }
 
 void SwitchedStationModel::repair_interface(int i) {
   m_rs->repair_interface(i, now());
   if (m_if[i]->m_line) m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, true);
-  rearm_all();
+  after_call();
 }
 
 }  // namespace pbvbus::devices

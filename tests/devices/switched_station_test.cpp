@@ -601,5 +601,166 @@ TEST(SwitchedStation, CommandedSwitchoverByPrimaryRequestOnLineB) {
   EXPECT_TRUE(fresh);
 }
 
+// --- Flying Redundancy: one line, primary at A, backup at A + 64, swapped on switchover ---------
+
+constexpr std::uint8_t kFrA = kAddr;      // 5: the primary address
+constexpr std::uint8_t kFrB = kAddr + 64;  // 69: the backup address
+
+/// PBVB0A11.gsd (Slave_Redundancy_supp = 3) in Flying mode on one line; one master with two
+/// slave entries, A and A + 64, both with the PrmCmd block: Seq_Nr 1, Primary_Request,
+/// Properties 0C (Address_Change | Address_Offset64: flying redundancy), hold 100 × 10 ms.
+/// Entry A writes kOutA, entry A + 64 kOutB.
+struct OneLine {
+  bus::Scheduler sched;
+  bus::Line line{sched, "FR", kBaud};
+  FrameRecorder rec;
+  fdl::BusParams bp;
+  std::unique_ptr<dp::Master> master;
+  std::unique_ptr<fdl::ActiveStation> station;
+  std::unique_ptr<SwitchedStationModel> model;
+  bus::AttachmentId att[2] = {-1, -1};
+
+  OneLine() {
+    const GsdFile gsd = load("PBVB0A11.gsd");
+    bp = fdl::BusParams::defaults(kBaud);
+    bp.hsa = 12;
+    line.add_tap(rec);
+    std::vector<dp::SlaveParams> slaves;
+    for (const std::uint8_t a : {kFrA, kFrB}) {
+      auto sp = master_slave_params(gsd, modules(), a);
+      EXPECT_TRUE(sp.ok());
+      dp::SlaveParams p = *sp.value;
+      p.user_prm[2] |= 0x88;  // PrmCmd | Prm_Structure
+      const Bytes block{0x08, 0x02, 0x00, 0x08, 0x02, 0x0C, 0x00, 0x64};
+      p.user_prm.insert(p.user_prm.end(), block.begin(), block.end());
+      slaves.push_back(p);
+    }
+    master = std::make_unique<dp::Master>(dp::MasterParams{}, std::move(slaves));
+    station = std::make_unique<fdl::ActiveStation>(1, bp, *master);
+    line.attach(*station, "master 1");
+    SwitchedStationOptions o;
+    o.address = kFrA;
+    o.bus_params = bp;
+    o.redundancy.mode = redundancy::RedundancyMode::Flying;
+    auto b = SwitchedStationModel::build(gsd, modules(), o);
+    EXPECT_TRUE(b.ok()) << (b.errors.empty() ? "" : b.errors[0]);
+    model = std::move(b.model);
+    for (int i = 0; i < 2; ++i) att[i] = model->attach(i, line);
+    EXPECT_EQ(model->set_behaviour(0, IoBehaviour::constant_value({0x12, 0x34})), "");
+    EXPECT_EQ(master->image(kFrA).write_outputs(1, kOutA), dp::ImageAccess::Ok);
+    EXPECT_EQ(master->image(kFrB).write_outputs(1, kOutB), dp::ImageAccess::Ok);
+  }
+};
+
+TEST(SwitchedStationFlying, BuildRefusesWithoutTheFlyingBitOrAboveAddress61) {
+  SwitchedStationOptions o;
+  o.bus_params = fdl::BusParams::defaults(kBaud);
+  o.redundancy.mode = redundancy::RedundancyMode::Flying;
+  o.address = 61;
+  auto ok = SwitchedStationModel::build(load("PBVB0A11.gsd"), modules(), o);
+  ASSERT_TRUE(ok.ok()) << (ok.errors.empty() ? "" : ok.errors[0]);
+  EXPECT_EQ(ok.model->mode(), redundancy::RedundancyMode::Flying);
+  EXPECT_EQ(ok.model->interface_address(0), 61);
+  EXPECT_EQ(ok.model->interface_address(1), 125);
+  auto sr_only = SwitchedStationModel::build(load("PBVB0A10.gsd"), modules(), o);  // supp = 1
+  EXPECT_FALSE(sr_only.ok());
+  o.address = 62;
+  auto high = SwitchedStationModel::build(load("PBVB0A11.gsd"), modules(), o);
+  EXPECT_FALSE(high.ok());
+  // System Redundancy keeps the same address on both interfaces.
+  o.redundancy.mode = redundancy::RedundancyMode::System;
+  auto sr = SwitchedStationModel::build(load("PBVB0A11.gsd"), modules(), o);
+  ASSERT_TRUE(sr.ok());
+  EXPECT_EQ(sr.model->interface_address(1), 62);
+}
+
+TEST(SwitchedStationFlying, CommandedSwitchoverSwapsTheAddressesWithoutPulse) {
+  OneLine t;
+  OutputSampler s(*t.model);
+  t.line.add_tap(s);
+  // Interface 1's transceiver stays off at first: entry A + 64 gets no answer, so its Set_Prm
+  // (with Primary_Request) comes only once it is switched on: a commanded switchover to A + 64.
+  t.line.set_transceiver_ok(t.att[1], false);
+  t.line.start();
+  t.sched.run_until(50 * kMs);
+  ASSERT_EQ(t.model->role(0), Role::Primary);
+  ASSERT_EQ(t.model->role(1), Role::Backup);
+  EXPECT_EQ(t.model->interface_address(0), kFrA);
+  EXPECT_EQ(t.model->interface_address(1), kFrB);
+  EXPECT_EQ(t.master->slave_state(kFrA), dp::SlaveStatusState::DataExchange);
+  t.line.set_transceiver_ok(t.att[1], true);
+  while (t.model->role(1) != Role::BpSwitchover) {
+    ASSERT_LT(t.sched.now(), 500 * kMs) << "no Primary_Request to A + 64";
+    t.sched.run_until(t.sched.now() + kMs / 10);
+  }
+  // The Set_Prm to A + 64 (SD2, DA C5 = 69 | EXT, DSAP 3D): BP_SWITCHOVER at its end.
+  bus::Ticks prm_end = bus::kNever;
+  for (std::size_t i = 0; i < t.rec.size(); ++i) {
+    const auto& b = t.rec.frame(i).bytes;
+    if (b.size() > 8 && b[0] == 0x68 && b[4] == (0x80 | kFrB) && b[7] == 0x3D)
+      prm_end = t.rec.frame(i).end;
+  }
+  ASSERT_NE(prm_end, bus::kNever);
+  const bus::Ticks swap_at = prm_end + 2 * kMs;  // switchover request 1 ms, take-over 1 ms
+  t.sched.run_until(swap_at - 1);
+  EXPECT_EQ(t.model->role(0), Role::Backup);  // handed over at prm_end + 1 ms ...
+  EXPECT_EQ(t.model->role(1), Role::BpSwitchover);
+  EXPECT_EQ(t.model->interface_address(0), kFrA);  // ... but still at A
+  EXPECT_EQ(t.model->interface_address(1), kFrB);
+  t.sched.run_until(swap_at);
+  EXPECT_EQ(t.model->role(1), Role::Primary);
+  EXPECT_EQ(t.model->interface_address(0), kFrB);
+  EXPECT_EQ(t.model->interface_address(1), kFrA);
+  t.sched.run_until(swap_at + 200 * kMs);
+
+  using K = redundancy::RedEvent::Kind;
+  int swaps = 0;
+  for (const auto& e : t.model->events()) {
+    if (e.kind != K::AddressSwap) continue;
+    ++swaps;
+    EXPECT_EQ(e.iface, 1);
+    EXPECT_EQ(e.at, swap_at);
+  }
+  EXPECT_EQ(swaps, 1);
+  EXPECT_EQ(t.master->slave_state(kFrA), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(t.master->slave_state(kFrB), dp::SlaveStatusState::DataExchange);
+
+  // Every reply's source address and transmitter: A from interface 0 and A + 64 from interface 1
+  // before the swap, the other way round after it. (A reply starting within 100 us after the swap
+  // may answer a request taken before it, with the old address; none is counted.)
+  int n[2][2] = {};  // [after][interface]
+  for (std::size_t i = 0; i < t.rec.size(); ++i) {
+    const auto& f = t.rec.frame(i);
+    if (f.sender != t.att[0] && f.sender != t.att[1]) continue;
+    const auto& b = f.bytes;
+    int sa = -1;
+    if (b.size() >= 6 && b[0] == 0x68) sa = b[5] & 0x7F;
+    if (b.size() >= 3 && b[0] == 0x10) sa = b[2] & 0x7F;
+    if (sa < 0) continue;  // E5
+    if (f.start >= swap_at && f.start < swap_at + kMs / 10) continue;
+    const bool after = f.start >= swap_at;
+    const int iface = f.sender == t.att[0] ? 0 : 1;
+    const int want = (iface == 0) != after ? kFrA : kFrB;
+    EXPECT_EQ(sa, want) << "at " << f.start << ": " << t.rec.hex(i);
+    ++n[after][iface];
+  }
+  EXPECT_GT(n[0][0], 0);
+  EXPECT_GT(n[0][1], 0);
+  EXPECT_GT(n[1][0], 0);
+  EXPECT_GT(n[1][1], 0);
+
+  // No pulse: from the first Data_Exchange at A the backplane shows entry A's outputs, before and
+  // after the swap (the interface now at A is the PRIMARY); entry A + 64's never reach it.
+  bool started = false;
+  for (const auto& x : s.samples) {
+    if (!started && x.out == kOutA) started = true;
+    if (started) {
+      ASSERT_EQ(x.out, kOutA) << x.at;
+    }
+  }
+  EXPECT_TRUE(started);
+  EXPECT_FALSE(t.model->outputs_held());
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

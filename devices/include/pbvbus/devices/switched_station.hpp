@@ -35,6 +35,16 @@
 //   backplane has its own supply). Station power loss = both attachments off: not modelled as
 //   such yet (the RedundantSlave keeps its state).
 // - T_SLAVE_UM: the GSD's Slave_Max_Switch_Over_Time (unit 10 ms, assumption in gsd.hpp).
+// - Flying Redundancy (options.redundancy.mode = Flying; §G.1): both interface devices go on ONE
+//   line; interface 0 starts at `address` (A), interface 1 at A + 64. Refused unless the GSD's
+//   Slave_Redundancy_supp has the Flying bit (0x02) and A <= 61. The FDL stations' addresses
+//   follow RedundantSlave::address_offset(): after every call the line makes into either
+//   interface device (frame, timer, power) and after fail/repair_interface() the model sets
+//   both stations' addresses (fdl::PassiveStation::set_address, which re-reads the line's
+//   receive filter and forgets the FCBs). The swap happens inside RedundantSlave::on_time() or
+//   a request, so the stations change address in the same call, at the same virtual time. A
+//   reply already scheduled by the request that caused the swap still goes out with the old
+//   address (as after Set_Slave_Add). build() refuses System Redundancy unless bit 0 is set.
 
 #include <cstdint>
 #include <memory>
@@ -54,7 +64,7 @@
 namespace pbvbus::devices {
 
 struct SwitchedStationOptions {
-  std::uint8_t address = 3;   ///< 0..126, the same on both lines
+  std::uint8_t address = 3;   ///< 0..126, the same on both lines (Flying: A, 0..61)
   fdl::BusParams bus_params;  ///< both lines' parameters (baud, min TSDR)
   std::optional<std::uint32_t> tsdr;  ///< own station delay in t_bit; unset = bus min TSDR
   std::string name;           ///< default "<Model_Name> @<address>"
@@ -78,7 +88,11 @@ class SwitchedStationModel {
   SwitchedStationModel& operator=(const SwitchedStationModel&) = delete;
 
   const std::string& name() const { return m_name; }
+  /// The station address (Flying Redundancy: the primary address A).
   std::uint8_t address() const { return m_address; }
+  /// The address interface i's FDL station answers at now (Flying: A or A + 64).
+  std::uint8_t interface_address(int i) const;
+  redundancy::RedundancyMode mode() const { return m_rs->params().mode; }
   std::uint32_t tsdr() const { return m_tsdr; }
   const dp::SlaveConfig& config() const { return m_rs->engine(0).config(); }
   const GsdBytes& default_user_prm() const { return m_default_prm; }
@@ -118,6 +132,13 @@ class SwitchedStationModel {
   SwitchedStationModel() = default;
   void refresh_inputs(bus::Ticks now);
   void rearm_all();
+  /// Flying Redundancy: each FDL station's address from RedundantSlave::address_offset().
+  void sync_addresses();
+  /// After every call from a line or a fault: addresses, then the timers of both lines.
+  void after_call() {
+    sync_addresses();
+    rearm_all();
+  }
   bus::Ticks now() const;
 
   std::string m_name;

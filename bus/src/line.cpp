@@ -429,8 +429,8 @@ void Line::deliver(Transmission& t, std::size_t to, std::size_t len, std::uint16
   refresh_filter(to);
 }
 
-void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end) {
-  if (m_taps.empty()) return;
+TapFrame Line::tap_view(const Transmission& t, std::size_t len, std::uint16_t extra_flags,
+                        Ticks end) const {
   TapFrame f;
   f.line = this;
   f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
@@ -439,19 +439,18 @@ void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
   f.sender = static_cast<std::uint16_t>(t.from->id);
   f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  return f;
+}
+
+void Line::tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end) {
+  if (m_taps.empty()) return;
+  TapFrame f = tap_view(t, len, extra_flags, end);
   for (Tap* tap : m_taps) tap->on_frame(f);
 }
 
 void Line::probe_frame(const Transmission& t, std::uint64_t probes, std::size_t len,
                        std::uint16_t extra_flags, Ticks end) {
-  TapFrame f;
-  f.line = this;
-  f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
-  f.start = t.start;
-  f.end = end;
-  f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
-  f.sender = static_cast<std::uint16_t>(t.from->id);
-  f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  TapFrame f = tap_view(t, len, extra_flags, end);
   for (std::uint64_t b = probes; b != 0; b &= b - 1) {
     const ProbeTap& p = m_probes[static_cast<std::size_t>(std::countr_zero(b))];
     f.probe = static_cast<std::int16_t>(p.at);

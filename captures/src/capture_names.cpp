@@ -1,5 +1,6 @@
 #include "capture_names.hpp"
 
+#include <cstdio>
 #include <utility>
 
 namespace pbvbus::captures::names {
@@ -36,6 +37,18 @@ std::vector<std::string_view> flag_reasons(std::uint32_t flags) {
   for (const auto& [bit, name] : kNames)
     if (flags & bit) out.push_back(name);
   return out;
+}
+
+std::string format_time_ns(std::int64_t ns) {
+  char buf[48];
+  const char* sign = ns < 0 ? "-" : "";
+  // -(ns + 1) + 1: INT64_MIN has no positive int64 counterpart.
+  const std::uint64_t a =
+      ns < 0 ? static_cast<std::uint64_t>(-(ns + 1)) + 1 : static_cast<std::uint64_t>(ns);
+  std::snprintf(buf, sizeof buf, "%s%llu.%09llu s", sign,
+                static_cast<unsigned long long>(a / 1'000'000'000),
+                static_cast<unsigned long long>(a % 1'000'000'000));
+  return buf;
 }
 
 }  // namespace pbvbus::captures::names

@@ -5,6 +5,7 @@
 // sets (pcapng_writer.hpp). Internal to the captures layer.
 
 #include <cstdint>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -26,5 +27,8 @@ std::string_view sap_service(std::uint8_t sap);
 /// The link-layer error bits of an epb_flags value, in bit order, as words ("symbol error
 /// (collision)", "packet too short (partial)", ...).
 std::vector<std::string_view> flag_reasons(std::uint32_t flags);
+
+/// A capture time in ns as seconds with nine decimals: "2.000985333 s", "-0.000000001 s".
+std::string format_time_ns(std::int64_t ns);
 
 }  // namespace pbvbus::captures::names

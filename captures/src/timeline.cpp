@@ -513,15 +513,6 @@ std::optional<std::int64_t> parse_time_ns(std::string_view s) {
   return static_cast<std::int64_t>(v);
 }
 
-std::string format_time_ns(std::int64_t ns) {
-  char buf[48];
-  const char* sign = ns < 0 ? "-" : "";
-  const std::uint64_t a =
-      ns < 0 ? static_cast<std::uint64_t>(-(ns + 1)) + 1 : static_cast<std::uint64_t>(ns);
-  std::snprintf(buf, sizeof buf, "%s%llu.%09llu s", sign,
-                static_cast<unsigned long long>(a / 1'000'000'000),
-                static_cast<unsigned long long>(a % 1'000'000'000));
-  return buf;
-}
+std::string format_time_ns(std::int64_t ns) { return names::format_time_ns(ns); }
 
 }  // namespace pbvbus::captures

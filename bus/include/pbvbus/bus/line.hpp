@@ -188,6 +188,9 @@ class Line final : private EventTarget {
   void refresh_filter(std::size_t i);
   /// Whether attachment i's (cached) filter takes a frame with destination `da` (-1: none).
   bool accepts(std::size_t i, int da) const;
+  /// What the taps see of transmission `t` (its first `len` octets), whole-line or at a probe.
+  TapFrame tap_view(const Transmission& t, std::size_t len, std::uint16_t extra_flags,
+                    Ticks end) const;
   void tap_frame(const Transmission& t, std::size_t len, std::uint16_t extra_flags, Ticks end);
   /// Hands the frame (or its first `len` octets) to the probes in `probes` (bits of m_probes).
   void probe_frame(const Transmission& t, std::uint64_t probes, std::size_t len,

@@ -52,6 +52,7 @@ class Line::Port final : public DevicePort {
   void set_timer(Ticks at) override;
   bool receiving() const override;
   void receive_filter_changed() override;
+  bool medium_fault() const override { return m_line.m_short; }
 
  private:
   Line& m_line;

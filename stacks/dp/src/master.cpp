@@ -41,6 +41,8 @@ std::string_view to_string(MasterEvent::Kind k) {
     case MasterEvent::Kind::Diagnosis: return "diagnosis";
     case MasterEvent::Kind::Alarm: return "alarm";
     case MasterEvent::Kind::ModeChange: return "mode change";
+    case MasterEvent::Kind::DataExchangeEntered: return "data exchange entered";
+    case MasterEvent::Kind::PrmCmdDone: return "PrmCmd done";
   }
   return "?";
 }
@@ -63,7 +65,11 @@ std::vector<std::uint8_t> SlaveParams::set_prm_du() const {
   h.min_tsdr = min_tsdr;
   h.ident = ident;
   h.group_ident = group_ident;
-  return encode_prm(h, user_prm);
+  if (prm_cmd.empty()) return encode_prm(h, user_prm);
+  std::vector<std::uint8_t> user(user_prm);
+  if (user.size() >= 3) user[2] |= kPrmCmd | kPrmStructure;
+  user.insert(user.end(), prm_cmd.begin(), prm_cmd.end());
+  return encode_prm(h, user);
 }
 
 std::vector<std::uint8_t> SlaveParams::chk_cfg_du() const {
@@ -104,8 +110,10 @@ Master::Master(MasterParams params, std::vector<SlaveParams> slaves) : m_p(std::
     if (sp.address > kMaxSlaveAddress) throw std::invalid_argument(who + "address must be 0..125");
     if (sp.address == m_p.address) throw std::invalid_argument(who + "address is the master's");
     if (m_index[sp.address] >= 0) throw std::invalid_argument(who + "configured twice");
-    if (sp.user_prm.size() > kMaxUserPrmLen)
+    if (sp.user_prm.size() + sp.prm_cmd.size() > kMaxUserPrmLen)
       throw std::invalid_argument(who + "more than 237 octets of user prm data");
+    if (!sp.prm_cmd.empty() && (sp.prm_cmd.size() != kPrmCmdBlockLen || !sp.dpv1()))
+      throw std::invalid_argument(who + "a PrmCmd block is 8 octets and needs a DP-V1 Set_Prm");
     if ((sp.station_status & kPrmWdOn) && (sp.wd_fact_1 == 0 || sp.wd_fact_2 == 0))
       throw std::invalid_argument(who + "watchdog factors must be 1..255");
     SlaveConfig sc;
@@ -142,6 +150,22 @@ std::span<const std::uint8_t> Master::slave_diag(std::uint8_t a) const { return 
 const MasterSlaveStats& Master::slave_stats(std::uint8_t a) const { return slave(a).stats; }
 MasterImage& Master::image(std::uint8_t a) { return *slave(a).image; }
 const MasterImage& Master::image(std::uint8_t a) const { return *slave(a).image; }
+
+bool Master::prm_cmd(std::uint8_t a, std::span<const std::uint8_t> block, bool send) {
+  if (!has_slave(a) || block.size() != kPrmCmdBlockLen) return false;
+  Slave& s = slave(a);
+  if (s.p.prm_cmd.size() != kPrmCmdBlockLen) return false;
+  s.p.prm_cmd.assign(block.begin(), block.end());
+  // The block is the last 8 octets of the stored Set_Prm (set_prm_du() appends it).
+  std::copy(block.begin(), block.end(), s.prm.end() - static_cast<std::ptrdiff_t>(kPrmCmdBlockLen));
+  // Owed unless the start-up's own Set_Prm has yet to go out (it carries the new block).
+  s.prm_cmd_due = send && s.state != SlaveStatusState::Prm && s.state != SlaveStatusState::Diag &&
+                  s.state != SlaveStatusState::NotPresent && s.state != SlaveStatusState::Locked &&
+                  s.state != SlaveStatusState::Inactive;
+  return true;
+}
+
+bool Master::prm_cmd_pending(std::uint8_t a) const { return has_slave(a) && slave(a).prm_cmd_due; }
 
 std::vector<std::uint8_t> Master::addresses() const {
   std::vector<std::uint8_t> out;
@@ -357,12 +381,23 @@ bool Master::main_request(Slave& s, bus::Ticks now, fdl::Request& out) {
       fill(out, s, kSapSetPrm, kSapMs0, Kind::Prm);
       out.data.assign(s.prm.begin(), s.prm.end());
       ++s.stats.startups;
+      s.prm_cmd_due = false;  // this Set_Prm carries the current PrmCmd block
       return true;
     case SlaveStatusState::Cfg:
       fill(out, s, kSapChkCfg, kSapMs0, Kind::Cfg);
       out.data.assign(s.cfg.begin(), s.cfg.end());
       return true;
     case SlaveStatusState::DataExchange: {
+      if (s.prm_cmd_due) {
+        // Pure PrmCmd (§G.2): header + DPV1_Status_1..3 + the block, instead of this pass's
+        // Data_Exchange; the slave keeps its outputs (Output_Hold_Time covers the gap).
+        s.prm_cmd_due = false;
+        fill(out, s, kSapSetPrm, kSapMs0, Kind::PrmCmd);
+        out.data.assign(s.prm.begin(), s.prm.begin() + static_cast<std::ptrdiff_t>(kPrmLenDpv1));
+        out.data.insert(out.data.end(), s.prm.end() - static_cast<std::ptrdiff_t>(kPrmCmdBlockLen),
+                        s.prm.end());
+        return true;
+      }
       fill(out, s, std::nullopt, std::nullopt, Kind::DataExchange);
       if (m_mode == MasterMode::Operate) {
         out.data.resize(s.layout.outputs);
@@ -433,6 +468,19 @@ void Master::on_confirmation(const Confirmation& con) {
       break;
     case Kind::DataExchange: on_dx(s, con); break;
     case Kind::Acyclic: on_acyclic(s, con); break;
+    case Kind::PrmCmd:
+      if (is_empty_ack(con)) {
+        ++s.stats.prm_cmds;
+        MasterEvent e;
+        e.kind = MasterEvent::Kind::PrmCmdDone;
+        e.time = con.now;
+        e.slave = s.p.address;
+        emit(e);
+      } else {
+        ++s.stats.invalid_responses;
+        restart(s, con.now, MasterEvent::Cause::InvalidResponse);
+      }
+      break;
     default: break;
   }
 }
@@ -738,16 +786,18 @@ void Master::enter_dx(Slave& s, bus::Ticks now) {
   s.image->set_valid(true);
   if (s.in_dx) return;  // back from Stat_Diag
   s.in_dx = true;
+  MasterEvent e;
+  e.time = now;
+  e.slave = s.p.address;
+  e.diag = s.diag;
   if (s.failed) {
     s.failed = false;
     ++s.stats.returns;
-    MasterEvent e;
     e.kind = MasterEvent::Kind::StationReturn;
-    e.time = now;
-    e.slave = s.p.address;
-    e.diag = s.diag;
     emit(e);
   }
+  e.kind = MasterEvent::Kind::DataExchangeEntered;
+  emit(e);
 }
 
 }  // namespace pbvbus::dp

@@ -57,6 +57,11 @@ class DevicePort {
   /// on_frame, on_timer), so this is only needed for a change made from outside those calls
   /// (a management action, a scenario step). Until then the line may use the old filter.
   virtual void receive_filter_changed() {}
+  /// The RS-485 driver's read-back: true while what this device would send cannot reach the
+  /// cable intact (the line is short-circuited). A PROFIBUS ASIC compares what it sends with
+  /// what it reads back and reports a bus fault (S7: BUSF on, a master system failure); a
+  /// device whose own transceiver is dead cannot tell (it reads back nothing, like silence).
+  virtual bool medium_fault() const { return false; }
 
  protected:
   ~DevicePort() = default;

@@ -117,6 +117,10 @@ struct SlaveParams {
   bool fail_safe = false;                ///< send no output data in Clear (GSD Fail_Safe)
   std::uint16_t c1_response_timeout = 100;  ///< 10 ms units (GSD C1_Response_Timeout)
   bool active = true;  ///< false: never addressed (diag shows Deactivated)
+  /// PI 2.212 slave redundancy: an 8-octet PrmCmd block (structured, type 0x02) appended to
+  /// Set_Prm after user_prm, with DPV1_Status_3 |= PrmCmd | Prm_Structure (0x88). Empty = none.
+  /// The dp layer carries the octets; redundancy::MasterSystem decides what they say.
+  std::vector<std::uint8_t> prm_cmd;
 
   bool dpv1() const { return user_prm.size() >= 3 && (user_prm[0] & kDpv1Enable) != 0; }
   std::vector<std::uint8_t> set_prm_du() const;
@@ -160,6 +164,7 @@ struct MasterSlaveStats {
   std::uint64_t dh = 0;               ///< DH answers
   std::uint64_t alarms = 0;
   std::uint64_t alarm_acks = 0;       ///< positive Alarm_Ack responses
+  std::uint64_t prm_cmds = 0;         ///< pure PrmCmd Set_Prms acknowledged in data exchange
   // DP cycle: time between two consecutive Data_Exchange polls (request starts) of the slave.
   std::uint64_t cycle_count = 0;
   bus::Ticks cycle_min = 0;
@@ -175,6 +180,9 @@ struct MasterEvent {
     Diagnosis,       ///< a Slave_Diag was read (see the rules above)
     Alarm,           ///< a DP-V1 alarm in the diagnosis (S7: OB 82/OB 40/...)
     ModeChange,      ///< the master changed its operating state (e.g. Auto_Clear)
+    DataExchangeEntered,  ///< the slave reached data exchange (every start-up, after any
+                          ///< StationReturn); no S7 event of its own
+    PrmCmdDone,      ///< a pure PrmCmd Set_Prm was acknowledged (the slave stays in DX)
   };
   enum class Cause : std::uint8_t {
     None,
@@ -234,6 +242,20 @@ class Master final : public fdl::InitiatorUser {
 
   void set_event_handler(MasterEventHandler h) { m_events = std::move(h); }
 
+  /// PI 2.212: replaces the slave's PrmCmd block (8 octets, SlaveParams::prm_cmd must have been
+  /// configured) for every later Set_Prm, and sends it at once as a "pure PrmCmd" Set_Prm
+  /// (7-octet header + DPV1_Status_1..3 + the block = 18 octets, the VPC3's PRM_CMD_LENGTH,
+  /// protocol-facts.md §G.2) as the slave's next main request if it is in data exchange or
+  /// further in its start-up than the Set_Prm step (a start-up Set_Prm not yet sent carries the
+  /// new block anyway). The pure PrmCmd keeps the slave in data exchange: an SC/empty answer →
+  /// event PrmCmdDone; any other answer restarts the slave's start-up; no answer is a station
+  /// failure as for any request. Returns false (nothing changes) for an unknown slave, a slave
+  /// without a configured PrmCmd block or a block that is not 8 octets. With send = false the
+  /// block only replaces the stored one (what a later start-up's Set_Prm will carry).
+  bool prm_cmd(std::uint8_t address, std::span<const std::uint8_t> block, bool send = true);
+  /// Whether a pure PrmCmd for the slave is waiting to be sent.
+  bool prm_cmd_pending(std::uint8_t address) const;
+
   // --- DP-V1 MSAC_C1 (bus thread). Each returns an id (> 0) or 0 if refused: unknown slave, not
   // DP-V1, not in data exchange, or a length out of 1..240. The callback runs on completion.
   std::uint32_t read(std::uint8_t address, std::uint8_t slot, std::uint8_t index,
@@ -250,7 +272,7 @@ class Master final : public fdl::InitiatorUser {
   void on_token(bus::Ticks now, bus::Ticks trr) override;
 
  private:
-  enum class Kind : std::uint8_t { None, GlobalControl, Diag, Prm, Cfg, DataExchange, Acyclic };
+  enum class Kind : std::uint8_t { None, GlobalControl, Diag, Prm, Cfg, DataExchange, Acyclic, PrmCmd };
   struct Job {
     std::uint32_t id = 0;
     std::uint8_t fn = 0;
@@ -275,6 +297,7 @@ class Master final : public fdl::InitiatorUser {
     SlaveLayout layout;
     std::vector<std::uint8_t> prm;
     std::vector<std::uint8_t> cfg;
+    bool prm_cmd_due = false;  ///< a pure PrmCmd Set_Prm is owed (see prm_cmd())
     std::unique_ptr<MasterImage> image;
     SlaveStatusState state = SlaveStatusState::Inactive;
     bool failed = false;

@@ -146,6 +146,9 @@ class ActiveStation final : public bus::Device {
   /// Station type at `a` as known from GAP polls, replies and the LAS; nullopt = nobody.
   std::optional<StationType> live(std::uint8_t a) const;
   std::vector<std::pair<std::uint8_t, StationType>> live_list() const;
+  /// The transceiver's read-back reports a bus fault (bus::DevicePort::medium_fault(): a
+  /// short circuit); false while not attached.
+  bool medium_fault() const { return bound() && port().medium_fault(); }
   /// Whether requests to `a` currently go without repeats (it did not answer).
   bool non_operational(std::uint8_t a) const { return a < 128 && m_nonop.test(a); }
 

@@ -1,0 +1,402 @@
+// The redundant DP master system (master_system.hpp has the decisions).
+#include "pbvbus/redundancy/master_system.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "pbvbus/dp/diagnosis.hpp"
+
+namespace pbvbus::redundancy {
+
+std::string_view to_string(LineLoss c) {
+  switch (c) {
+    case LineLoss::ShortCircuit: return "short circuit";
+    case LineLoss::MasterStop: return "master stop";
+    case LineLoss::MasterFailure: return "master failure";
+  }
+  return "?";
+}
+
+std::uint16_t SystemEvent::code() const {
+  switch (kind) {
+    case Kind::RedundancyLoss: return 0x73A3;
+    case Kind::RedundancyReturn: return 0x72A3;
+    case Kind::StationFailure: return 0x39C4;
+    case Kind::StationReturn: return 0x38C4;
+    case Kind::MasterSystemFailure: return 0x39C3;
+    case Kind::MasterSystemReturn: return 0x38C3;
+    case Kind::Switchover: return 0;
+  }
+  return 0;
+}
+
+int SystemEvent::ob() const {
+  switch (kind) {
+    case Kind::RedundancyLoss:
+    case Kind::RedundancyReturn: return 70;
+    case Kind::Switchover: return 0;
+    default: return 86;
+  }
+}
+
+std::string_view to_string(SystemEvent::Kind k) {
+  switch (k) {
+    case SystemEvent::Kind::RedundancyLoss: return "redundancy loss";
+    case SystemEvent::Kind::RedundancyReturn: return "redundancy restored";
+    case SystemEvent::Kind::StationFailure: return "station failure";
+    case SystemEvent::Kind::StationReturn: return "station return";
+    case SystemEvent::Kind::MasterSystemFailure: return "master system failure";
+    case SystemEvent::Kind::MasterSystemReturn: return "master system return";
+    case SystemEvent::Kind::Switchover: return "switchover";
+  }
+  return "?";
+}
+
+std::string_view to_string(SystemEvent::Cause c) {
+  switch (c) {
+    case SystemEvent::Cause::None: return "none";
+    case SystemEvent::Cause::ChannelFailure: return "channel failure";
+    case SystemEvent::Cause::ChannelMissing: return "channel missing";
+    case SystemEvent::Cause::LineLost: return "line lost";
+    case SystemEvent::Cause::SwitchoverTimeout: return "switchover timeout";
+    case SystemEvent::Cause::StartUp: return "start-up";
+  }
+  return "?";
+}
+
+std::optional<RedStatusBlock> find_red_status(std::span<const std::uint8_t> diag) {
+  if (diag.size() <= dp::kStdDiagLen) return std::nullopt;
+  std::vector<dp::ExtDiagBlock> blocks;
+  if (!dp::split_ext_diag(diag.subspan(dp::kStdDiagLen), blocks)) return std::nullopt;
+  for (const auto& b : blocks) {
+    if (b.bytes.size() != kRedStatusLen || b.bytes[1] != kStatusRedStatus) continue;
+    RedStatusBlock r;
+    if (decode_red_status(b.bytes, r) == RedStatusError::None) return r;
+  }
+  return std::nullopt;
+}
+
+// --------------------------------------------------------------------------------------------
+
+MasterSystem::MasterSystem(dp::Master& a, dp::Master& b, std::vector<SwitchedStationRef> switched,
+                           MasterSystemParams p)
+    : m_master{&a, &b}, m_p(p) {
+  m_index.fill(-1);
+  if (m_p.preferred != 0 && m_p.preferred != 1)
+    throw std::invalid_argument("master system: the preferred line is 0 or 1");
+  if (m_p.switch_attempts < 1) throw std::invalid_argument("master system: switch_attempts >= 1");
+  for (const auto& r : switched) {
+    const std::string who = "master system: switched station " + std::to_string(r.address) + ": ";
+    if (r.address > dp::kMaxSlaveAddress) throw std::invalid_argument(who + "bad address");
+    if (m_index[r.address] >= 0) throw std::invalid_argument(who + "listed twice");
+    for (int l = 0; l < 2; ++l) {
+      if (!m_master[l]->has_slave(r.address))
+        throw std::invalid_argument(who + "not configured on line " + std::to_string(l));
+      if (m_master[l]->slave_params(r.address).prm_cmd.size() != kPrmCmdLen)
+        throw std::invalid_argument(who + "no PrmCmd block in its Set_Prm on line " +
+                                    std::to_string(l));
+    }
+    Station s;
+    s.address = r.address;
+    s.switched = true;
+    s.t_slave_um = r.t_slave_um;
+    s.flying = r.flying;
+    m_index[r.address] = static_cast<int>(m_st.size());
+    m_st.push_back(s);
+  }
+  for (int l = 0; l < 2; ++l) {
+    for (std::uint8_t addr : m_master[l]->addresses()) {
+      if (m_index[addr] >= 0) {
+        if (m_st[static_cast<std::size_t>(m_index[addr])].switched) continue;
+        throw std::invalid_argument("master system: one-sided slave " + std::to_string(addr) +
+                                    " is configured on both lines (a switched station?)");
+      }
+      Station s;
+      s.address = addr;
+      s.home = l;
+      m_index[addr] = static_cast<int>(m_st.size());
+      m_st.push_back(s);
+    }
+  }
+  // The start-up blocks: Primary_Request on the preferred line only.
+  for (auto& s : m_st) {
+    if (!s.switched) continue;
+    s.seq = 1;
+    for (int l = 0; l < 2; ++l) {
+      const auto blk = block(s, l == m_p.preferred);
+      m_master[l]->prm_cmd(s.address, blk, false);
+    }
+  }
+}
+
+MasterSystem::Station* MasterSystem::find(std::uint8_t a) {
+  return a < 128 && m_index[a] >= 0 ? &m_st[static_cast<std::size_t>(m_index[a])] : nullptr;
+}
+const MasterSystem::Station* MasterSystem::find(std::uint8_t a) const {
+  return a < 128 && m_index[a] >= 0 ? &m_st[static_cast<std::size_t>(m_index[a])] : nullptr;
+}
+
+std::array<std::uint8_t, kPrmCmdLen> MasterSystem::block(const Station& s,
+                                                         bool primary_request) const {
+  PrmCmd c;
+  c.seq_nr = s.seq & 0x1F;
+  c.primary_request = primary_request;
+  c.address_change = true;  // AUMA: Address_Change alone = system redundancy
+  c.address_offset64 = s.flying;
+  c.output_hold_time = m_p.output_hold_time;
+  std::array<std::uint8_t, kPrmCmdLen> out{};
+  encode_prm_cmd(c, out);  // cannot fail: Seq_Nr masked, Specifier 0
+  return out;
+}
+
+bool MasterSystem::reporting(int line) const {
+  // A 39C3 line loss reports once for the whole line; a master failure reports per station.
+  return !m_line[line].lost || m_line[line].cause == LineLoss::MasterFailure;
+}
+
+void MasterSystem::emit(SystemEvent::Kind k, bus::Ticks t, int line, std::uint8_t station,
+                        SystemEvent::Cause cause, int from) {
+  SystemEvent e;
+  e.kind = k;
+  e.time = t;
+  e.line = line;
+  e.station = station;
+  e.cause = cause;
+  e.from = from;
+  m_events.push_back(e);
+  if (m_cb) m_cb(e);
+}
+
+void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {
+  if (line != 0 && line != 1) return;
+  using K = dp::MasterEvent::Kind;
+  if (e.kind == K::ModeChange) {
+    const bool running = e.mode == dp::MasterMode::Clear || e.mode == dp::MasterMode::Operate;
+    if (!running) line_lost(line, LineLoss::MasterStop, e.time);
+    else if (m_line[line].lost && m_line[line].cause == LineLoss::MasterStop)
+      line_back(line, e.time);
+    return;
+  }
+  Station* s = find(e.slave);
+  if (s == nullptr || (!s->switched && s->home != line)) return;
+  switch (e.kind) {
+    case K::StationFailure: channel_down(*s, line, e.time, reporting(line)); break;
+    case K::DataExchangeEntered: channel_up(*s, line, e.time, e.diag); break;
+    case K::Diagnosis:
+      if (s->switched) observe_red_status(*s, line, e.diag);
+      break;
+    default: break;
+  }
+}
+
+void MasterSystem::observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag) {
+  const auto rs = find_red_status(diag);
+  if (!rs || !rs->own.primary || !s.up[line]) return;
+  // The station says which interface drives its outputs: that is the active channel, whether
+  // we commanded it or the station switched by itself.
+  s.active = line;
+  if (s.target == line) {
+    s.target = -1;
+    s.deadline = bus::kNever;
+    s.attempts = 0;
+  }
+}
+
+void MasterSystem::channel_up(Station& s, int line, bus::Ticks now,
+                              std::span<const std::uint8_t> diag) {
+  const int other = 1 - line;
+  s.up[line] = true;
+  s.down[line] = false;
+  if (!s.switched) {
+    if (s.failed) {
+      s.failed = false;
+      if (!s.silent_failed) emit(SystemEvent::Kind::StationReturn, now, line, s.address);
+      s.silent_failed = false;
+    }
+    return;
+  }
+  if (s.failed) {
+    s.failed = false;
+    if (!s.silent_failed) emit(SystemEvent::Kind::StationReturn, now, line, s.address);
+    s.silent_failed = false;
+  }
+  if (s.up[other] && s.red_lost) {
+    s.red_lost = false;
+    if (!s.silent_red_lost) emit(SystemEvent::Kind::RedundancyReturn, now, line, s.address);
+    s.silent_red_lost = false;
+  } else if (s.down[other] && !s.red_lost) {
+    // Start-up with the other channel absent.
+    s.red_lost = true;
+    s.silent_red_lost = !reporting(other);
+    if (!s.silent_red_lost)
+      emit(SystemEvent::Kind::RedundancyLoss, now, other, s.address,
+           SystemEvent::Cause::ChannelMissing);
+  }
+  observe_red_status(s, line, diag);
+  const bool has_primary = s.active >= 0 && s.up[s.active];
+  if (!has_primary && s.target < 0) switch_to(s, line, now, SystemEvent::Cause::StartUp);
+}
+
+void MasterSystem::channel_down(Station& s, int line, bus::Ticks now, bool report,
+                                SystemEvent::Cause cause) {
+  const int other = 1 - line;
+  const bool was_up = s.up[line];
+  s.up[line] = false;
+  s.down[line] = true;
+  if (!s.switched) {
+    if (!s.failed) {
+      s.failed = true;
+      s.silent_failed = !report;
+      if (report) emit(SystemEvent::Kind::StationFailure, now, line, s.address, cause);
+    }
+    return;
+  }
+  if (s.active == line) s.active = -1;
+  if (s.up[other]) {
+    if (!s.red_lost) {
+      s.red_lost = true;
+      s.silent_red_lost = !report;
+      if (report)
+        emit(SystemEvent::Kind::RedundancyLoss, now, line, s.address,
+             was_up ? cause : SystemEvent::Cause::ChannelMissing);
+    }
+    // The other channel is up: make it active unless it already is (or is becoming so).
+    if (s.active != other && s.target != other) switch_to(s, other, now, cause);
+    return;
+  }
+  if (s.down[other]) {
+    // Both channels gone (F11, F24): the station has failed.
+    s.target = -1;
+    s.deadline = bus::kNever;
+    s.active = -1;
+    if (!s.failed) {
+      s.failed = true;
+      s.silent_failed = !report;
+      if (report) emit(SystemEvent::Kind::StationFailure, now, line, s.address, cause);
+    }
+  }
+  // Otherwise the other channel's state is not known yet (start-up): wait for it.
+}
+
+void MasterSystem::switch_to(Station& s, int line, bus::Ticks now, SystemEvent::Cause cause) {
+  const int other = 1 - line;
+  s.seq = static_cast<std::uint8_t>((s.seq + 1) & 0x1F);
+  const auto req = block(s, true);
+  const auto idle = block(s, false);
+  // The failed/old line's stored Set_Prm loses its Primary_Request first (no switch back at a
+  // later re-start-up there), then the request goes out on the new line.
+  m_master[other]->prm_cmd(s.address, idle, false);
+  m_master[line]->prm_cmd(s.address, req, true);
+  const int from = s.active;
+  s.target = line;
+  if (s.attempts == 0 || cause != SystemEvent::Cause::SwitchoverTimeout) s.attempts = 1;
+  s.deadline = now + std::max(m_p.switch_supervision, 2 * s.t_slave_um);
+  ++m_switchovers;
+  emit(SystemEvent::Kind::Switchover, now, line, s.address, cause, from);
+}
+
+void MasterSystem::line_lost(int line, LineLoss cause, bus::Ticks now) {
+  if ((line != 0 && line != 1) || m_line[line].lost) return;
+  m_line[line].lost = true;
+  m_line[line].cause = cause;
+  const bool per_station = cause == LineLoss::MasterFailure;
+  if (!per_station)
+    emit(SystemEvent::Kind::MasterSystemFailure, now, line, 0xFF, SystemEvent::Cause::LineLost);
+  for (auto& s : m_st) {
+    if (!s.switched && s.home != line) continue;
+    if (!s.up[line] && s.down[line]) continue;
+    channel_down(s, line, now, per_station, SystemEvent::Cause::LineLost);
+  }
+}
+
+void MasterSystem::line_back(int line, bus::Ticks now) {
+  if ((line != 0 && line != 1) || !m_line[line].lost) return;
+  m_line[line].lost = false;
+  if (m_line[line].cause != LineLoss::MasterFailure)
+    emit(SystemEvent::Kind::MasterSystemReturn, now, line, 0xFF, SystemEvent::Cause::LineLost);
+  // The channels come back one by one as the line's master reaches data exchange with them.
+}
+
+bus::Ticks MasterSystem::next_deadline() const {
+  bus::Ticks t = bus::kNever;
+  for (const auto& s : m_st) t = std::min(t, s.deadline);
+  return t;
+}
+
+void MasterSystem::on_time(bus::Ticks now) {
+  for (auto& s : m_st) {
+    if (s.deadline > now) continue;
+    s.deadline = bus::kNever;
+    const int line = s.target;
+    s.target = -1;
+    if (line < 0) continue;
+    if (s.up[line] && s.attempts < m_p.switch_attempts) {
+      const int tries = s.attempts + 1;
+      switch_to(s, line, now, SystemEvent::Cause::SwitchoverTimeout);
+      s.attempts = tries;
+      continue;
+    }
+    // F24: the station did not take over in time: it is lost as a whole.
+    s.active = -1;
+    s.attempts = 0;
+    if (!s.failed) {
+      s.failed = true;
+      s.silent_failed = false;
+      emit(SystemEvent::Kind::StationFailure, now, line, s.address,
+           SystemEvent::Cause::SwitchoverTimeout);
+    }
+  }
+}
+
+bool MasterSystem::is_switched(std::uint8_t a) const {
+  const Station* s = find(a);
+  return s != nullptr && s->switched;
+}
+int MasterSystem::active(std::uint8_t a) const {
+  const Station* s = find(a);
+  if (s == nullptr) return -1;
+  if (!s->switched) return s->up[s->home] ? s->home : -1;
+  return s->active;
+}
+int MasterSystem::switching_to(std::uint8_t a) const {
+  const Station* s = find(a);
+  return s != nullptr ? s->target : -1;
+}
+bool MasterSystem::channel_up(std::uint8_t a, int line) const {
+  const Station* s = find(a);
+  return s != nullptr && (line == 0 || line == 1) && s->up[line];
+}
+bool MasterSystem::redundancy_lost(std::uint8_t a) const {
+  const Station* s = find(a);
+  return s != nullptr && s->red_lost;
+}
+bool MasterSystem::station_failed(std::uint8_t a) const {
+  const Station* s = find(a);
+  return s != nullptr && s->failed;
+}
+std::vector<std::uint8_t> MasterSystem::addresses() const {
+  std::vector<std::uint8_t> out;
+  for (const auto& s : m_st) out.push_back(s.address);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+bool MasterSystem::write_outputs(std::uint8_t a, std::size_t module,
+                                 std::span<const std::uint8_t> data) {
+  const Station* s = find(a);
+  if (s == nullptr) return false;
+  bool ok = true;
+  for (int l = 0; l < 2; ++l) {
+    if (!s->switched && s->home != l) continue;
+    dp::MasterImage& img = m_master[l]->image(a);
+    if (img.write_outputs(module, data) != dp::ImageAccess::Ok) ok = false;
+  }
+  return ok;
+}
+
+const dp::MasterImage* MasterSystem::active_image(std::uint8_t a) const {
+  const int l = active(a);
+  return l < 0 ? nullptr : &m_master[l]->image(a);
+}
+
+}  // namespace pbvbus::redundancy

@@ -218,7 +218,7 @@ TEST(SwitchoverTiming, GoldenFiguresAt1500k) {
 struct LineA {
   bus::Scheduler sched;
   bus::Line line{sched, "A", kBaud};
-  fdl::BusParams bp = fdl::BusParams::defaults(kBaud);
+  fdl::BusParams bp;
   std::unique_ptr<dp::Master> master;
   std::unique_ptr<fdl::ActiveStation> station;
   std::vector<std::unique_ptr<dp::SlaveEngine>> engines;
@@ -226,7 +226,7 @@ struct LineA {
   std::vector<bus::AttachmentId> att;
   std::vector<dp::MasterEvent> events;
 
-  LineA() {
+  explicit LineA(fdl::BusParams params = fdl::BusParams::defaults(kBaud)) : bp(params) {
     struct Def {
       std::uint8_t address;
       std::uint16_t ident;
@@ -283,6 +283,35 @@ TEST(SwitchoverTiming, PlannedTtrBoundsTheSimulatedDpCycle) {
     RecordProperty("cycle_max_ticks_" + std::to_string(s), std::to_string(st.cycle_max));
   }
   EXPECT_TRUE(a.events.empty() || a.events.front().kind != dp::MasterEvent::Kind::StationFailure);
+}
+
+TEST(SwitchoverTiming, AnsweredGapPollWithTheSmallestSlotTime) {
+  // TSL at its floor, max TSDR + 15 = 165: an unanswered GAP poll takes 66 + 165 = 231 bits, one
+  // answered by a slave (the GAP walk reaches 3, 4 and 5) 66 + 150 + 66 + 37 = 319, so the plan
+  // reserves 319. T_TR = 1265 + 293 + 70 + 319 + 583 + (121 + 165) = 2816 bits.
+  // HSA 6 and G 1 make the GAP walk short (2, 3, 4, 5, 6, 0, then one pass without), so that
+  // answered polls are frequent and some pass has one together with a Global_Control.
+  fdl::BusParams bp = fdl::BusParams::defaults(kBaud);
+  bp.tsl = 165;
+  bp.hsa = 6;
+  bp.gap_factor = 1;
+  ASSERT_EQ(bp.validate(), "");
+  const SwitchoverPlan p = plan_switchover(bp, example_slaves());
+  EXPECT_EQ(p.line[0].gap.total(), 319);
+  EXPECT_EQ(p.line[0].gap.response, 66);
+  EXPECT_EQ(p.line[0].t_tr_bits, 2816);
+  LineA a(bp);
+  a.run_for(400 * kMs);
+  EXPECT_GT(a.station->stats().gap_polls, 100u);
+  for (std::uint8_t s : {std::uint8_t{3}, std::uint8_t{4}, std::uint8_t{5}}) {
+    SCOPED_TRACE(static_cast<int>(s));
+    ASSERT_EQ(a.master->slave_state(s), dp::SlaveStatusState::DataExchange);
+    EXPECT_LE(a.master->slave_stats(s).cycle_max, p.line[0].t_tr);
+    // A pass with Global_Control and an answered GAP poll: 1265 + 70 + 293 + 319 = 1947 bits.
+    EXPECT_GE(a.master->slave_stats(s).cycle_max, 1947 * kTpb);
+    RecordProperty("cycle_max_ticks_" + std::to_string(s),
+                   std::to_string(a.master->slave_stats(s).cycle_max));
+  }
 }
 
 TEST(SwitchoverTiming, NoResponseWithinRecognition) {

@@ -31,7 +31,9 @@ struct Ctx {
     t = std::max(t, bp.min_tsdr);
     return t;
   }
-  std::int64_t dx_request(const PlannedSlave& s) const { return kBits * fc_frame_octets(s.out_len); }
+  std::int64_t dx_request(const PlannedSlave& s) const {
+    return kBits * fc_frame_octets(s.out_len);
+  }
   CycleBits dx(const PlannedSlave& s) const {
     return {dx_request(s), tsdr(s), kBits * reply_frame_octets(s.in_len), tid1};
   }
@@ -73,11 +75,11 @@ void plan_line(const Ctx& c, const std::vector<const PlannedSlave*>& on_line, in
     lp.retry = {max_req, c.tsl, 0, 0};
     lp.failed_attempt = lp.retry;
   }
-  lp.t_tr_bits = lp.dx_bits + lp.gc.total() + lp.token.total() + lp.gap.total() +
-                 lp.diag.total() + lp.retry.total();
-  lp.recognition_bits =
-      on_line.empty() ? 0
-                      : lp.t_tr_bits + (1 + std::int64_t{c.bp.max_retry}) * lp.failed_attempt.total();
+  lp.t_tr_bits = lp.dx_bits + lp.gc.total() + lp.token.total() + lp.gap.total() + lp.diag.total() +
+                 lp.retry.total();
+  lp.recognition_bits = on_line.empty() ? 0
+                                        : lp.t_tr_bits + (1 + std::int64_t{c.bp.max_retry}) *
+                                                             lp.failed_attempt.total();
   lp.line_loss_recognition_bits = lp.t_tr_bits;
   lp.t_tr = c.ticks(lp.t_tr_bits);
   lp.recognition = c.ticks(lp.recognition_bits);
@@ -124,8 +126,7 @@ SwitchoverPlan plan_switchover(const fdl::BusParams& bp, const std::vector<Plann
       switched.push_back(&s);
     } else {
       on_line[s.line].push_back(&s);
-      if (s.t_slave_um)
-        plan.notes.push_back(who(s) + ": one-sided; its T_SLAVE_UM is not used");
+      if (s.t_slave_um) plan.notes.push_back(who(s) + ": one-sided; its T_SLAVE_UM is not used");
     }
   }
   for (int i = 0; i < 2; ++i) {
@@ -173,8 +174,8 @@ SwitchoverPlan plan_switchover(const fdl::BusParams& bp, const std::vector<Plann
     plan.system_t_dp_um_bits[lost] = 2 * plan.line[to].t_tr_bits + prm_sum[to];
     plan.system_t_dp_um[lost] = c.ticks(plan.system_t_dp_um_bits[lost]);
     plan.system_bound_master_stop[lost] = plan.system_t_dp_um[lost] + plan.max_t_slave_um;
-    plan.system_bound[lost] = plan.line[lost].line_loss_recognition +
-                              plan.system_bound_master_stop[lost];
+    plan.system_bound[lost] =
+        plan.line[lost].line_loss_recognition + plan.system_bound_master_stop[lost];
   }
   return plan;
 }

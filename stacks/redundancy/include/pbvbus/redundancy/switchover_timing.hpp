@@ -83,21 +83,21 @@ constexpr std::int64_t reply_frame_octets(std::size_t after_fc) {
   return after_fc == 0 ? 1 : fc_frame_octets(after_fc);
 }
 inline constexpr std::int64_t kTokenOctets = 3;
-inline constexpr std::int64_t kFdlStatusOctets = 6;       ///< SD1 request and SD1 reply
-inline constexpr std::size_t kSapOctets = 2;              ///< DSAP + SSAP
+inline constexpr std::int64_t kFdlStatusOctets = 6;  ///< SD1 request and SD1 reply
+inline constexpr std::size_t kSapOctets = 2;         ///< DSAP + SSAP
 inline constexpr std::size_t kGlobalControlDu = 2;
-inline constexpr std::size_t kMaxDpData = 244;            ///< DP payload with SAPs (§B.1)
+inline constexpr std::size_t kMaxDpData = 244;  ///< DP payload with SAPs (§B.1)
 
 /// One slave as the planner sees it.
 struct PlannedSlave {
   std::uint8_t address = 0;
   std::string name;
-  std::size_t in_len = 0;            ///< Data_Exchange input octets (slave → master)
-  std::size_t out_len = 0;           ///< Data_Exchange output octets (master → slave)
-  std::uint32_t max_tsdr_bits = 0;   ///< the slave's max TSDR (GSD MaxTsdr_<baud>); 0 = bus max TSDR
-  std::size_t max_diag_len = 6;      ///< the longest Slave_Diag DU it may send (6..244)
-  bool switched = false;             ///< on both lines (a switched station)
-  int line = 0;                      ///< 0 = A, 1 = B; ignored when switched
+  std::size_t in_len = 0;           ///< Data_Exchange input octets (slave → master)
+  std::size_t out_len = 0;          ///< Data_Exchange output octets (master → slave)
+  std::uint32_t max_tsdr_bits = 0;  ///< the slave's max TSDR (GSD MaxTsdr_<baud>); 0 = bus max TSDR
+  std::size_t max_diag_len = 6;     ///< the longest Slave_Diag DU it may send (6..244)
+  bool switched = false;            ///< on both lines (a switched station)
+  int line = 0;                     ///< 0 = A, 1 = B; ignored when switched
   std::optional<bus::Ticks> t_slave_um;  ///< the station's own switchover time (switched only)
 };
 
@@ -126,7 +126,7 @@ struct LinePlan {
   CycleBits diag;                  ///< one Slave_Diag read after DH (largest)
   CycleBits retry;                 ///< one repeat: largest request + TSL
   std::int64_t t_tr_bits = 0;
-  CycleBits failed_attempt;        ///< one unanswered attempt: largest request + TSL
+  CycleBits failed_attempt;  ///< one unanswered attempt: largest request + TSL
   std::int64_t recognition_bits = 0;
   std::int64_t line_loss_recognition_bits = 0;
   bus::Ticks t_tr = 0;
@@ -138,12 +138,12 @@ struct LinePlan {
 struct StationBound {
   std::uint8_t address = 0;
   std::string name;
-  CycleBits prm_cmd[2];              ///< the PrmCmd cycle on line i (same on both lines)
+  CycleBits prm_cmd[2];  ///< the PrmCmd cycle on line i (same on both lines)
   /// Index = the line of the failing active channel; the new one is on the other line.
   std::int64_t t_dp_um_bits[2] = {0, 0};
   bus::Ticks recognition[2] = {0, 0};
   bus::Ticks t_dp_um[2] = {0, 0};
-  bus::Ticks t_slave_um = 0;         ///< 0 when not given (see notes)
+  bus::Ticks t_slave_um = 0;  ///< 0 when not given (see notes)
   bool t_slave_um_given = false;
   bus::Ticks bound[2] = {0, 0};
   bus::Ticks worst() const { return bound[0] > bound[1] ? bound[0] : bound[1]; }
@@ -158,8 +158,8 @@ struct SwitchoverPlan {
   std::int64_t system_t_dp_um_bits[2] = {0, 0};
   bus::Ticks system_t_dp_um[2] = {0, 0};
   bus::Ticks max_t_slave_um = 0;  ///< the slowest switched station's T_SLAVE_UM (0: none given)
-  bus::Ticks system_bound[2] = {0, 0};               ///< line lost (short circuit)
-  bus::Ticks system_bound_master_stop[2] = {0, 0};   ///< master failure/stop: recognised at once
+  bus::Ticks system_bound[2] = {0, 0};              ///< line lost (short circuit)
+  bus::Ticks system_bound_master_stop[2] = {0, 0};  ///< master failure/stop: recognised at once
   std::vector<std::string> notes;
 };
 

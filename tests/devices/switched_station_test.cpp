@@ -56,6 +56,17 @@ std::vector<std::string> dialogue(const FrameRecorder& rec, std::vector<std::siz
   return out;
 }
 
+/// The end of the first Data_Exchange request to the station (SD2, DA = the station without the
+/// EXT bit: no SAPs) on a line that ends at or after `after`; the instant its outputs are taken.
+bus::Ticks first_dx_end(const FrameRecorder& rec, bus::Ticks after) {
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& f = rec.frame(i);
+    const auto& b = f.bytes;
+    if (f.end >= after && b.size() > 6 && b[0] == 0x68 && b[4] == kAddr) return f.end;
+  }
+  return bus::kNever;
+}
+
 struct TwoLines {
   bus::Scheduler sched;
   bus::Line line[2] = {bus::Line{sched, "A", kBaud}, bus::Line{sched, "B", kBaud}};
@@ -236,7 +247,7 @@ TEST(SwitchedStation, RedundantStartUpOnEachLine) {
   // Interface A becomes PRIMARY at the end of its Set_Prm (last stop bit), B BACKUP one link
   // delay (1 ms) later.
   const bus::Ticks prm_end = t.rec[0].frame(idx[0][2]).end;
-  ASSERT_EQ(t.model->events().size(), 2u);
+  ASSERT_EQ(t.model->events().size(), 3u);
   const auto& e0 = t.model->events()[0];
   EXPECT_EQ(e0.kind, redundancy::RedEvent::Kind::RoleChanged);
   EXPECT_EQ(e0.iface, 0);
@@ -250,6 +261,11 @@ TEST(SwitchedStation, RedundantStartUpOnEachLine) {
   EXPECT_EQ(e1.from, Role::SWaiting);
   EXPECT_EQ(e1.to, Role::Backup);
   EXPECT_EQ(e1.at, prm_end + 1 * kMs);
+  // The first outputs after start-up: at the end of A's first Data_Exchange (dialogue #10).
+  const auto& e2 = t.model->events()[2];
+  EXPECT_EQ(e2.kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(e2.iface, 0);
+  EXPECT_EQ(e2.at, t.rec[0].frame(idx[0][10]).end);
 }
 
 // --- active and passive channel -------------------------------------------------------------------
@@ -309,20 +325,26 @@ TEST(SwitchedStation, PrimaryTransceiverFailureSwitchesToBWithoutPulse) {
 
   // Events: A FAILED at 150 ms; B hears nothing after A's heartbeat of 100 ms (arrived at
   // 101 ms, link delay 1 ms) and counts it lost after the 300 ms supervision: PRIMARY at 401 ms.
+  // ev[2]: the start-up's FreshOutputs (A). Then B's first outputs: FreshOutputs at the end of
+  // B's first Data_Exchange request after 401 ms.
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 5u);
-  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::RoleChanged);
-  EXPECT_EQ(ev[2].iface, 0);
-  EXPECT_EQ(ev[2].to, Role::Failed);
-  EXPECT_EQ(ev[2].at, 150 * kMs);
-  EXPECT_EQ(ev[3].kind, redundancy::RedEvent::Kind::PartnerLost);
-  EXPECT_EQ(ev[3].iface, 1);
-  EXPECT_EQ(ev[3].at, 401 * kMs);
-  EXPECT_EQ(ev[4].kind, redundancy::RedEvent::Kind::RoleChanged);
+  ASSERT_EQ(ev.size(), 7u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[3].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[3].iface, 0);
+  EXPECT_EQ(ev[3].to, Role::Failed);
+  EXPECT_EQ(ev[3].at, 150 * kMs);
+  EXPECT_EQ(ev[4].kind, redundancy::RedEvent::Kind::PartnerLost);
   EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].from, Role::Backup);
-  EXPECT_EQ(ev[4].to, Role::Primary);
   EXPECT_EQ(ev[4].at, 401 * kMs);
+  EXPECT_EQ(ev[5].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].from, Role::Backup);
+  EXPECT_EQ(ev[5].to, Role::Primary);
+  EXPECT_EQ(ev[5].at, 401 * kMs);
+  EXPECT_EQ(ev[6].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[6].iface, 1);
+  EXPECT_EQ(ev[6].at, first_dx_end(t.rec[1], 401 * kMs));
 
   // No pulse: every sample after the failure is A's last value or B's, never zero, and once B's
   // value is there A's never comes back. B's first arrives with B's first Data_Exchange after
@@ -378,14 +400,19 @@ TEST(SwitchedStation, LinkAndWatchdogRunWhenOnlyLineBDrivesTheTimer) {
   EXPECT_EQ(t.model->role(1), Role::Primary);
   EXPECT_EQ(t.model->role(0), Role::Backup);
   const auto& ev = t.model->events();
-  ASSERT_GE(ev.size(), 4u);
-  EXPECT_EQ(ev[2].iface, 0);
-  EXPECT_EQ(ev[2].from, Role::Primary);
-  EXPECT_EQ(ev[2].to, Role::Backup);
-  EXPECT_EQ(ev[2].at, last_dx_a + 1000 * kMs);
-  EXPECT_EQ(ev[3].iface, 1);
-  EXPECT_EQ(ev[3].to, Role::Primary);
-  EXPECT_EQ(ev[3].at, last_dx_a + 1000 * kMs + 1 * kMs);
+  ASSERT_GE(ev.size(), 6u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);  // start-up, A
+  EXPECT_EQ(ev[3].iface, 0);
+  EXPECT_EQ(ev[3].from, Role::Primary);
+  EXPECT_EQ(ev[3].to, Role::Backup);
+  EXPECT_EQ(ev[3].at, last_dx_a + 1000 * kMs);
+  EXPECT_EQ(ev[4].iface, 1);
+  EXPECT_EQ(ev[4].to, Role::Primary);
+  EXPECT_EQ(ev[4].at, last_dx_a + 1000 * kMs + 1 * kMs);
+  // Autonomous switchover: the hold ends at B's first Data_Exchange as PRIMARY.
+  EXPECT_EQ(ev[5].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].at, first_dx_end(t.rec[1], last_dx_a + 1001 * kMs));
   EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutB);
 }
 
@@ -441,27 +468,29 @@ TEST(SwitchedStation, BackupFailureAndRepairLeaveTheOutputsAlone) {
   // B restarts S_WAITING at 600 ms, its heartbeat reaches A at 601 ms (PartnerBack), A's
   // become-backup reaches B at 602 ms. No switch back, A stays PRIMARY throughout.
   using K = redundancy::RedEvent::Kind;
+  // (ev[2]: the start-up's FreshOutputs; the backup's failure starts no hold: no other.)
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 7u);
-  EXPECT_EQ(ev[2].kind, K::RoleChanged);
-  EXPECT_EQ(ev[2].iface, 1);
-  EXPECT_EQ(ev[2].to, Role::Failed);
-  EXPECT_EQ(ev[2].at, 150 * kMs);
-  EXPECT_EQ(ev[3].kind, K::PartnerLost);
-  EXPECT_EQ(ev[3].iface, 0);
-  EXPECT_EQ(ev[3].at, 401 * kMs);
-  EXPECT_EQ(ev[4].kind, K::RoleChanged);
-  EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].from, Role::Failed);
-  EXPECT_EQ(ev[4].to, Role::SWaiting);
-  EXPECT_EQ(ev[4].at, 600 * kMs);
-  EXPECT_EQ(ev[5].kind, K::PartnerBack);
-  EXPECT_EQ(ev[5].iface, 0);
-  EXPECT_EQ(ev[5].at, 601 * kMs);
-  EXPECT_EQ(ev[6].kind, K::RoleChanged);
-  EXPECT_EQ(ev[6].iface, 1);
-  EXPECT_EQ(ev[6].to, Role::Backup);
-  EXPECT_EQ(ev[6].at, 602 * kMs);
+  ASSERT_EQ(ev.size(), 8u);
+  EXPECT_EQ(ev[2].kind, K::FreshOutputs);
+  EXPECT_EQ(ev[3].kind, K::RoleChanged);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].to, Role::Failed);
+  EXPECT_EQ(ev[3].at, 150 * kMs);
+  EXPECT_EQ(ev[4].kind, K::PartnerLost);
+  EXPECT_EQ(ev[4].iface, 0);
+  EXPECT_EQ(ev[4].at, 401 * kMs);
+  EXPECT_EQ(ev[5].kind, K::RoleChanged);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].from, Role::Failed);
+  EXPECT_EQ(ev[5].to, Role::SWaiting);
+  EXPECT_EQ(ev[5].at, 600 * kMs);
+  EXPECT_EQ(ev[6].kind, K::PartnerBack);
+  EXPECT_EQ(ev[6].iface, 0);
+  EXPECT_EQ(ev[6].at, 601 * kMs);
+  EXPECT_EQ(ev[7].kind, K::RoleChanged);
+  EXPECT_EQ(ev[7].iface, 1);
+  EXPECT_EQ(ev[7].to, Role::Backup);
+  EXPECT_EQ(ev[7].at, 602 * kMs);
   for (std::size_t k = first; k < s.samples.size(); ++k)
     ASSERT_EQ(s.samples[k].out, kOutA) << s.samples[k].at;
 }
@@ -564,18 +593,25 @@ TEST(SwitchedStation, CommandedSwitchoverByPrimaryRequestOnLineB) {
   // BP_SWITCHOVER at the end of B's Set_Prm; the switchover request reaches A 1 ms later (A
   // BACKUP), the take-over reaches B 1 ms after that (B PRIMARY).
   const bus::Ticks prm_end = t.rec[1].frame(idx[2]).end;
+  // (ev[2]: the start-up's FreshOutputs from A; ev[6]: B's, at the end of its first
+  // Data_Exchange as PRIMARY, dialogue #14.)
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 5u);
-  EXPECT_EQ(ev[2].iface, 1);
-  EXPECT_EQ(ev[2].to, Role::BpSwitchover);
-  EXPECT_EQ(ev[2].at, prm_end);
-  EXPECT_EQ(ev[3].iface, 0);
-  EXPECT_EQ(ev[3].from, Role::Primary);
-  EXPECT_EQ(ev[3].to, Role::Backup);
-  EXPECT_EQ(ev[3].at, prm_end + 1 * kMs);
-  EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].to, Role::Primary);
-  EXPECT_EQ(ev[4].at, prm_end + 2 * kMs);
+  ASSERT_EQ(ev.size(), 7u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[2].iface, 0);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].to, Role::BpSwitchover);
+  EXPECT_EQ(ev[3].at, prm_end);
+  EXPECT_EQ(ev[4].iface, 0);
+  EXPECT_EQ(ev[4].from, Role::Primary);
+  EXPECT_EQ(ev[4].to, Role::Backup);
+  EXPECT_EQ(ev[4].at, prm_end + 1 * kMs);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].to, Role::Primary);
+  EXPECT_EQ(ev[5].at, prm_end + 2 * kMs);
+  EXPECT_EQ(ev[6].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[6].iface, 1);
+  EXPECT_EQ(ev[6].at, t.rec[1].frame(idx[14]).end);
   EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
   EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
 

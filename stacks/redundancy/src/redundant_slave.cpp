@@ -383,17 +383,22 @@ dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) 
       case Role::Primary: set_ack(i); break;
       case Role::Backup:
       case Role::SWaiting:
-      case Role::SPrimary:
-        // With a live PRIMARY partner (e.g. this interface was just repaired and restarts in
+      case Role::SPrimary: {
+        // With a PRIMARY partner (e.g. this interface was just repaired and restarts in
         // S_WAITING while the other carries the process), Primary_Request is a commanded
-        // switchover through the partner, never a second primary.
-        if (alive(1 - i) && !f.partner_lost && m_if[1 - i].role == Role::Primary) {
+        // switchover through the partner, never a second primary. A partner that has failed
+        // without being counted lost yet is, for this interface, still what it was: it asks,
+        // gets no answer and takes over after switch_timeout.
+        const Iface& partner = m_if[1 - i];
+        const Role believed = partner.role == Role::Failed ? partner.failed_from : partner.role;
+        if (!f.partner_lost && believed == Role::Primary) {
           set_role(i, Role::BpSwitchover, v.now);
           send(i, Msg::SwitchReq, v.now);
         } else {
           set_role(i, Role::Primary, v.now);
         }
         break;
+      }
       case Role::BpSwitchover:
       case Role::Failed:
       case Role::Off: break;
@@ -431,6 +436,7 @@ void RedundantSlave::refresh_status() {
 
 void RedundantSlave::fail_interface(int i, bus::Ticks now) {
   on_time(now);
+  if (m_if[i].role != Role::Failed) m_if[i].failed_from = m_if[i].role;
   set_role(i, Role::Failed, now);
   m_if[i].was_data_exch = false;
   sync_alarms(now);

@@ -26,7 +26,9 @@
 // - Commanded switchover: Primary_Request to the BACKUP → BP_SWITCHOVER, switchover request to
 //   the primary; on arrival the primary becomes BACKUP (outputs held) and sends take-over; on
 //   its arrival the requester becomes PRIMARY and sets Prm_Cmd_Ack. 2 × link_delay. Primary_
-//   Request to the primary: acknowledged, no change. With the partner lost: PRIMARY at once.
+//   Request to the primary: acknowledged, no change. With the partner lost (counted by the
+//   supervision or a switchover timeout): PRIMARY at once. A partner that has failed but is not
+//   yet counted lost is taken for what it was before the failure (it failed silently).
 //   Switchover request timeout: a partner that has failed silently (not yet counted lost by the
 //   supervision) never answers; the requester waits `switch_timeout` (10 ms) after the
 //   Primary_Request, then counts the partner lost (PartnerLost) and becomes PRIMARY (Prm_Cmd_Ack
@@ -233,6 +235,8 @@ class RedundantSlave {
     std::uint8_t cmd_function = 0;  ///< Function of the last PrmCmd
     std::int32_t status_cache = -1;
     bus::Ticks switch_deadline = bus::kNever;  ///< BP_SWITCHOVER: give up waiting for take-over
+    Role failed_from = Role::SWaiting;  ///< the role before fail_interface(): what the partner
+                                        ///< believes until it counts this interface lost
   };
   /// An alarm the station keeps until the PRIMARY's master acknowledges it.
   struct StationAlarm {

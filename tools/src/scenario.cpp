@@ -492,7 +492,7 @@ class Planner {
     }
     const DpSlavePlan* sp = nullptr;
     for (const auto& d : plan.dp_slaves)
-      if (d.line == li && d.address == s.address()) sp = &d;
+      if (d.switched < 0 && d.line == li && d.address == s.address()) sp = &d;
     if (sp == nullptr) {
       error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_slave " +
                                              std::to_string(s.address()) + " on line " + quoted(ln));

@@ -307,7 +307,7 @@ dp::AlarmResult SwitchedStationModel::raise_alarm(std::uint8_t type, std::uint8_
                                                   std::span<const std::uint8_t> data,
                                                   std::uint8_t* seq_nr) {
   const dp::AlarmResult r = m_rs->raise_alarm(type, slot, spec, add_ack, data, now(), seq_nr);
-  after_call();  // the PRIMARY's next Data_Exchange answers DH: nothing to re-arm, but cheap
+  after_call();  // raise_alarm ran the station's due timers first: re-arm both lines
   return r;
 }
 

@@ -946,6 +946,64 @@ TEST(SwitchedStation, AlarmAcknowledgedBeforeTheSwitchoverIsNotRepeated) {
   EXPECT_EQ(t.model->redundant_slave().engine(1).application().alarms_outstanding(), 0u);
 }
 
+TEST(SwitchedStation, AlarmOfAFailedPrimaryIsDeliveredOnceByTheNewPrimary) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // Raised on A, and A fails at the same instant, before master A can poll it: the alarm must
+  // not die with the interface. B takes over at 401 ms (A's heartbeat of 100 ms, arrived at
+  // 101 ms, + 300 ms supervision) and carries it from then on.
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  t.model->fail_interface(0);
+  t.run_until(600 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  EXPECT_TRUE(log[0].of(K::Alarm).empty());
+  const auto b = log[1].of(K::Alarm);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_GE(b[0].at, 401 * kMs);
+  EXPECT_EQ(b[0].specifier, 0x01);
+  EXPECT_EQ(b[0].data, kAlarmData);
+  EXPECT_EQ(alarm_acks(t.rec[1]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+}
+
+TEST(SwitchedStation, AlarmDroppedByAPrimaryLeavingDataExchangeGoesToTheNewPrimary) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // A's attachment loses power (master A hears nothing more) right after the alarm is raised
+  // on A. A's engine drops the alarm when its watchdog expires (last Data_Exchange + 1 s) and
+  // the station switches to B 1 ms later (autonomous): the alarm must reach master B, once.
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  EXPECT_EQ(t.model->redundant_slave().engine(0).application().alarms_outstanding(), 1u);
+  t.line[0].set_power(t.att[0], false);
+  t.run_until(1300 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  EXPECT_TRUE(log[0].of(K::Alarm).empty());
+  ASSERT_EQ(log[1].of(K::Alarm).size(), 1u);
+  bus::Ticks b_primary = bus::kNever;  // A's watchdog expiry + 1 ms
+  for (const auto& e : t.model->events())
+    if (e.kind == redundancy::RedEvent::Kind::RoleChanged && e.iface == 1 && e.to == Role::Primary)
+      b_primary = e.at;
+  ASSERT_GT(b_primary, 1000 * kMs);  // the watchdog (1 s) ran out after the 150 ms power-off
+  EXPECT_GE(log[1].of(K::Alarm)[0].at, b_primary);
+  EXPECT_EQ(alarm_acks(t.rec[1]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+}
+
 TEST(SwitchedStation, AlarmRaisedBeforeAnyPrimaryWaitsForIt) {
   using K = dp::MasterEvent::Kind;
   TwoLines t(100);

@@ -118,9 +118,13 @@ struct MasterTiming {
   fdl::BusParams params;
 };
 
-std::int64_t bits_ns(std::int64_t bits, bus::Baud baud) { return bus::ticks_to_ns(bus::bits_to_ticks(bits, baud)); }
+std::int64_t bits_ns(std::int64_t bits, bus::Baud baud) {
+  return bus::ticks_to_ns(bus::bits_to_ticks(bits, baud));
+}
 
-std::string us_of_bits(std::int64_t bits, bus::Baud baud) { return format_us(bus::bits_to_ticks(bits, baud)); }
+std::string us_of_bits(std::int64_t bits, bus::Baud baud) {
+  return format_us(bus::bits_to_ticks(bits, baud));
+}
 
 /// Milliseconds with three decimals, rounded down: "36.902 ms".
 std::string ms(bus::Ticks t) {
@@ -132,7 +136,8 @@ std::string ms(bus::Ticks t) {
 }
 
 /// The switched station `address` of system `rp`, or nullptr.
-const SwitchedPlan* switched_plan(const ScenarioPlan& plan, const RedundancyPlan& rp, std::uint8_t address) {
+const SwitchedPlan* switched_plan(const ScenarioPlan& plan, const RedundancyPlan& rp,
+                                  std::uint8_t address) {
   for (int k : rp.switched) {
     const SwitchedPlan& s = plan.switched.at(static_cast<std::size_t>(k));
     if (s.address == address) return &s;
@@ -191,27 +196,31 @@ class Table {
   std::vector<std::vector<std::string>> m_rows;
 };
 
-std::string num(std::int64_t v) { return std::to_string(v); }
+std::string num(std::int64_t v) {
+  return std::to_string(v);
+}
 
 void print_bus_params(const std::string& line, const fdl::BusParams& p, std::ostream& out) {
   out << "  bus parameters (line " << line << ", " << bus::baud_name(p.baud) << "): TSL " << p.tsl
-      << ", min TSDR " << p.min_tsdr << ", max TSDR " << p.max_tsdr << ", TID1 " << p.tid1() << ", TID2 "
-      << p.tid2() << ", TTR " << p.ttr << " bit, max_retry " << int(p.max_retry) << "; 1 bit = "
-      << format_us(bus::bits_to_ticks(1, p.baud)) << " us\n";
+      << ", min TSDR " << p.min_tsdr << ", max TSDR " << p.max_tsdr << ", TID1 " << p.tid1()
+      << ", TID2 " << p.tid2() << ", TTR " << p.ttr << " bit, max_retry " << int(p.max_retry)
+      << "; 1 bit = " << format_us(bus::bits_to_ticks(1, p.baud)) << " us\n";
 }
 
 /// T_TR and its parts, the DP error recognition.
-void print_line(const std::string& title, const LinePlan& lp, const SwitchoverPlan& p, std::int64_t max_retry,
-                std::ostream& out) {
+void print_line(const std::string& title, const LinePlan& lp, const SwitchoverPlan& p,
+                std::int64_t max_retry, std::ostream& out) {
   out << "\n  " << title << "\n";
   Table t({1});
   t.add({"term", "", "request", "TSDR/TSL", "reply", "idle", "bits", "us"});
   for (const auto& s : lp.slaves) {
     const CycleBits& c = s.dx;
-    t.add({"Data_Exchange " + std::to_string(s.address), s.name + (is_switched(p, s.address) ? " (switched)" : ""),
-           num(c.request), num(c.tsdr), num(c.response), num(c.idle), num(c.total()), us_of_bits(c.total(), p.baud)});
+    t.add({"Data_Exchange " + std::to_string(s.address),
+           s.name + (is_switched(p, s.address) ? " (switched)" : ""), num(c.request), num(c.tsdr),
+           num(c.response), num(c.idle), num(c.total()), us_of_bits(c.total(), p.baud)});
   }
-  t.add({"sum of Data_Exchange cycles", "", "", "", "", "", num(lp.dx_bits), us_of_bits(lp.dx_bits, p.baud)});
+  t.add({"sum of Data_Exchange cycles", "", "", "", "", "", num(lp.dx_bits),
+         us_of_bits(lp.dx_bits, p.baud)});
   auto row = [&](const std::string& what, const std::string& detail, const CycleBits& c) {
     t.add({what, detail, num(c.request), num(c.tsdr), num(c.response), num(c.idle), num(c.total()),
            us_of_bits(c.total(), p.baud)});
@@ -223,7 +232,8 @@ void print_line(const std::string& title, const LinePlan& lp, const SwitchoverPl
   row("retry reserve", "largest request + TSL", lp.retry);
   t.add({"T_TR", "", "", "", "", "", num(lp.t_tr_bits), us_of_bits(lp.t_tr_bits, p.baud)});
   t.add({"DP error recognition",
-         "T_TR + " + std::to_string(1 + max_retry) + " x " + std::to_string(lp.failed_attempt.total()),
+         "T_TR + " + std::to_string(1 + max_retry) + " x " +
+             std::to_string(lp.failed_attempt.total()),
          "", "", "", "", num(lp.recognition_bits), us_of_bits(lp.recognition_bits, p.baud)});
   t.print(out, "    ");
 }
@@ -236,20 +246,23 @@ void print_notes(const std::vector<std::string>& notes, std::ostream& out) {
 
 void print_system_text(const ScenarioPlan& plan, const SystemTiming& s, std::ostream& out) {
   const SwitchoverPlan& p = s.plan;
-  out << "\nRedundant DP master system \"" << s.rp->name << "\": line A " << s.line_name[0] << " (DP master "
-      << s.master_address[0] << "), line B " << s.line_name[1] << " (DP master " << s.master_address[1] << ")\n";
+  out << "\nRedundant DP master system \"" << s.rp->name << "\": line A " << s.line_name[0]
+      << " (DP master " << s.master_address[0] << "), line B " << s.line_name[1] << " (DP master "
+      << s.master_address[1] << ")\n";
   print_bus_params(s.line_name[0], s.params, out);
   for (int side = 0; side < 2; ++side)
-    print_line("line " + s.line_name[side] + " (" + (side == 0 ? "A" : "B") + "): target rotation time T_TR",
+    print_line("line " + s.line_name[side] + " (" + (side == 0 ? "A" : "B") +
+                   "): target rotation time T_TR",
                p.line[side], p, s.params.max_retry, out);
 
-  out << "\n  switched stations: bound = recognition (failing line) + T_DP_UM (to the other) + T_SLAVE_UM\n";
+  out << "\n  switched stations: bound = recognition (failing line) + T_DP_UM (to the other) + "
+         "T_SLAVE_UM\n";
   if (p.stations.empty()) {
     out << "    (none)\n";
   } else {
     Table t({1, 3, 4});
-    t.add({"station", "model", "T_SLAVE_UM", "from", "failing", "recognition", "T_DP_UM bits", "T_DP_UM", "bound",
-           "worst"});
+    t.add({"station", "model", "T_SLAVE_UM", "from", "failing", "recognition", "T_DP_UM bits",
+           "T_DP_UM", "bound", "worst"});
     for (const auto& st : p.stations) {
       const SwitchedPlan* sw = switched_plan(plan, *s.rp, st.address);
       for (int from = 0; from < 2; ++from)
@@ -269,21 +282,24 @@ void print_system_text(const ScenarioPlan& plan, const SystemTiming& s, std::ost
   else
     out << "none with a T_SLAVE_UM\n";
   Table t({1});
-  t.add({"lost", "to", "recognition", "T_DP_UM_system bits", "T_DP_UM_system", "T_SLAVE_UM", "short circuit",
-         "master stop/failure"});
+  t.add({"lost", "to", "recognition", "T_DP_UM_system bits", "T_DP_UM_system", "T_SLAVE_UM",
+         "short circuit", "master stop/failure"});
   for (int lost = 0; lost < 2; ++lost)
     t.add({s.line_name[lost], s.line_name[1 - lost], ms(p.line[lost].line_loss_recognition),
            num(p.system_t_dp_um_bits[lost]), ms(p.system_t_dp_um[lost]), ms(p.max_t_slave_um),
            ms(p.system_bound[lost]), ms(p.system_bound_master_stop[lost])});
   t.print(out, "    ");
-  out << "    (short circuit: recognition + T_DP_UM_system + T_SLAVE_UM; master stop/failure is known at once)\n";
+  out << "    (short circuit: recognition + T_DP_UM_system + T_SLAVE_UM; master stop/failure is "
+         "known at once)\n";
   print_notes(p.notes, out);
 }
 
 void print_master_text(const MasterTiming& m, std::ostream& out) {
-  out << "\nDP master " << int(m.mp->params.address) << " on line " << m.line_name << " (not redundant)\n";
+  out << "\nDP master " << int(m.mp->params.address) << " on line " << m.line_name
+      << " (not redundant)\n";
   print_bus_params(m.line_name, m.params, out);
-  print_line("line " + m.line_name + ": target rotation time T_TR", m.plan.line[0], m.plan, m.params.max_retry, out);
+  print_line("line " + m.line_name + ": target rotation time T_TR", m.plan.line[0], m.plan,
+             m.params.max_retry, out);
   print_notes(m.plan.notes, out);
 }
 
@@ -295,25 +311,31 @@ std::string jcycle(const CycleBits& c, bus::Baud baud) {
          ", \"bits\": " + num(c.total()) + ", \"ns\": " + num(bits_ns(c.total(), baud)) + "}";
 }
 
-std::string jopt_ns(std::optional<bus::Ticks> t) { return t ? num(bus::ticks_to_ns(*t)) : "null"; }
+std::string jopt_ns(std::optional<bus::Ticks> t) {
+  return t ? num(bus::ticks_to_ns(*t)) : "null";
+}
 
 std::string jbus(const fdl::BusParams& p) {
   return "{\"baud\": " + num(static_cast<std::uint32_t>(p.baud)) + ", \"tsl\": " + num(p.tsl) +
-         ", \"min_tsdr\": " + num(p.min_tsdr) + ", \"max_tsdr\": " + num(p.max_tsdr) + ", \"tqui\": " + num(p.tqui) +
-         ", \"tset\": " + num(p.tset) + ", \"ttr\": " + num(p.ttr) + ", \"max_retry\": " + num(p.max_retry) +
-         ", \"tid1\": " + num(p.tid1()) + ", \"tid2\": " + num(p.tid2()) + "}";
+         ", \"min_tsdr\": " + num(p.min_tsdr) + ", \"max_tsdr\": " + num(p.max_tsdr) +
+         ", \"tqui\": " + num(p.tqui) + ", \"tset\": " + num(p.tset) + ", \"ttr\": " + num(p.ttr) +
+         ", \"max_retry\": " + num(p.max_retry) + ", \"tid1\": " + num(p.tid1()) +
+         ", \"tid2\": " + num(p.tid2()) + "}";
 }
 
-std::string jline(const LinePlan& lp, const SwitchoverPlan& p, int side, const std::string& name, int master,
-                  const std::string& ind) {
+std::string jline(const LinePlan& lp, const SwitchoverPlan& p, int side, const std::string& name,
+                  int master, const std::string& ind) {
   const bus::Baud b = p.baud;
   std::ostringstream o;
-  o << "{\"side\": \"" << (side == 0 ? "A" : "B") << "\", \"name\": " << json_quote(name) << ", \"master\": " << master
-    << ",\n" << ind << " \"slaves\": [";
+  o << "{\"side\": \"" << (side == 0 ? "A" : "B") << "\", \"name\": " << json_quote(name)
+    << ", \"master\": " << master << ",\n"
+    << ind << " \"slaves\": [";
   for (std::size_t i = 0; i < lp.slaves.size(); ++i) {
     const auto& s = lp.slaves[i];
-    o << (i ? "," : "") << "\n" << ind << "   {\"address\": " << int(s.address) << ", \"model\": " << json_quote(s.name)
-      << ", \"switched\": " << (is_switched(p, s.address) ? "true" : "false") << ", \"dx\": " << jcycle(s.dx, b) << "}";
+    o << (i ? "," : "") << "\n"
+      << ind << "   {\"address\": " << int(s.address) << ", \"model\": " << json_quote(s.name)
+      << ", \"switched\": " << (is_switched(p, s.address) ? "true" : "false")
+      << ", \"dx\": " << jcycle(s.dx, b) << "}";
   }
   o << (lp.slaves.empty() ? "],\n" : "\n" + ind + " ],\n");
   o << ind << " \"dx_bits\": " << lp.dx_bits << ", \"dx_ns\": " << bits_ns(lp.dx_bits, b) << ",\n";
@@ -322,7 +344,8 @@ std::string jline(const LinePlan& lp, const SwitchoverPlan& p, int side, const s
   o << ind << " \"gap\": " << jcycle(lp.gap, b) << ",\n";
   o << ind << " \"diag\": " << jcycle(lp.diag, b) << ",\n";
   o << ind << " \"retry\": " << jcycle(lp.retry, b) << ",\n";
-  o << ind << " \"t_tr_bits\": " << lp.t_tr_bits << ", \"t_tr_ns\": " << bus::ticks_to_ns(lp.t_tr) << ",\n";
+  o << ind << " \"t_tr_bits\": " << lp.t_tr_bits << ", \"t_tr_ns\": " << bus::ticks_to_ns(lp.t_tr)
+    << ",\n";
   o << ind << " \"failed_attempt\": " << jcycle(lp.failed_attempt, b) << ",\n";
   o << ind << " \"recognition_bits\": " << lp.recognition_bits
     << ", \"recognition_ns\": " << bus::ticks_to_ns(lp.recognition) << "}";
@@ -338,7 +361,8 @@ std::string jnotes(const std::vector<std::string>& notes) {
 void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& systems,
                 const std::vector<MasterTiming>& masters, std::ostream& out) {
   out << "{\"schema\": \"pbvbus.timing/1\",\n";
-  out << " \"scenario\": {\"name\": " << json_quote(plan.name) << ", \"file\": " << json_quote(plan.file) << "},\n";
+  out << " \"scenario\": {\"name\": " << json_quote(plan.name)
+      << ", \"file\": " << json_quote(plan.file) << "},\n";
   out << " \"redundant_systems\": [";
   for (std::size_t n = 0; n < systems.size(); ++n) {
     const SystemTiming& s = systems[n];
@@ -347,20 +371,23 @@ void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& syste
     out << "   \"bus_params\": " << jbus(s.params) << ",\n";
     out << "   \"lines\": [";
     for (int side = 0; side < 2; ++side)
-      out << (side ? ",\n    " : "\n    ") << jline(p.line[side], p, side, s.line_name[side], s.master_address[side], "    ");
+      out << (side ? ",\n    " : "\n    ")
+          << jline(p.line[side], p, side, s.line_name[side], s.master_address[side], "    ");
     out << "],\n   \"stations\": [";
     for (std::size_t k = 0; k < p.stations.size(); ++k) {
       const auto& st = p.stations[k];
       const SwitchedPlan* sw = switched_plan(plan, *s.rp, st.address);
-      out << (k ? "," : "") << "\n    {\"address\": " << int(st.address) << ", \"model\": " << json_quote(st.name)
-          << ", \"t_slave_um_ns\": " << jopt_ns(st.t_slave_um_given ? std::optional<bus::Ticks>(st.t_slave_um) : std::nullopt)
-          << ", \"t_slave_um_source\": \"" << t_slave_um_source(sw) << "\",\n     \"prm_cmd\": "
-          << jcycle(st.prm_cmd[0], p.baud) << ",\n     \"failing\": [";
+      out << (k ? "," : "") << "\n    {\"address\": " << int(st.address)
+          << ", \"model\": " << json_quote(st.name) << ", \"t_slave_um_ns\": "
+          << jopt_ns(st.t_slave_um_given ? std::optional<bus::Ticks>(st.t_slave_um) : std::nullopt)
+          << ", \"t_slave_um_source\": \"" << t_slave_um_source(sw)
+          << "\",\n     \"prm_cmd\": " << jcycle(st.prm_cmd[0], p.baud) << ",\n     \"failing\": [";
       for (int from = 0; from < 2; ++from)
         out << (from ? ",\n       " : "") << "{\"line\": " << json_quote(s.line_name[from])
             << ", \"to\": " << json_quote(s.line_name[1 - from])
             << ", \"recognition_ns\": " << bus::ticks_to_ns(st.recognition[from])
-            << ", \"t_dp_um_bits\": " << st.t_dp_um_bits[from] << ", \"t_dp_um_ns\": " << bus::ticks_to_ns(st.t_dp_um[from])
+            << ", \"t_dp_um_bits\": " << st.t_dp_um_bits[from]
+            << ", \"t_dp_um_ns\": " << bus::ticks_to_ns(st.t_dp_um[from])
             << ", \"bound_ns\": " << bus::ticks_to_ns(st.bound[from]) << "}";
       out << "],\n     \"worst_ns\": " << bus::ticks_to_ns(st.worst()) << "}";
     }
@@ -374,9 +401,11 @@ void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& syste
           << ", \"t_dp_um_system_bits\": " << p.system_t_dp_um_bits[lost]
           << ", \"t_dp_um_system_ns\": " << bus::ticks_to_ns(p.system_t_dp_um[lost])
           << ", \"max_t_slave_um_ns\": " << bus::ticks_to_ns(p.max_t_slave_um)
-          << ", \"slowest_station\": " << (slow != nullptr ? std::to_string(slow->address) : std::string("null"))
+          << ", \"slowest_station\": "
+          << (slow != nullptr ? std::to_string(slow->address) : std::string("null"))
           << ", \"bound_short_circuit_ns\": " << bus::ticks_to_ns(p.system_bound[lost])
-          << ", \"bound_master_stop_ns\": " << bus::ticks_to_ns(p.system_bound_master_stop[lost]) << "}";
+          << ", \"bound_master_stop_ns\": " << bus::ticks_to_ns(p.system_bound_master_stop[lost])
+          << "}";
     out << "],\n   \"notes\": " << jnotes(p.notes) << "}";
   }
   out << (systems.empty() ? "],\n" : "\n ],\n");
@@ -385,7 +414,8 @@ void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& syste
     const MasterTiming& m = masters[n];
     out << (n ? "," : "") << "\n  {\"address\": " << int(m.mp->params.address) << ",\n";
     out << "   \"bus_params\": " << jbus(m.params) << ",\n";
-    out << "   \"line\": " << jline(m.plan.line[0], m.plan, 0, m.line_name, m.mp->params.address, "    ") << ",\n";
+    out << "   \"line\": "
+        << jline(m.plan.line[0], m.plan, 0, m.line_name, m.mp->params.address, "    ") << ",\n";
     out << "   \"notes\": " << jnotes(m.plan.notes) << "}";
   }
   out << (masters.empty() ? "]}\n" : "\n ]}\n");
@@ -461,7 +491,8 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
     print_json(plan, systems, masters, out);
     return 0;
   }
-  out << "Scenario \"" << plan.name << "\" (" << plan.file << "): planned DP rotation and switchover times\n";
+  out << "Scenario \"" << plan.name << "\" (" << plan.file
+      << "): planned DP rotation and switchover times\n";
   if (systems.empty() && masters.empty()) {
     out << "no DP master system in this scenario: nothing to plan\n";
     return 0;

@@ -24,9 +24,11 @@
 namespace pbvbus::tools {
 
 /// The planner's slaves of redundant system `system` (index into plan.redundant_systems).
-std::vector<redundancy::PlannedSlave> planned_slaves_of_system(const ScenarioPlan& plan, int system);
+std::vector<redundancy::PlannedSlave> planned_slaves_of_system(const ScenarioPlan& plan,
+                                                               int system);
 /// The planner's slaves of dp_master `dp_master` (index into plan.dp_masters), all on line 0.
-std::vector<redundancy::PlannedSlave> planned_slaves_of_master(const ScenarioPlan& plan, int dp_master);
+std::vector<redundancy::PlannedSlave> planned_slaves_of_master(const ScenarioPlan& plan,
+                                                               int dp_master);
 
 /// plan_switchover for redundant system `system`, with the notes above added. Throws
 /// std::invalid_argument as plan_switchover does.

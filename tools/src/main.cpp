@@ -19,6 +19,7 @@ const Command kCommands[] = {
     {"gsd", pbvbus::tools::cmd_gsd, "read a GSD file and print what it describes"},
     {"inspect", pbvbus::tools::cmd_inspect, "summarise a pcapng capture (frames, errors, gaps, events)"},
     {"timeline", pbvbus::tools::cmd_timeline, "draw a capture as an interactive HTML page or an SVG"},
+    {"timing", pbvbus::tools::cmd_timing, "plan DP rotation and switchover times of a scenario"},
 };
 
 void usage(std::ostream& os) {

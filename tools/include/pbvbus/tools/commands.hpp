@@ -15,5 +15,6 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err);
+int cmd_timing(const Args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace pbvbus::tools

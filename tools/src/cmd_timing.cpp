@@ -1,0 +1,505 @@
+// `pbvbus timing SCENARIO [--json]`: plans the DP rotation and switchover times of a scenario
+// with redundancy::plan_switchover (switchover_timing.hpp; derivation in
+// docs/switchover-timing.md). For every redundant_master_system: per line the target rotation
+// time T_TR with its parts and the DP error-recognition time; per switched station T_DP_UM,
+// T_SLAVE_UM (from the GSD, the scenario, or missing) and the bound for either failing line;
+// the system-level switchover (a whole line lost: short circuit, master stop/failure); the
+// planner's notes. For every dp_master outside a redundant system: its line's T_TR (its slaves
+// planned as one-sided slaves of line A, the system terms left out). The planner's input comes
+// from timing_plan.hpp.
+// Exit 0 on success (also for a scenario without a DP master system), 2 for bad usage or a
+// broken scenario (FILE:LINE:COLUMN: reason on stderr).
+//
+// JSON schema "pbvbus.timing/1" (stable: fields are only ever added; a change of meaning gets a
+// new version). All figures are integers: bit times (`_bits`) of the line's baud rate, or
+// nanoseconds (`_ns`, rounded down) of the same durations.
+//
+//   { "schema": "pbvbus.timing/1",
+//     "scenario": { "name": str, "file": str },
+//     "redundant_systems": [ {
+//       "name": str,
+//       "bus_params": BUS,          // line A's; the planner uses them for both lines
+//       "lines": [ LINE, LINE ],    // [0] = line A, [1] = line B
+//       "stations": [ {             // switched stations, in file order
+//         "address": int, "model": str,
+//         "t_slave_um_ns": int|null,             // the station's own switchover time
+//         "t_slave_um_source": "gsd"|"scenario"|"missing",   // missing: counted as 0
+//         "prm_cmd": CYCLE,                      // the pure PrmCmd Set_Prm cycle
+//         "failing": [ {             // [0]: its active channel on line A fails, [1]: on line B
+//           "line": str, "to": str,             // failing line, the line it switches to
+//           "recognition_ns": int,              // DP error recognition on the failing line
+//           "t_dp_um_bits": int, "t_dp_um_ns": int,   // T_TR(to) + PRMCMD + T_TR(to)
+//           "bound_ns": int } ],                // recognition + T_DP_UM + T_SLAVE_UM
+//         "worst_ns": int } ],                  // the larger bound
+//       "system": [ {               // [0]: line A lost, [1]: line B lost
+//         "lost": str, "to": str,
+//         "recognition_ns": int,                // line loss noticed: one T_TR of the lost line
+//         "t_dp_um_system_bits": int, "t_dp_um_system_ns": int,  // T_TR + Σ PRMCMD + T_TR
+//         "max_t_slave_um_ns": int,             // the slowest switched station's (0: none)
+//         "slowest_station": int|null,          // its address; null without any T_SLAVE_UM
+//         "bound_short_circuit_ns": int,        // recognition + T_DP_UM_system + max T_SLAVE_UM
+//         "bound_master_stop_ns": int } ],      // master stop/failure: recognised at once
+//       "notes": [ str ] } ],                   // the planner's assumptions and warnings
+//     "dp_masters": [ {             // dp_masters outside a redundant system, in file order
+//       "address": int,
+//       "bus_params": BUS,
+//       "line": LINE,
+//       "notes": [ str ] } ] }
+//
+//   BUS   = { "baud": int (bit/s), "tsl","min_tsdr","max_tsdr","tqui","tset","ttr","max_retry",
+//             "tid1","tid2": int (bit times except max_retry) }
+//   LINE  = { "side": "A"|"B", "name": str, "master": int (its DP master's address),
+//             "slaves": [ { "address": int, "model": str, "switched": bool,
+//                           "dx": CYCLE } ],       // the Data_Exchange cycle, in input order
+//             "dx_bits": int, "dx_ns": int,        // Σ Data_Exchange cycles
+//             "global_control": CYCLE, "token": CYCLE, "gap": CYCLE,
+//             "diag": CYCLE,                       // diagnosis reserve (zero without slaves)
+//             "retry": CYCLE,                      // retry reserve (zero without slaves)
+//             "t_tr_bits": int, "t_tr_ns": int,
+//             "failed_attempt": CYCLE,             // one unanswered attempt: request + TSL
+//             "recognition_bits": int, "recognition_ns": int }   // T_TR + (1 + max_retry) · that
+//   CYCLE = { "request_bits": int, "tsdr_bits": int (responder delay, or TSL when unanswered),
+//             "response_bits": int, "idle_bits": int, "bits": int (their sum), "ns": int }
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pbvbus/redundancy/switchover_timing.hpp"
+#include "pbvbus/tools/commands.hpp"
+#include "pbvbus/tools/json_text.hpp"
+#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/tools/timing_plan.hpp"
+
+namespace pbvbus::tools {
+
+namespace {
+
+using redundancy::CycleBits;
+using redundancy::LinePlan;
+using redundancy::SwitchoverPlan;
+
+constexpr const char* kUsage =
+    "usage: pbvbus timing SCENARIO [--json]\n"
+    "\n"
+    "Plans the DP rotation and switchover times of a scenario (docs/switchover-timing.md).\n"
+    "For every redundant_master_system: per line the target rotation time T_TR with its parts\n"
+    "(Data_Exchange cycles, Global_Control, token, GAP poll, diagnosis and retry reserves) and\n"
+    "the DP error-recognition time; per switched station T_DP_UM, T_SLAVE_UM (from the GSD or\n"
+    "the scenario) and the switchover bound for either failing line; the system switchover\n"
+    "when a whole line is lost (short circuit, master stop or failure); the planner's notes.\n"
+    "For every other dp_master: its line's T_TR.\n"
+    "\n"
+    "  --json    print the same as one JSON object (schema pbvbus.timing/1)\n"
+    "  --help    this text\n"
+    "\n"
+    "Exit status: 0 success, 2 bad usage or a broken scenario (FILE:LINE:COLUMN: reason on\n"
+    "stderr).\n";
+
+/// What the command plans, with the names the output uses.
+struct SystemTiming {
+  const RedundancyPlan* rp = nullptr;
+  SwitchoverPlan plan;
+  std::string line_name[2];
+  int master_address[2] = {0, 0};
+  fdl::BusParams params;
+};
+
+struct MasterTiming {
+  const DpMasterPlan* mp = nullptr;
+  SwitchoverPlan plan;
+  std::string line_name;
+  fdl::BusParams params;
+};
+
+std::int64_t bits_ns(std::int64_t bits, bus::Baud baud) {
+  return bus::ticks_to_ns(bus::bits_to_ticks(bits, baud));
+}
+
+std::string us_of_bits(std::int64_t bits, bus::Baud baud) {
+  return format_us(bus::bits_to_ticks(bits, baud));
+}
+
+/// Milliseconds with three decimals, rounded down: "36.902 ms".
+std::string ms(bus::Ticks t) {
+  const std::int64_t us = bus::ticks_to_ns(t) / 1000;
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%lld.%03lld ms", static_cast<long long>(us / 1000),
+                static_cast<long long>(us % 1000));
+  return buf;
+}
+
+/// The switched station `address` of system `rp`, or nullptr.
+const SwitchedPlan* switched_plan(const ScenarioPlan& plan, const RedundancyPlan& rp,
+                                  std::uint8_t address) {
+  for (int k : rp.switched) {
+    const SwitchedPlan& s = plan.switched.at(static_cast<std::size_t>(k));
+    if (s.address == address) return &s;
+  }
+  return nullptr;
+}
+
+const char* t_slave_um_source(const SwitchedPlan* s) {
+  if (s == nullptr || !s->t_slave_um) return "missing";
+  return s->t_slave_um_from_gsd ? "gsd" : "scenario";
+}
+
+/// The slowest switched station (largest given T_SLAVE_UM), or nullptr.
+const redundancy::StationBound* slowest(const SwitchoverPlan& p) {
+  const redundancy::StationBound* best = nullptr;
+  for (const auto& s : p.stations)
+    if (s.t_slave_um_given && (best == nullptr || s.t_slave_um > best->t_slave_um)) best = &s;
+  return best;
+}
+
+bool is_switched(const SwitchoverPlan& p, std::uint8_t address) {
+  return std::any_of(p.stations.begin(), p.stations.end(),
+                     [&](const redundancy::StationBound& s) { return s.address == address; });
+}
+
+// --- text output -------------------------------------------------------------------------------
+
+/// Columns padded to their widest cell; column 0 (and every column in `left`) left-aligned,
+/// the others right-aligned.
+class Table {
+ public:
+  explicit Table(std::vector<std::size_t> left = {}) : m_left(std::move(left)) {}
+  void add(std::vector<std::string> row) { m_rows.push_back(std::move(row)); }
+  void print(std::ostream& out, const std::string& indent) const {
+    std::vector<std::size_t> w;
+    for (const auto& r : m_rows)
+      for (std::size_t c = 0; c < r.size(); ++c) {
+        if (w.size() <= c) w.push_back(0);
+        w[c] = std::max(w[c], r[c].size());
+      }
+    for (const auto& r : m_rows) {
+      std::string line = indent;
+      for (std::size_t c = 0; c < r.size(); ++c) {
+        const bool left = c == 0 || std::find(m_left.begin(), m_left.end(), c) != m_left.end();
+        const std::string pad(w[c] - r[c].size(), ' ');
+        if (c) line += "  ";
+        line += left ? r[c] + pad : pad + r[c];
+      }
+      while (!line.empty() && line.back() == ' ') line.pop_back();
+      out << line << "\n";
+    }
+  }
+
+ private:
+  std::vector<std::size_t> m_left;
+  std::vector<std::vector<std::string>> m_rows;
+};
+
+std::string num(std::int64_t v) {
+  return std::to_string(v);
+}
+
+void print_bus_params(const std::string& line, const fdl::BusParams& p, std::ostream& out) {
+  out << "  bus parameters (line " << line << ", " << bus::baud_name(p.baud) << "): TSL " << p.tsl
+      << ", min TSDR " << p.min_tsdr << ", max TSDR " << p.max_tsdr << ", TID1 " << p.tid1()
+      << ", TID2 " << p.tid2() << ", TTR " << p.ttr << " bit, max_retry " << int(p.max_retry)
+      << "; 1 bit = " << format_us(bus::bits_to_ticks(1, p.baud)) << " us\n";
+}
+
+/// T_TR and its parts, the DP error recognition.
+void print_line(const std::string& title, const LinePlan& lp, const SwitchoverPlan& p,
+                std::int64_t max_retry, std::ostream& out) {
+  out << "\n  " << title << "\n";
+  Table t({1});
+  t.add({"term", "", "request", "TSDR/TSL", "reply", "idle", "bits", "us"});
+  for (const auto& s : lp.slaves) {
+    const CycleBits& c = s.dx;
+    t.add({"Data_Exchange " + std::to_string(s.address),
+           s.name + (is_switched(p, s.address) ? " (switched)" : ""), num(c.request), num(c.tsdr),
+           num(c.response), num(c.idle), num(c.total()), us_of_bits(c.total(), p.baud)});
+  }
+  t.add({"sum of Data_Exchange cycles", "", "", "", "", "", num(lp.dx_bits),
+         us_of_bits(lp.dx_bits, p.baud)});
+  auto row = [&](const std::string& what, const std::string& detail, const CycleBits& c) {
+    t.add({what, detail, num(c.request), num(c.tsdr), num(c.response), num(c.idle), num(c.total()),
+           us_of_bits(c.total(), p.baud)});
+  };
+  row("Global_Control", "SDN + TID2", lp.gc);
+  row("token", "to itself + TID1", lp.token);
+  row("GAP poll", lp.gap.response == 0 ? "unanswered: TSL" : "answered", lp.gap);
+  row("diag reserve", "largest Slave_Diag", lp.diag);
+  row("retry reserve", "largest request + TSL", lp.retry);
+  t.add({"T_TR", "", "", "", "", "", num(lp.t_tr_bits), us_of_bits(lp.t_tr_bits, p.baud)});
+  t.add({"DP error recognition",
+         "T_TR + " + std::to_string(1 + max_retry) + " x " +
+             std::to_string(lp.failed_attempt.total()),
+         "", "", "", "", num(lp.recognition_bits), us_of_bits(lp.recognition_bits, p.baud)});
+  t.print(out, "    ");
+}
+
+void print_notes(const std::vector<std::string>& notes, std::ostream& out) {
+  if (notes.empty()) return;
+  out << "\n  notes:\n";
+  for (const auto& n : notes) out << "    - " << n << "\n";
+}
+
+void print_system_text(const ScenarioPlan& plan, const SystemTiming& s, std::ostream& out) {
+  const SwitchoverPlan& p = s.plan;
+  out << "\nRedundant DP master system \"" << s.rp->name << "\": line A " << s.line_name[0]
+      << " (DP master " << s.master_address[0] << "), line B " << s.line_name[1] << " (DP master "
+      << s.master_address[1] << ")\n";
+  print_bus_params(s.line_name[0], s.params, out);
+  for (int side = 0; side < 2; ++side)
+    print_line("line " + s.line_name[side] + " (" + (side == 0 ? "A" : "B") +
+                   "): target rotation time T_TR",
+               p.line[side], p, s.params.max_retry, out);
+
+  out << "\n  switched stations: bound = recognition (failing line) + T_DP_UM (to the other) + "
+         "T_SLAVE_UM\n";
+  if (p.stations.empty()) {
+    out << "    (none)\n";
+  } else {
+    Table t({1, 3, 4});
+    t.add({"station", "model", "T_SLAVE_UM", "from", "failing", "recognition", "T_DP_UM bits",
+           "T_DP_UM", "bound", "worst"});
+    for (const auto& st : p.stations) {
+      const SwitchedPlan* sw = switched_plan(plan, *s.rp, st.address);
+      for (int from = 0; from < 2; ++from)
+        t.add({from == 0 ? std::to_string(st.address) : "", from == 0 ? st.name : "",
+               from == 0 ? (st.t_slave_um_given ? ms(st.t_slave_um) : "-") : "",
+               from == 0 ? t_slave_um_source(sw) : "", s.line_name[from], ms(st.recognition[from]),
+               num(st.t_dp_um_bits[from]), ms(st.t_dp_um[from]), ms(st.bound[from]),
+               from == 0 ? ms(st.worst()) : ""});
+    }
+    t.print(out, "    ");
+  }
+
+  const redundancy::StationBound* slow = slowest(p);
+  out << "\n  system switchover (a whole line lost); slowest station: ";
+  if (slow != nullptr)
+    out << int(slow->address) << ", T_SLAVE_UM " << ms(slow->t_slave_um) << "\n";
+  else
+    out << "none with a T_SLAVE_UM\n";
+  Table t({1});
+  t.add({"lost", "to", "recognition", "T_DP_UM_system bits", "T_DP_UM_system", "T_SLAVE_UM",
+         "short circuit", "master stop/failure"});
+  for (int lost = 0; lost < 2; ++lost)
+    t.add({s.line_name[lost], s.line_name[1 - lost], ms(p.line[lost].line_loss_recognition),
+           num(p.system_t_dp_um_bits[lost]), ms(p.system_t_dp_um[lost]), ms(p.max_t_slave_um),
+           ms(p.system_bound[lost]), ms(p.system_bound_master_stop[lost])});
+  t.print(out, "    ");
+  out << "    (short circuit: recognition + T_DP_UM_system + T_SLAVE_UM; master stop/failure is "
+         "known at once)\n";
+  print_notes(p.notes, out);
+}
+
+void print_master_text(const MasterTiming& m, std::ostream& out) {
+  out << "\nDP master " << int(m.mp->params.address) << " on line " << m.line_name
+      << " (not redundant)\n";
+  print_bus_params(m.line_name, m.params, out);
+  print_line("line " + m.line_name + ": target rotation time T_TR", m.plan.line[0], m.plan,
+             m.params.max_retry, out);
+  print_notes(m.plan.notes, out);
+}
+
+// --- JSON output -------------------------------------------------------------------------------
+
+std::string jcycle(const CycleBits& c, bus::Baud baud) {
+  return "{\"request_bits\": " + num(c.request) + ", \"tsdr_bits\": " + num(c.tsdr) +
+         ", \"response_bits\": " + num(c.response) + ", \"idle_bits\": " + num(c.idle) +
+         ", \"bits\": " + num(c.total()) + ", \"ns\": " + num(bits_ns(c.total(), baud)) + "}";
+}
+
+std::string jopt_ns(std::optional<bus::Ticks> t) {
+  return t ? num(bus::ticks_to_ns(*t)) : "null";
+}
+
+std::string jbus(const fdl::BusParams& p) {
+  return "{\"baud\": " + num(static_cast<std::uint32_t>(p.baud)) + ", \"tsl\": " + num(p.tsl) +
+         ", \"min_tsdr\": " + num(p.min_tsdr) + ", \"max_tsdr\": " + num(p.max_tsdr) +
+         ", \"tqui\": " + num(p.tqui) + ", \"tset\": " + num(p.tset) + ", \"ttr\": " + num(p.ttr) +
+         ", \"max_retry\": " + num(p.max_retry) + ", \"tid1\": " + num(p.tid1()) +
+         ", \"tid2\": " + num(p.tid2()) + "}";
+}
+
+std::string jline(const LinePlan& lp, const SwitchoverPlan& p, int side, const std::string& name,
+                  int master, const std::string& ind) {
+  const bus::Baud b = p.baud;
+  std::ostringstream o;
+  o << "{\"side\": \"" << (side == 0 ? "A" : "B") << "\", \"name\": " << json_quote(name)
+    << ", \"master\": " << master << ",\n"
+    << ind << " \"slaves\": [";
+  for (std::size_t i = 0; i < lp.slaves.size(); ++i) {
+    const auto& s = lp.slaves[i];
+    o << (i ? "," : "") << "\n"
+      << ind << "   {\"address\": " << int(s.address) << ", \"model\": " << json_quote(s.name)
+      << ", \"switched\": " << (is_switched(p, s.address) ? "true" : "false")
+      << ", \"dx\": " << jcycle(s.dx, b) << "}";
+  }
+  o << (lp.slaves.empty() ? "],\n" : "\n" + ind + " ],\n");
+  o << ind << " \"dx_bits\": " << lp.dx_bits << ", \"dx_ns\": " << bits_ns(lp.dx_bits, b) << ",\n";
+  o << ind << " \"global_control\": " << jcycle(lp.gc, b) << ",\n";
+  o << ind << " \"token\": " << jcycle(lp.token, b) << ",\n";
+  o << ind << " \"gap\": " << jcycle(lp.gap, b) << ",\n";
+  o << ind << " \"diag\": " << jcycle(lp.diag, b) << ",\n";
+  o << ind << " \"retry\": " << jcycle(lp.retry, b) << ",\n";
+  o << ind << " \"t_tr_bits\": " << lp.t_tr_bits << ", \"t_tr_ns\": " << bus::ticks_to_ns(lp.t_tr)
+    << ",\n";
+  o << ind << " \"failed_attempt\": " << jcycle(lp.failed_attempt, b) << ",\n";
+  o << ind << " \"recognition_bits\": " << lp.recognition_bits
+    << ", \"recognition_ns\": " << bus::ticks_to_ns(lp.recognition) << "}";
+  return o.str();
+}
+
+std::string jnotes(const std::vector<std::string>& notes) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < notes.size(); ++i) s += (i ? ", " : "") + json_quote(notes[i]);
+  return s + "]";
+}
+
+void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& systems,
+                const std::vector<MasterTiming>& masters, std::ostream& out) {
+  out << "{\"schema\": \"pbvbus.timing/1\",\n";
+  out << " \"scenario\": {\"name\": " << json_quote(plan.name)
+      << ", \"file\": " << json_quote(plan.file) << "},\n";
+  out << " \"redundant_systems\": [";
+  for (std::size_t n = 0; n < systems.size(); ++n) {
+    const SystemTiming& s = systems[n];
+    const SwitchoverPlan& p = s.plan;
+    out << (n ? "," : "") << "\n  {\"name\": " << json_quote(s.rp->name) << ",\n";
+    out << "   \"bus_params\": " << jbus(s.params) << ",\n";
+    out << "   \"lines\": [";
+    for (int side = 0; side < 2; ++side)
+      out << (side ? ",\n    " : "\n    ")
+          << jline(p.line[side], p, side, s.line_name[side], s.master_address[side], "    ");
+    out << "],\n   \"stations\": [";
+    for (std::size_t k = 0; k < p.stations.size(); ++k) {
+      const auto& st = p.stations[k];
+      const SwitchedPlan* sw = switched_plan(plan, *s.rp, st.address);
+      out << (k ? "," : "") << "\n    {\"address\": " << int(st.address)
+          << ", \"model\": " << json_quote(st.name) << ", \"t_slave_um_ns\": "
+          << jopt_ns(st.t_slave_um_given ? std::optional<bus::Ticks>(st.t_slave_um) : std::nullopt)
+          << ", \"t_slave_um_source\": \"" << t_slave_um_source(sw)
+          << "\",\n     \"prm_cmd\": " << jcycle(st.prm_cmd[0], p.baud) << ",\n     \"failing\": [";
+      for (int from = 0; from < 2; ++from)
+        out << (from ? ",\n       " : "") << "{\"line\": " << json_quote(s.line_name[from])
+            << ", \"to\": " << json_quote(s.line_name[1 - from])
+            << ", \"recognition_ns\": " << bus::ticks_to_ns(st.recognition[from])
+            << ", \"t_dp_um_bits\": " << st.t_dp_um_bits[from]
+            << ", \"t_dp_um_ns\": " << bus::ticks_to_ns(st.t_dp_um[from])
+            << ", \"bound_ns\": " << bus::ticks_to_ns(st.bound[from]) << "}";
+      out << "],\n     \"worst_ns\": " << bus::ticks_to_ns(st.worst()) << "}";
+    }
+    out << (p.stations.empty() ? "],\n" : "\n   ],\n");
+    const redundancy::StationBound* slow = slowest(p);
+    out << "   \"system\": [";
+    for (int lost = 0; lost < 2; ++lost)
+      out << (lost ? ",\n    " : "\n    ") << "{\"lost\": " << json_quote(s.line_name[lost])
+          << ", \"to\": " << json_quote(s.line_name[1 - lost])
+          << ", \"recognition_ns\": " << bus::ticks_to_ns(p.line[lost].line_loss_recognition)
+          << ", \"t_dp_um_system_bits\": " << p.system_t_dp_um_bits[lost]
+          << ", \"t_dp_um_system_ns\": " << bus::ticks_to_ns(p.system_t_dp_um[lost])
+          << ", \"max_t_slave_um_ns\": " << bus::ticks_to_ns(p.max_t_slave_um)
+          << ", \"slowest_station\": "
+          << (slow != nullptr ? std::to_string(slow->address) : std::string("null"))
+          << ", \"bound_short_circuit_ns\": " << bus::ticks_to_ns(p.system_bound[lost])
+          << ", \"bound_master_stop_ns\": " << bus::ticks_to_ns(p.system_bound_master_stop[lost])
+          << "}";
+    out << "],\n   \"notes\": " << jnotes(p.notes) << "}";
+  }
+  out << (systems.empty() ? "],\n" : "\n ],\n");
+  out << " \"dp_masters\": [";
+  for (std::size_t n = 0; n < masters.size(); ++n) {
+    const MasterTiming& m = masters[n];
+    out << (n ? "," : "") << "\n  {\"address\": " << int(m.mp->params.address) << ",\n";
+    out << "   \"bus_params\": " << jbus(m.params) << ",\n";
+    out << "   \"line\": "
+        << jline(m.plan.line[0], m.plan, 0, m.line_name, m.mp->params.address, "    ") << ",\n";
+    out << "   \"notes\": " << jnotes(m.plan.notes) << "}";
+  }
+  out << (masters.empty() ? "]}\n" : "\n ]}\n");
+}
+
+}  // namespace
+
+int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
+  bool json = false;
+  std::string file;
+  for (const auto& a : args) {
+    if (a == "--help" || a == "-h") {
+      out << kUsage;
+      return 0;
+    }
+    if (a == "--json") {
+      json = true;
+    } else if (!a.empty() && a[0] == '-') {
+      err << "pbvbus timing: unknown option '" << a << "'\n" << kUsage;
+      return 2;
+    } else if (!file.empty()) {
+      err << "pbvbus timing: only one SCENARIO, got '" << file << "' and '" << a << "'\n";
+      return 2;
+    } else {
+      file = a;
+    }
+  }
+  if (file.empty()) {
+    err << "pbvbus timing: no SCENARIO given\n" << kUsage;
+    return 2;
+  }
+  const LoadResult loaded = load_scenario_file(file);
+  if (!loaded.ok()) {
+    for (const auto& d : loaded.errors) err << d.str() << "\n";
+    return 2;
+  }
+  const ScenarioPlan& plan = *loaded.plan;
+
+  std::vector<SystemTiming> systems;
+  std::vector<MasterTiming> masters;
+  std::vector<bool> in_system(plan.dp_masters.size(), false);
+  try {
+    for (std::size_t k = 0; k < plan.redundant_systems.size(); ++k) {
+      const RedundancyPlan& rp = plan.redundant_systems[k];
+      SystemTiming s;
+      s.rp = &rp;
+      s.plan = plan_system_timing(plan, static_cast<int>(k));
+      s.params = plan.lines.at(static_cast<std::size_t>(rp.line[0])).params;
+      for (int side = 0; side < 2; ++side) {
+        s.line_name[side] = plan.lines.at(static_cast<std::size_t>(rp.line[side])).name;
+        const auto mi = static_cast<std::size_t>(rp.master[side]);
+        s.master_address[side] = plan.dp_masters.at(mi).params.address;
+        in_system.at(mi) = true;
+      }
+      systems.push_back(std::move(s));
+    }
+    for (std::size_t k = 0; k < plan.dp_masters.size(); ++k) {
+      if (in_system[k]) continue;
+      const DpMasterPlan& mp = plan.dp_masters[k];
+      MasterTiming m;
+      m.mp = &mp;
+      m.plan = plan_master_timing(plan, static_cast<int>(k));
+      m.line_name = plan.lines.at(static_cast<std::size_t>(mp.line)).name;
+      m.params = plan.lines.at(static_cast<std::size_t>(mp.line)).params;
+      masters.push_back(std::move(m));
+    }
+  } catch (const std::exception& e) {
+    err << "pbvbus timing: " << plan.file << ": " << e.what() << "\n";
+    return 2;
+  }
+
+  if (json) {
+    print_json(plan, systems, masters, out);
+    return 0;
+  }
+  out << "Scenario \"" << plan.name << "\" (" << plan.file
+      << "): planned DP rotation and switchover times\n";
+  if (systems.empty() && masters.empty()) {
+    out << "no DP master system in this scenario: nothing to plan\n";
+    return 0;
+  }
+  for (const auto& s : systems) print_system_text(plan, s, out);
+  for (const auto& m : masters) print_master_text(m, out);
+  return 0;
+}
+
+}  // namespace pbvbus::tools

@@ -144,6 +144,13 @@ local line_event_codes = {
   [8] = "transceiver failed", [9] = "transceiver repaired", [10] = "babbling transmitter",
   [11] = "babbling stopped",
 }
+-- Redundancy events (tools/include/pbvbus/tools/redundancy_system.hpp): code =
+-- redundancy::SystemEvent::Kind, value = the S7 event id (0 for a switchover record).
+local redundancy_event_codes = {
+  [0] = "redundancy loss", [1] = "redundancy restored", [2] = "station failure",
+  [3] = "station return", [4] = "master system failure", [5] = "master system return",
+  [6] = "switchover",
+}
 
 ------------------------------------------------------------------------------------------------
 -- FDL fields
@@ -412,6 +419,7 @@ local EV = {
   b = ProtoField.int32("pbevent.b", "Station/attachment b", base.DEC),
   value = ProtoField.uint64("pbevent.value", "Value", base.HEX),
   text = ProtoField.string("pbevent.text", "Text", base.UNICODE),
+  s7 = ProtoField.string("pbevent.s7", "S7 event id"),
 }
 ev.fields = {}
 for _, f in pairs(EV) do table.insert(ev.fields, f) end
@@ -1280,11 +1288,16 @@ function ev.dissector(tvb, pinfo, tree)
   t:add_le(EV.code, tvb(2, 2))
   local cname
   if cat == 1 then cname = line_event_codes[code] end
+  if cat == 4 then cname = redundancy_event_codes[code] end
   if cname then t:add(EV.code_name, tvb(2, 2), cname) end
   t:add_le(EV.line, tvb(4, 4))
   t:add_le(EV.a, tvb(8, 4))
   t:add_le(EV.b, tvb(12, 4))
   t:add_le(EV.value, tvb(16, 8))
+  -- Redundancy and CPU events carry the S7 event id (W#16#73A3 ...) in the value.
+  if (cat == 4 or cat == 5) and tvb(16, 4):le_uint() ~= 0 then
+    t:add(EV.s7, tvb(16, 2), string.format("W#16#%04X", tvb(16, 4):le_uint()))
+  end
   local text = ""
   if n > 24 then
     text = tvb(24, n - 24):string(ENC_UTF_8)

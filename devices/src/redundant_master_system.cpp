@@ -3,6 +3,8 @@
 
 #include <stdexcept>
 
+#include "pbvbus/dp/sap.hpp"
+
 namespace pbvbus::devices {
 
 /// One line's master: the dp::Master behind its ActiveStation, with the model's checks around
@@ -22,8 +24,11 @@ class RedundantMasterSystemModel::Node final : public fdl::InitiatorUser {
   }
   bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override {
     m_model.check_medium(m_line, now);
-    return m_master.next_request(prio, now, out);
+    if (!m_master.next_request(prio, now, out)) return false;
+    if (out.da == fdl::kBroadcast && out.dsap == dp::kSapGlobalControl) ++global_controls;
+    return true;
   }
+  std::uint64_t global_controls = 0;
   void on_confirmation(const fdl::Confirmation& con) override {
     // Before the master can turn a short circuit into station failures.
     m_model.check_medium(m_line, con.now);
@@ -49,7 +54,8 @@ RedundantMasterSystemModel::RedundantMasterSystemModel(
     RedundantMasterSystemOptions o, std::vector<dp::SlaveParams> slaves_a,
     std::vector<dp::SlaveParams> slaves_b, std::vector<redundancy::SwitchedStationRef> switched) {
   m_node[0] = std::make_unique<Node>(*this, 0, o.master[0], std::move(slaves_a), o.bus_params);
-  m_node[1] = std::make_unique<Node>(*this, 1, o.master[1], std::move(slaves_b), o.bus_params);
+  m_node[1] = std::make_unique<Node>(*this, 1, o.master[1], std::move(slaves_b),
+                                     o.bus_params_b ? *o.bus_params_b : o.bus_params);
   m_system = std::make_unique<redundancy::MasterSystem>(m_node[0]->master(), m_node[1]->master(),
                                                         std::move(switched), o.system);
   for (int l = 0; l < 2; ++l) {
@@ -68,6 +74,9 @@ const fdl::ActiveStation& RedundantMasterSystemModel::station(int l) const {
 }
 dp::Master& RedundantMasterSystemModel::master(int l) { return m_node[l]->master(); }
 const dp::Master& RedundantMasterSystemModel::master(int l) const { return m_node[l]->master(); }
+std::uint64_t RedundantMasterSystemModel::global_controls(int l) const {
+  return m_node[l]->global_controls;
+}
 
 bus::AttachmentId RedundantMasterSystemModel::attach(int line, bus::Line& l, std::string label) {
   if (line != 0 && line != 1) throw std::invalid_argument("redundant master system: line 0 or 1");

@@ -106,6 +106,7 @@ class SwitchedStationModel::Iface final : public bus::Device {
   bool m_powered = false;
   bus::Line* m_line = nullptr;
   bus::AttachmentId m_att = -1;
+  bool m_off_by_station = false;  ///< powered off by power_off_station(), to bring back
 };
 
 bus::Ticks SwitchedStationModel::Port::now() const { return m_if.outer().now(); }
@@ -264,8 +265,50 @@ void SwitchedStationModel::fail_interface(int i) {
 
 void SwitchedStationModel::repair_interface(int i) {
   m_rs->repair_interface(i, now());
-  if (m_if[i]->m_line) m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, true);
+  // Repaired while the station is off: the transceiver comes back with power_on_station().
+  if (m_if[i]->m_line && m_rs->powered())
+    m_if[i]->m_line->set_transceiver_ok(m_if[i]->m_att, true);
   after_call();
+}
+
+void SwitchedStationModel::power_off_station() {
+  const bus::Ticks t = now();
+  m_rs->power_off(t);
+  for (auto& f : m_if) {
+    // The FDL station goes too (it would still answer FDL Status on its own), whether or not the
+    // line knows of the attachment; only an interface the line powers is ours to bring back.
+    f->m_off_by_station = f->m_powered;
+    if (f->m_powered) f->on_power_off(t);
+    if (f->m_line) f->m_line->set_transceiver_ok(f->m_att, false);
+  }
+  after_call();
+}
+
+void SwitchedStationModel::power_on_station() {
+  const bus::Ticks t = now();
+  for (int i = 0; i < 2; ++i) {
+    Iface& f = *m_if[i];
+    if (f.m_line && m_rs->role(i) != redundancy::Role::Failed)
+      f.m_line->set_transceiver_ok(f.m_att, true);
+  }
+  for (auto& f : m_if) {
+    // As at the line's power-on: the FDL station restarts and powers the RedundantSlave (a cold
+    // start, RedundantSlave::power_on) through the interface's port.
+    if (!f->m_off_by_station) continue;
+    f->m_off_by_station = false;
+    f->on_power_on(t);
+  }
+  if (!m_rs->powered()) m_rs->power_on(t);  // no attachment powered: the backplane still starts
+  after_call();
+}
+
+dp::AlarmResult SwitchedStationModel::raise_alarm(std::uint8_t type, std::uint8_t slot,
+                                                  dp::AlarmSpec spec, bool add_ack,
+                                                  std::span<const std::uint8_t> data,
+                                                  std::uint8_t* seq_nr) {
+  const dp::AlarmResult r = m_rs->raise_alarm(type, slot, spec, add_ack, data, now(), seq_nr);
+  after_call();  // raise_alarm ran the station's due timers first: re-arm both lines
+  return r;
 }
 
 }  // namespace pbvbus::devices

@@ -6,6 +6,7 @@
 // after every DP cycle (no pulse).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,6 +57,17 @@ std::vector<std::string> dialogue(const FrameRecorder& rec, std::vector<std::siz
   return out;
 }
 
+/// The end of the first Data_Exchange request to the station (SD2, DA = the station without the
+/// EXT bit: no SAPs) on a line that ends at or after `after`; the instant its outputs are taken.
+bus::Ticks first_dx_end(const FrameRecorder& rec, bus::Ticks after) {
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& f = rec.frame(i);
+    const auto& b = f.bytes;
+    if (f.end >= after && b.size() > 6 && b[0] == 0x68 && b[4] == kAddr) return f.end;
+  }
+  return bus::kNever;
+}
+
 struct TwoLines {
   bus::Scheduler sched;
   bus::Line line[2] = {bus::Line{sched, "A", kBaud}, bus::Line{sched, "B", kBaud}};
@@ -69,7 +81,7 @@ struct TwoLines {
   /// Master on line A asks for Primary_Request, line B's master does not; Output_Hold_Time
   /// `hold_10ms`.
   explicit TwoLines(std::uint16_t hold_10ms = 100, bool master_on_b = true,
-                    bool primary_request_on_b = false) {
+                    bool primary_request_on_b = false, bool auto_alarm_ack_a = true) {
     const GsdFile gsd = load("PBVB0A10.gsd");
     bp = fdl::BusParams::defaults(kBaud);
     bp.hsa = 12;
@@ -87,7 +99,9 @@ struct TwoLines {
                         static_cast<std::uint8_t>(hold_10ms >> 8),
                         static_cast<std::uint8_t>(hold_10ms & 0xFF)};
       p.user_prm.insert(p.user_prm.end(), block.begin(), block.end());
-      master[i] = std::make_unique<dp::Master>(dp::MasterParams{}, std::vector<dp::SlaveParams>{p});
+      dp::MasterParams mp;
+      mp.auto_alarm_ack = i == 1 || auto_alarm_ack_a;
+      master[i] = std::make_unique<dp::Master>(mp, std::vector<dp::SlaveParams>{p});
       station[i] = std::make_unique<fdl::ActiveStation>(1, bp, *master[i]);
       line[i].attach(*station[i], "master 1");
     }
@@ -236,7 +250,7 @@ TEST(SwitchedStation, RedundantStartUpOnEachLine) {
   // Interface A becomes PRIMARY at the end of its Set_Prm (last stop bit), B BACKUP one link
   // delay (1 ms) later.
   const bus::Ticks prm_end = t.rec[0].frame(idx[0][2]).end;
-  ASSERT_EQ(t.model->events().size(), 2u);
+  ASSERT_EQ(t.model->events().size(), 3u);
   const auto& e0 = t.model->events()[0];
   EXPECT_EQ(e0.kind, redundancy::RedEvent::Kind::RoleChanged);
   EXPECT_EQ(e0.iface, 0);
@@ -250,6 +264,11 @@ TEST(SwitchedStation, RedundantStartUpOnEachLine) {
   EXPECT_EQ(e1.from, Role::SWaiting);
   EXPECT_EQ(e1.to, Role::Backup);
   EXPECT_EQ(e1.at, prm_end + 1 * kMs);
+  // The first outputs after start-up: at the end of A's first Data_Exchange (dialogue #10).
+  const auto& e2 = t.model->events()[2];
+  EXPECT_EQ(e2.kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(e2.iface, 0);
+  EXPECT_EQ(e2.at, t.rec[0].frame(idx[0][10]).end);
 }
 
 // --- active and passive channel -------------------------------------------------------------------
@@ -309,20 +328,26 @@ TEST(SwitchedStation, PrimaryTransceiverFailureSwitchesToBWithoutPulse) {
 
   // Events: A FAILED at 150 ms; B hears nothing after A's heartbeat of 100 ms (arrived at
   // 101 ms, link delay 1 ms) and counts it lost after the 300 ms supervision: PRIMARY at 401 ms.
+  // ev[2]: the start-up's FreshOutputs (A). Then B's first outputs: FreshOutputs at the end of
+  // B's first Data_Exchange request after 401 ms.
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 5u);
-  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::RoleChanged);
-  EXPECT_EQ(ev[2].iface, 0);
-  EXPECT_EQ(ev[2].to, Role::Failed);
-  EXPECT_EQ(ev[2].at, 150 * kMs);
-  EXPECT_EQ(ev[3].kind, redundancy::RedEvent::Kind::PartnerLost);
-  EXPECT_EQ(ev[3].iface, 1);
-  EXPECT_EQ(ev[3].at, 401 * kMs);
-  EXPECT_EQ(ev[4].kind, redundancy::RedEvent::Kind::RoleChanged);
+  ASSERT_EQ(ev.size(), 7u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[3].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[3].iface, 0);
+  EXPECT_EQ(ev[3].to, Role::Failed);
+  EXPECT_EQ(ev[3].at, 150 * kMs);
+  EXPECT_EQ(ev[4].kind, redundancy::RedEvent::Kind::PartnerLost);
   EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].from, Role::Backup);
-  EXPECT_EQ(ev[4].to, Role::Primary);
   EXPECT_EQ(ev[4].at, 401 * kMs);
+  EXPECT_EQ(ev[5].kind, redundancy::RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].from, Role::Backup);
+  EXPECT_EQ(ev[5].to, Role::Primary);
+  EXPECT_EQ(ev[5].at, 401 * kMs);
+  EXPECT_EQ(ev[6].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[6].iface, 1);
+  EXPECT_EQ(ev[6].at, first_dx_end(t.rec[1], 401 * kMs));
 
   // No pulse: every sample after the failure is A's last value or B's, never zero, and once B's
   // value is there A's never comes back. B's first arrives with B's first Data_Exchange after
@@ -378,14 +403,19 @@ TEST(SwitchedStation, LinkAndWatchdogRunWhenOnlyLineBDrivesTheTimer) {
   EXPECT_EQ(t.model->role(1), Role::Primary);
   EXPECT_EQ(t.model->role(0), Role::Backup);
   const auto& ev = t.model->events();
-  ASSERT_GE(ev.size(), 4u);
-  EXPECT_EQ(ev[2].iface, 0);
-  EXPECT_EQ(ev[2].from, Role::Primary);
-  EXPECT_EQ(ev[2].to, Role::Backup);
-  EXPECT_EQ(ev[2].at, last_dx_a + 1000 * kMs);
-  EXPECT_EQ(ev[3].iface, 1);
-  EXPECT_EQ(ev[3].to, Role::Primary);
-  EXPECT_EQ(ev[3].at, last_dx_a + 1000 * kMs + 1 * kMs);
+  ASSERT_GE(ev.size(), 6u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);  // start-up, A
+  EXPECT_EQ(ev[3].iface, 0);
+  EXPECT_EQ(ev[3].from, Role::Primary);
+  EXPECT_EQ(ev[3].to, Role::Backup);
+  EXPECT_EQ(ev[3].at, last_dx_a + 1000 * kMs);
+  EXPECT_EQ(ev[4].iface, 1);
+  EXPECT_EQ(ev[4].to, Role::Primary);
+  EXPECT_EQ(ev[4].at, last_dx_a + 1000 * kMs + 1 * kMs);
+  // Autonomous switchover: the hold ends at B's first Data_Exchange as PRIMARY.
+  EXPECT_EQ(ev[5].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].at, first_dx_end(t.rec[1], last_dx_a + 1001 * kMs));
   EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutB);
 }
 
@@ -441,27 +471,29 @@ TEST(SwitchedStation, BackupFailureAndRepairLeaveTheOutputsAlone) {
   // B restarts S_WAITING at 600 ms, its heartbeat reaches A at 601 ms (PartnerBack), A's
   // become-backup reaches B at 602 ms. No switch back, A stays PRIMARY throughout.
   using K = redundancy::RedEvent::Kind;
+  // (ev[2]: the start-up's FreshOutputs; the backup's failure starts no hold: no other.)
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 7u);
-  EXPECT_EQ(ev[2].kind, K::RoleChanged);
-  EXPECT_EQ(ev[2].iface, 1);
-  EXPECT_EQ(ev[2].to, Role::Failed);
-  EXPECT_EQ(ev[2].at, 150 * kMs);
-  EXPECT_EQ(ev[3].kind, K::PartnerLost);
-  EXPECT_EQ(ev[3].iface, 0);
-  EXPECT_EQ(ev[3].at, 401 * kMs);
-  EXPECT_EQ(ev[4].kind, K::RoleChanged);
-  EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].from, Role::Failed);
-  EXPECT_EQ(ev[4].to, Role::SWaiting);
-  EXPECT_EQ(ev[4].at, 600 * kMs);
-  EXPECT_EQ(ev[5].kind, K::PartnerBack);
-  EXPECT_EQ(ev[5].iface, 0);
-  EXPECT_EQ(ev[5].at, 601 * kMs);
-  EXPECT_EQ(ev[6].kind, K::RoleChanged);
-  EXPECT_EQ(ev[6].iface, 1);
-  EXPECT_EQ(ev[6].to, Role::Backup);
-  EXPECT_EQ(ev[6].at, 602 * kMs);
+  ASSERT_EQ(ev.size(), 8u);
+  EXPECT_EQ(ev[2].kind, K::FreshOutputs);
+  EXPECT_EQ(ev[3].kind, K::RoleChanged);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].to, Role::Failed);
+  EXPECT_EQ(ev[3].at, 150 * kMs);
+  EXPECT_EQ(ev[4].kind, K::PartnerLost);
+  EXPECT_EQ(ev[4].iface, 0);
+  EXPECT_EQ(ev[4].at, 401 * kMs);
+  EXPECT_EQ(ev[5].kind, K::RoleChanged);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].from, Role::Failed);
+  EXPECT_EQ(ev[5].to, Role::SWaiting);
+  EXPECT_EQ(ev[5].at, 600 * kMs);
+  EXPECT_EQ(ev[6].kind, K::PartnerBack);
+  EXPECT_EQ(ev[6].iface, 0);
+  EXPECT_EQ(ev[6].at, 601 * kMs);
+  EXPECT_EQ(ev[7].kind, K::RoleChanged);
+  EXPECT_EQ(ev[7].iface, 1);
+  EXPECT_EQ(ev[7].to, Role::Backup);
+  EXPECT_EQ(ev[7].at, 602 * kMs);
   for (std::size_t k = first; k < s.samples.size(); ++k)
     ASSERT_EQ(s.samples[k].out, kOutA) << s.samples[k].at;
 }
@@ -564,18 +596,25 @@ TEST(SwitchedStation, CommandedSwitchoverByPrimaryRequestOnLineB) {
   // BP_SWITCHOVER at the end of B's Set_Prm; the switchover request reaches A 1 ms later (A
   // BACKUP), the take-over reaches B 1 ms after that (B PRIMARY).
   const bus::Ticks prm_end = t.rec[1].frame(idx[2]).end;
+  // (ev[2]: the start-up's FreshOutputs from A; ev[6]: B's, at the end of its first
+  // Data_Exchange as PRIMARY, dialogue #14.)
   const auto& ev = t.model->events();
-  ASSERT_EQ(ev.size(), 5u);
-  EXPECT_EQ(ev[2].iface, 1);
-  EXPECT_EQ(ev[2].to, Role::BpSwitchover);
-  EXPECT_EQ(ev[2].at, prm_end);
-  EXPECT_EQ(ev[3].iface, 0);
-  EXPECT_EQ(ev[3].from, Role::Primary);
-  EXPECT_EQ(ev[3].to, Role::Backup);
-  EXPECT_EQ(ev[3].at, prm_end + 1 * kMs);
-  EXPECT_EQ(ev[4].iface, 1);
-  EXPECT_EQ(ev[4].to, Role::Primary);
-  EXPECT_EQ(ev[4].at, prm_end + 2 * kMs);
+  ASSERT_EQ(ev.size(), 7u);
+  EXPECT_EQ(ev[2].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[2].iface, 0);
+  EXPECT_EQ(ev[3].iface, 1);
+  EXPECT_EQ(ev[3].to, Role::BpSwitchover);
+  EXPECT_EQ(ev[3].at, prm_end);
+  EXPECT_EQ(ev[4].iface, 0);
+  EXPECT_EQ(ev[4].from, Role::Primary);
+  EXPECT_EQ(ev[4].to, Role::Backup);
+  EXPECT_EQ(ev[4].at, prm_end + 1 * kMs);
+  EXPECT_EQ(ev[5].iface, 1);
+  EXPECT_EQ(ev[5].to, Role::Primary);
+  EXPECT_EQ(ev[5].at, prm_end + 2 * kMs);
+  EXPECT_EQ(ev[6].kind, redundancy::RedEvent::Kind::FreshOutputs);
+  EXPECT_EQ(ev[6].iface, 1);
+  EXPECT_EQ(ev[6].at, t.rec[1].frame(idx[14]).end);
   EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
   EXPECT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
 
@@ -599,6 +638,399 @@ TEST(SwitchedStation, CommandedSwitchoverByPrimaryRequestOnLineB) {
     }
   }
   EXPECT_TRUE(fresh);
+}
+
+// --- station power loss and return ------------------------------------------------------------------
+
+/// A master's events, copied (the spans in MasterEvent die with the call).
+struct EventLog {
+  struct E {
+    dp::MasterEvent::Kind kind;
+    bus::Ticks at;
+    std::uint8_t type, slot, specifier;
+    Bytes data, diag;
+  };
+  std::vector<E> ev;
+  dp::MasterEventHandler handler() {
+    return [this](const dp::MasterEvent& e) {
+      ev.push_back({e.kind, e.time, e.alarm_type, e.alarm_slot, e.alarm_specifier,
+                    Bytes(e.alarm_data.begin(), e.alarm_data.end()),
+                    Bytes(e.diag.begin(), e.diag.end())});
+    };
+  }
+  std::vector<E> of(dp::MasterEvent::Kind k) const {
+    std::vector<E> out;
+    for (const auto& e : ev)
+      if (e.kind == k) out.push_back(e);
+    return out;
+  }
+};
+
+/// True if the frame was sent by the station (its SA in SD1/SD2, or a short acknowledgement:
+/// nobody else on these lines sends E5).
+bool from_station(const Bytes& b) {
+  return (b.size() >= 6 && b[0] == 0x68 && (b[5] & 0x7F) == kAddr) ||
+         (b.size() >= 3 && b[0] == 0x10 && (b[2] & 0x7F) == kAddr) ||
+         (b.size() == 1 && b[0] == 0xE5);
+}
+
+/// The end of the first Set_Prm (SD2, DA 85 = station | EXT, DSAP 3D) starting at or after `after`.
+bus::Ticks set_prm_end(const FrameRecorder& rec, bus::Ticks after) {
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& f = rec.frame(i);
+    const auto& b = f.bytes;
+    if (f.start >= after && b.size() > 8 && b[0] == 0x68 && b[4] == (0x80 | kAddr) &&
+        b[7] == 0x3D)
+      return f.end;
+  }
+  return bus::kNever;
+}
+
+TEST(SwitchedStation, StationPowerLossAndReturnOnBothLines) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  OutputSampler s(*t.model);
+  t.line[0].add_tap(s);
+  t.line[1].add_tap(s);
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  ASSERT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutA);
+  const bus::Ticks toff = t.sched.now();
+  t.model->power_off_station();
+  EXPECT_FALSE(t.model->station_powered());
+  EXPECT_EQ(t.model->role(0), Role::Off);
+  EXPECT_EQ(t.model->role(1), Role::Off);
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), (Bytes{0, 0}));
+  t.run_until(400 * kMs);
+  // Both masters lose the station (S7: OB 86 39C4 on each line), nothing returns yet.
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(log[i].of(K::StationFailure).size(), 1u) << i;
+    EXPECT_TRUE(log[i].of(K::StationReturn).empty()) << i;
+    EXPECT_NE(t.master[i]->slave_state(kAddr), dp::SlaveStatusState::DataExchange) << i;
+    // Not one frame from the station (FDL Status included) on either line while it is off.
+    for (std::size_t k = 0; k < t.rec[i].size(); ++k)
+      if (t.rec[i].frame(k).start >= toff) {
+        EXPECT_FALSE(from_station(t.rec[i].frame(k).bytes)) << i << ": " << t.rec[i].hex(k);
+      }
+  }
+  // A dead station drives nothing: 0 at every frame while off (no hold, no old value).
+  for (const auto& x : s.samples)
+    if (x.at >= toff) {
+      EXPECT_EQ(x.out, (Bytes{0, 0})) << x.at;
+    }
+
+  const bus::Ticks ton = t.sched.now();
+  const std::size_t n = t.model->events().size();
+  t.model->power_on_station();
+  EXPECT_TRUE(t.model->station_powered());
+  EXPECT_EQ(t.model->role(0), Role::SPrimary);
+  EXPECT_EQ(t.model->role(1), Role::SWaiting);
+  t.run_until(600 * kMs);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(log[i].of(K::StationFailure).size(), 1u) << i;
+    EXPECT_EQ(log[i].of(K::StationReturn).size(), 1u) << i;
+    EXPECT_EQ(t.master[i]->slave_state(kAddr), dp::SlaveStatusState::DataExchange) << i;
+  }
+  // Cold start, then the PRIMARY chosen by the next Primary_Request (line A's Set_Prm): A
+  // PRIMARY at the end of that Set_Prm, B BACKUP one link delay (1 ms) later; the hold ends
+  // with A's first Data_Exchange after it.
+  const bus::Ticks prm_end = set_prm_end(t.rec[0], ton);
+  ASSERT_NE(prm_end, bus::kNever);
+  using RK = redundancy::RedEvent::Kind;
+  const auto& ev = t.model->events();
+  ASSERT_EQ(ev.size(), n + 5);
+  EXPECT_EQ(ev[n].kind, RK::RoleChanged);
+  EXPECT_EQ(ev[n].from, Role::Off);
+  EXPECT_EQ(ev[n].to, Role::SPrimary);
+  EXPECT_EQ(ev[n].at, ton);
+  EXPECT_EQ(ev[n + 1].iface, 1);
+  EXPECT_EQ(ev[n + 1].to, Role::SWaiting);
+  EXPECT_EQ(ev[n + 2].iface, 0);
+  EXPECT_EQ(ev[n + 2].from, Role::SPrimary);
+  EXPECT_EQ(ev[n + 2].to, Role::Primary);
+  EXPECT_EQ(ev[n + 2].at, prm_end);
+  // The other two in time order (A's first Data_Exchange may come before or after the 1 ms).
+  int backup = 0, fresh = 0;
+  for (std::size_t k = n + 3; k < ev.size(); ++k) {
+    if (ev[k].kind == RK::RoleChanged) {
+      ++backup;
+      EXPECT_EQ(ev[k].iface, 1);
+      EXPECT_EQ(ev[k].to, Role::Backup);
+      EXPECT_EQ(ev[k].at, prm_end + 1 * kMs);
+    } else {
+      ++fresh;
+      EXPECT_EQ(ev[k].kind, RK::FreshOutputs);
+      EXPECT_EQ(ev[k].iface, 0);
+      EXPECT_EQ(ev[k].at, first_dx_end(t.rec[0], prm_end));
+    }
+    if (k > n + 3) {
+      EXPECT_GE(ev[k].at, ev[k - 1].at);
+    }
+  }
+  EXPECT_EQ(backup, 1);
+  EXPECT_EQ(fresh, 1);
+  EXPECT_EQ(Bytes(t.model->outputs().begin(), t.model->outputs().end()), kOutA);
+}
+
+// --- DP-V1 alarms over the active channel only, none lost (S6, S8) ------------------------------------
+
+/// Samples, at the end of every frame, how many alarms each interface's engine carries.
+struct AlarmSampler final : bus::Tap {
+  explicit AlarmSampler(SwitchedStationModel& m) : model(m) {}
+  void on_frame(const bus::TapFrame& f) override {
+    auto& rs = model.redundant_slave();
+    samples.push_back({f.end,
+                       {rs.engine(0).application().alarms_outstanding(),
+                        rs.engine(1).application().alarms_outstanding()}});
+  }
+  struct Sample {
+    bus::Ticks at;
+    std::size_t n[2];
+  };
+  SwitchedStationModel& model;
+  std::vector<Sample> samples;
+};
+
+/// The DUs of the Alarm_Acks (SD2 to the station, DSAP 32 = 50, SSAP 33 = 51) on a line.
+std::vector<Bytes> alarm_acks(const FrameRecorder& rec) {
+  std::vector<Bytes> out;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const auto& b = rec.frame(i).bytes;
+    if (b.size() > 11 && b[0] == 0x68 && b[4] == (0x80 | kAddr) && b[7] == 0x32 && b[8] == 0x33)
+      out.emplace_back(b.begin() + 9, b.end() - 2);
+  }
+  return out;
+}
+
+// The alarm of these tests: Diagnostic (type 1, enabled by DPV1_Status_2 = 20 in the Set_Prm),
+// slot 2, Appears (specifier bits 01), no Add_Ack, data AB CD. In the diagnosis: the
+// device-related block 06 (header: 4 + 2 octets) 01 02 <Seq_Nr << 3 | 01> AB CD.
+const Bytes kAlarmData{0xAB, 0xCD};
+
+bool contains(const Bytes& hay, const Bytes& needle) {
+  return std::search(hay.begin(), hay.end(), needle.begin(), needle.end()) != hay.end();
+}
+
+TEST(SwitchedStation, AlarmIsRaisedOnThePrimaryOnly) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  AlarmSampler al(*t.model);
+  t.line[1].add_tap(al);
+  t.start();
+  t.run_until(50 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  ASSERT_EQ(t.master[1]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  std::uint8_t seq = 0xFF;
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData, &seq),
+            dp::AlarmResult::Ok);
+  EXPECT_EQ(seq, 0);  // interface A's first alarm
+  EXPECT_EQ(t.model->redundant_slave().engine(0).application().alarms_outstanding(), 1u);
+  t.run_until(100 * kMs);
+  // Line A's master: the alarm once, block 06 01 02 01 AB CD in the diagnosis; acknowledged
+  // with 5C <slot 02> <type 01> <specifier 01>.
+  const auto a = log[0].of(K::Alarm);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_EQ(a[0].type, 1);
+  EXPECT_EQ(a[0].slot, 2);
+  EXPECT_EQ(a[0].specifier, 0x01);
+  EXPECT_EQ(a[0].data, kAlarmData);
+  EXPECT_TRUE(contains(a[0].diag, Bytes{0x06, 0x01, 0x02, 0x01, 0xAB, 0xCD}));
+  EXPECT_EQ(alarm_acks(t.rec[0]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.master[0]->slave_stats(kAddr).alarm_acks, 1u);
+  // Line B's master (in data exchange with the BACKUP all along): nothing; B's engine never
+  // carried it, sampled at every frame on line B.
+  EXPECT_TRUE(log[1].of(K::Alarm).empty());
+  EXPECT_TRUE(alarm_acks(t.rec[1]).empty());
+  ASSERT_FALSE(al.samples.empty());
+  for (const auto& x : al.samples) EXPECT_EQ(x.n[1], 0u) << x.at;
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+}
+
+TEST(SwitchedStation, UnacknowledgedAlarmIsRepeatedOnTheNewPrimaryOnce) {
+  using K = dp::MasterEvent::Kind;
+  // Line A's master does not acknowledge alarms; line B's master starts at 50 ms and commands
+  // the switchover (Primary_Request to the BACKUP).
+  TwoLines t(100, true, /*primary_request_on_b=*/true, /*auto_alarm_ack_a=*/false);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  AlarmSampler al(*t.model);
+  t.line[0].add_tap(al);
+  t.line[1].add_tap(al);
+  t.line[0].start();
+  t.run_until(50 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  t.run_until(60 * kMs);
+  ASSERT_EQ(log[0].of(K::Alarm).size(), 1u);  // seen on A, not acknowledged
+  ASSERT_EQ(t.model->alarms_outstanding(), 1u);
+  t.line[1].start();
+  t.run_until(200 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  ASSERT_EQ(t.model->role(0), Role::Backup);
+  // The hand-over instants: A BACKUP (alarm withdrawn from A) and B PRIMARY (raised on B).
+  bus::Ticks a_backup = bus::kNever, b_primary = bus::kNever;
+  for (const auto& e : t.model->events()) {
+    if (e.kind != redundancy::RedEvent::Kind::RoleChanged) continue;
+    if (e.iface == 0 && e.from == Role::Primary && e.to == Role::Backup) a_backup = e.at;
+    if (e.iface == 1 && e.to == Role::Primary) b_primary = e.at;
+  }
+  ASSERT_NE(a_backup, bus::kNever);
+  ASSERT_EQ(b_primary, a_backup + 1 * kMs);  // the take-over, one link delay later
+  // Exactly one delivery per line, one acknowledgement in all, on line B: the same type, slot,
+  // specifier bits (Appears) and data. B's engine numbers its first alarm 0 as A's did; the
+  // Seq_Nr is not carried over (it pairs alarm and Alarm_Ack within one line's relation only).
+  EXPECT_EQ(log[0].of(K::Alarm).size(), 1u);
+  const auto b = log[1].of(K::Alarm);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].type, 1);
+  EXPECT_EQ(b[0].slot, 2);
+  EXPECT_EQ(b[0].specifier, 0x01);
+  EXPECT_EQ(b[0].data, kAlarmData);
+  EXPECT_GE(b[0].at, b_primary);
+  EXPECT_TRUE(alarm_acks(t.rec[0]).empty());
+  EXPECT_EQ(alarm_acks(t.rec[1]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.master[0]->slave_stats(kAddr).alarm_acks, 0u);
+  EXPECT_EQ(t.master[1]->slave_stats(kAddr).alarm_acks, 1u);
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+  // At every frame: A's engine carries it only before A handed over, B's only from its
+  // take-over on; never both at once.
+  for (const auto& x : al.samples) {
+    if (x.at >= a_backup) {
+      EXPECT_EQ(x.n[0], 0u) << x.at;
+    }
+    if (x.at < b_primary) {
+      EXPECT_EQ(x.n[1], 0u) << x.at;
+    }
+    EXPECT_LE(x.n[0] + x.n[1], 1u) << x.at;
+  }
+  // Master A, still in data exchange with the BACKUP, re-read its diagnosis (Red_Status
+  // changes make DH) and the alarm is gone from it.
+  EXPECT_EQ(t.master[0]->slave_state(kAddr), dp::SlaveStatusState::DataExchange);
+  const auto diags = log[0].of(K::Diagnosis);
+  ASSERT_FALSE(diags.empty());
+  EXPECT_FALSE(contains(diags.back().diag, Bytes{0x06, 0x01, 0x02}));
+}
+
+TEST(SwitchedStation, AlarmAcknowledgedBeforeTheSwitchoverIsNotRepeated) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100, true, /*primary_request_on_b=*/true);  // both masters acknowledge
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.line[0].start();
+  t.run_until(50 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  t.run_until(80 * kMs);
+  ASSERT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);  // acknowledged on A
+  t.line[1].start();
+  t.run_until(200 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  EXPECT_EQ(log[0].of(K::Alarm).size(), 1u);
+  EXPECT_TRUE(log[1].of(K::Alarm).empty());
+  EXPECT_EQ(alarm_acks(t.rec[0]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_TRUE(alarm_acks(t.rec[1]).empty());
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+  EXPECT_EQ(t.model->redundant_slave().engine(1).application().alarms_outstanding(), 0u);
+}
+
+TEST(SwitchedStation, AlarmOfAFailedPrimaryIsDeliveredOnceByTheNewPrimary) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // Raised on A, and A fails at the same instant, before master A can poll it: the alarm must
+  // not die with the interface. B takes over at 401 ms (A's heartbeat of 100 ms, arrived at
+  // 101 ms, + 300 ms supervision) and carries it from then on.
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  t.model->fail_interface(0);
+  t.run_until(600 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  EXPECT_TRUE(log[0].of(K::Alarm).empty());
+  const auto b = log[1].of(K::Alarm);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_GE(b[0].at, 401 * kMs);
+  EXPECT_EQ(b[0].specifier, 0x01);
+  EXPECT_EQ(b[0].data, kAlarmData);
+  EXPECT_EQ(alarm_acks(t.rec[1]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+}
+
+TEST(SwitchedStation, AlarmDroppedByAPrimaryLeavingDataExchangeGoesToTheNewPrimary) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.start();
+  t.run_until(150 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  // A's attachment loses power (master A hears nothing more) right after the alarm is raised
+  // on A. A's engine drops the alarm when its watchdog expires (last Data_Exchange + 1 s) and
+  // the station switches to B 1 ms later (autonomous): the alarm must reach master B, once.
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData),
+            dp::AlarmResult::Ok);
+  EXPECT_EQ(t.model->redundant_slave().engine(0).application().alarms_outstanding(), 1u);
+  t.line[0].set_power(t.att[0], false);
+  t.run_until(1300 * kMs);
+  ASSERT_EQ(t.model->primary(), 1);
+  EXPECT_TRUE(log[0].of(K::Alarm).empty());
+  ASSERT_EQ(log[1].of(K::Alarm).size(), 1u);
+  bus::Ticks b_primary = bus::kNever;  // A's watchdog expiry + 1 ms
+  for (const auto& e : t.model->events())
+    if (e.kind == redundancy::RedEvent::Kind::RoleChanged && e.iface == 1 && e.to == Role::Primary)
+      b_primary = e.at;
+  ASSERT_GT(b_primary, 1000 * kMs);  // the watchdog (1 s) ran out after the 150 ms power-off
+  EXPECT_GE(log[1].of(K::Alarm)[0].at, b_primary);
+  EXPECT_EQ(alarm_acks(t.rec[1]), (std::vector<Bytes>{{0x5C, 0x02, 0x01, 0x01}}));
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+}
+
+TEST(SwitchedStation, AlarmRaisedBeforeAnyPrimaryWaitsForIt) {
+  using K = dp::MasterEvent::Kind;
+  TwoLines t(100);
+  set_up_io(t);
+  EventLog log[2];
+  for (int i = 0; i < 2; ++i) t.master[i]->set_event_handler(log[i].handler());
+  t.start();
+  t.run_until(1 * kMs);  // powered, S_PRIMARY / S_WAITING, no master has chosen yet
+  ASSERT_EQ(t.model->primary(), -1);
+  std::uint8_t seq = 0xFF;
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, kAlarmData, &seq),
+            dp::AlarmResult::Ok);
+  EXPECT_EQ(seq, 0xFF);  // not in any diagnosis yet: no Seq_Nr
+  EXPECT_EQ(t.model->alarms_outstanding(), 1u);
+  EXPECT_EQ(t.model->redundant_slave().engine(0).application().alarms_outstanding(), 0u);
+  EXPECT_EQ(t.model->redundant_slave().engine(1).application().alarms_outstanding(), 0u);
+  t.run_until(100 * kMs);
+  // A became PRIMARY; the alarm went into its diagnosis once it was in data exchange.
+  ASSERT_EQ(log[0].of(K::Alarm).size(), 1u);
+  EXPECT_EQ(log[0].of(K::Alarm)[0].specifier, 0x01);
+  EXPECT_TRUE(log[1].of(K::Alarm).empty());
+  EXPECT_EQ(t.model->alarms_outstanding(), 0u);
+  EXPECT_EQ(t.model->redundant_slave().alarms_acknowledged(), 1u);
+  // Arguments the engine would refuse are refused here too.
+  EXPECT_EQ(t.model->raise_alarm(0, 2, dp::AlarmSpec::Appears, false), dp::AlarmResult::BadArgument);
+  EXPECT_EQ(t.model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, Bytes(60, 0)),
+            dp::AlarmResult::BadArgument);
 }
 
 // --- Flying Redundancy: one line, primary at A, backup at A + 64, swapped on switchover ---------

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <optional>
+#include <stdexcept>
+#include <vector>
 
 #include "../dp/slave_harness.hpp"
 #include "pbvbus/redundancy/redundant_slave.hpp"
@@ -336,6 +338,210 @@ TEST(RedundantSlave, PrimaryWatchdogExpirySwitchesToTheBackupInDataExchange) {
   EXPECT_EQ(r.rs.role(0), Role::Backup);
   EXPECT_EQ(r.rs.outputs()[0], v);
 }
+
+// --- switchover request timeout -------------------------------------------------------------------
+
+/// The events of one kind, in order.
+std::vector<RedEvent> of_kind(const Rig& r, RedEvent::Kind k) {
+  std::vector<RedEvent> out;
+  for (const auto& e : r.events)
+    if (e.kind == k) out.push_back(e);
+  return out;
+}
+
+TEST(RedundantSlave, SwitchoverRequestTimesOutWhenThePartnerHasFailedSilently) {
+  Rig r;
+  redundant_start(r, 100);  // Output_Hold_Time 1 s
+  for (bus::Ticks t = 1000 * kMs; t < 1230 * kMs; t += 10 * kMs) r.cycle(t, 7);
+  // Interface 0 (PRIMARY) fails at 1234 ms. Its last heartbeat left at 1200 ms and arrived at
+  // 1201 ms: the supervision would count it lost only at 1501 ms.
+  r.rs.fail_interface(0, 1234 * kMs);
+  r.line_up[0] = false;
+  // Master 2 commands interface 1 to become primary at 1250 ms (pure PrmCmd, Seq_Nr 2).
+  const bus::Ticks tc = 1250 * kMs;
+  EXPECT_EQ(r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)), Bytes{0xE5});
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  // Nobody answers the switchover request: PRIMARY at tc + switch_timeout (10 ms), not at
+  // 1501 ms; the partner counted lost at that same tick, before the role change.
+  r.run_to(tc + 10 * kMs - 1);
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  EXPECT_TRUE(of_kind(r, RedEvent::Kind::PartnerLost).empty());
+  r.run_to(tc + 10 * kMs);
+  EXPECT_EQ(r.rs.role(1), Role::Primary);
+  ASSERT_GE(r.events.size(), 2u);
+  const RedEvent& lost = r.events[r.events.size() - 2];
+  const RedEvent& prim = r.events.back();
+  EXPECT_EQ(lost.kind, RedEvent::Kind::PartnerLost);
+  EXPECT_EQ(lost.iface, 1);
+  EXPECT_EQ(lost.at, 1260 * kMs);
+  EXPECT_EQ(prim.kind, RedEvent::Kind::RoleChanged);
+  EXPECT_EQ(prim.iface, 1);
+  EXPECT_EQ(prim.from, Role::BpSwitchover);
+  EXPECT_EQ(prim.to, Role::Primary);
+  EXPECT_EQ(prim.at, 1260 * kMs);
+  // Prm_Cmd_Ack as at a take-over: Seq_Nr 2 (0x10), Function 02, own 6A (Primary 02, DX 08,
+  // Baudrate 20, Output_Hold_Time started 40: A's outputs held since 1234 ms), partner 04
+  // (Hardware_defective). Red_Status the same pair, Function 00. Standard part: 00 0C 00 02
+  // (master 2), ident 12 34.
+  EXPECT_EQ(hex(r.diag(1, tc + 11 * kMs)),
+            "00 0C 00 02 12 34 08 9F 00 10 00 6A 04 00 08 9E 00 10 02 6A 04 00");
+  // The supervision does not count the partner lost a second time at 1501 ms.
+  r.run_to(1600 * kMs);
+  EXPECT_EQ(of_kind(r, RedEvent::Kind::PartnerLost).size(), 1u);
+  EXPECT_EQ(r.rs.primary(), 1);
+}
+
+TEST(RedundantSlave, SwitchoverRequestToALivePartnerStillTakesTwoLinkDelays) {
+  Rig r;
+  redundant_start(r, 100);
+  for (bus::Ticks t = 1000 * kMs; t < 1200 * kMs; t += 10 * kMs) r.cycle(t, 7);
+  const bus::Ticks tc = 1205 * kMs;
+  EXPECT_EQ(r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)), Bytes{0xE5});
+  r.run_to(tc + 2 * kMs - 1);
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  r.run_to(tc + 2 * kMs);  // 2 × link delay (1 ms)
+  EXPECT_EQ(r.rs.role(1), Role::Primary);
+  EXPECT_EQ(r.rs.role(0), Role::Backup);
+  // Past the 10 ms timeout nothing more happens: the deadline died with the take-over.
+  r.run_to(tc + 50 * kMs);
+  EXPECT_TRUE(of_kind(r, RedEvent::Kind::PartnerLost).empty());
+  EXPECT_EQ(r.rs.role(1), Role::Primary);
+  EXPECT_EQ(r.rs.role(0), Role::Backup);
+  // A timeout that a live partner cannot meet (≤ 2 × link delay) is refused.
+  RedundantSlaveParams p;
+  p.switch_timeout = 2 * p.link_delay;
+  EXPECT_THROW(RedundantSlave(station_config(), p), std::invalid_argument);
+  p.switch_timeout = 2 * p.link_delay + 1;
+  EXPECT_NO_THROW(RedundantSlave(station_config(), p));
+}
+
+// --- FreshOutputs: the end of the hold ---------------------------------------------------------------
+
+TEST(RedundantSlave, FreshOutputsAtStartUpAndAfterACommandedSwitchover) {
+  Rig r;
+  redundant_start(r, 100);
+  // Start-up: the first Data_Exchange of the PRIMARY (line A at 1000 ms) ends it.
+  r.cycle(1000 * kMs, 1);
+  auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_EQ(fresh.size(), 1u);
+  EXPECT_EQ(fresh[0].iface, 0);
+  EXPECT_EQ(fresh[0].at, 1000 * kMs);
+  for (bus::Ticks t = 1010 * kMs; t < 1200 * kMs; t += 10 * kMs) r.cycle(t, 2);
+  EXPECT_EQ(of_kind(r, RedEvent::Kind::FreshOutputs).size(), 1u);  // steady state: none
+  const bus::Ticks tc = 1205 * kMs;
+  EXPECT_EQ(r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)), Bytes{0xE5});
+  // Outputs while the roles move are not fresh ones: B in BP_SWITCHOVER at tc + 0.5 ms, A
+  // already BACKUP at tc + 1.5 ms.
+  r.req(1, tc + kMs / 2, std::nullopt, {3});
+  r.req(0, tc + 3 * kMs / 2, std::nullopt, {4});
+  EXPECT_EQ(r.rs.outputs()[0], 2);
+  EXPECT_EQ(of_kind(r, RedEvent::Kind::FreshOutputs).size(), 1u);
+  r.run_to(tc + 2 * kMs);
+  ASSERT_EQ(r.rs.primary(), 1);
+  // B's first Data_Exchange as PRIMARY, at tc + 5 ms: the end of the hold.
+  r.req(1, tc + 5 * kMs, std::nullopt, {5});
+  EXPECT_EQ(r.rs.outputs()[0], 5);
+  fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_EQ(fresh.size(), 2u);
+  EXPECT_EQ(fresh[1].iface, 1);
+  EXPECT_EQ(fresh[1].at, 1210 * kMs);
+  r.req(1, tc + 15 * kMs, std::nullopt, {6});
+  EXPECT_EQ(of_kind(r, RedEvent::Kind::FreshOutputs).size(), 2u);
+}
+
+TEST(RedundantSlave, FreshOutputsAfterAnAutonomousSwitchover) {
+  Rig r;
+  redundant_start(r, 100);
+  bus::Ticks t = 1000 * kMs;
+  for (int k = 0; k < 10; ++k, t += 10 * kMs) r.cycle(t, 1);
+  // Master 1's last request at 1090 ms; watchdog 1 s → interface 0 leaves Data_Exch at 2090 ms,
+  // interface 1 PRIMARY at 2091 ms; B's next Data_Exchange: the cycle of 2100 ms, line B
+  // 100 us later → FreshOutputs at 2100.1 ms from interface 1.
+  r.line_up[0] = false;
+  for (; t < 2200 * kMs; t += 10 * kMs) r.cycle(t, 2);
+  const auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_EQ(fresh.size(), 2u);
+  EXPECT_EQ(fresh[0].iface, 0);
+  EXPECT_EQ(fresh[0].at, 1000 * kMs);
+  EXPECT_EQ(fresh[1].iface, 1);
+  EXPECT_EQ(fresh[1].at, 2100 * kMs + kMs / 10);
+}
+
+// --- station power ---------------------------------------------------------------------------------------
+
+TEST(RedundantSlave, PowerOffIsADeadStationPowerOnAColdStart) {
+  Rig r;
+  redundant_start(r, 100);
+  for (bus::Ticks t = 1000 * kMs; t < 1200 * kMs; t += 10 * kMs) r.cycle(t, 9);
+  // A Primary_Request to B at 1203 ms puts a switchover request on the link (due 1204 ms);
+  // the station loses power at 1203.5 ms, before it arrives.
+  EXPECT_EQ(r.req(1, 1203 * kMs, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)),
+            Bytes{0xE5});
+  const bus::Ticks toff = 1203 * kMs + kMs / 2;
+  r.rs.power_off(toff);
+  EXPECT_FALSE(r.rs.powered());
+  EXPECT_EQ(r.rs.outputs()[0], 0);  // drives nothing at once, no hold
+  EXPECT_FALSE(r.rs.outputs_held());
+  EXPECT_EQ(r.rs.role(0), Role::Off);
+  EXPECT_EQ(r.rs.role(1), Role::Off);
+  EXPECT_EQ(r.rs.primary(), -1);
+  EXPECT_EQ(r.rs.next_deadline(), bus::kNever);
+  // Both interfaces silent.
+  EXPECT_EQ(r.req(0, 1210 * kMs, dp::kSapSlaveDiag, {}), Bytes{});
+  EXPECT_EQ(r.req(1, 1210 * kMs, std::nullopt, {9}), Bytes{});
+  const std::size_t n = r.events.size();
+  r.run_to(2000 * kMs);
+  EXPECT_EQ(r.events.size(), n);  // nothing happens in a dead station (no hold expiry either)
+  EXPECT_EQ(r.rs.outputs()[0], 0);
+  // Power returns at 2 s: as at the first power-on (the switchover request died with the
+  // link): S_PRIMARY / S_WAITING, Wait_Prm, no Prm_Cmd_Ack, Red_Status Seq_Nr 0.
+  r.rs.power_on(2000 * kMs);
+  ASSERT_EQ(r.events.size(), n + 2);
+  EXPECT_EQ(r.events[n].from, Role::Off);
+  EXPECT_EQ(r.events[n].to, Role::SPrimary);
+  EXPECT_EQ(r.events[n].at, 2000 * kMs);
+  EXPECT_EQ(r.events[n + 1].to, Role::SWaiting);
+  EXPECT_EQ(hex(r.rs.engine(0).current_diag()), "02 05 00 FF 12 34 08 9F 00 00 00 02 00 00");
+  EXPECT_EQ(hex(r.rs.engine(1).current_diag()), "02 05 00 FF 12 34 08 9F 00 00 00 00 02 00");
+  r.run_to(2001 * kMs);  // a switchover request in flight before would have arrived by now
+  EXPECT_EQ(r.rs.role(0), Role::SPrimary);
+  EXPECT_EQ(r.rs.role(1), Role::SWaiting);
+  // Tsprimary restarts at 2 s: the first swap at 4000 ms.
+  r.run_to(4000 * kMs - 1);
+  EXPECT_EQ(r.rs.role(0), Role::SPrimary);
+  r.run_to(4000 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::SWaiting);
+  EXPECT_EQ(r.rs.role(1), Role::SPrimary);
+  // The next Primary_Request chooses the primary: master 2 at 4500 ms → interface 1 PRIMARY,
+  // interface 0 BACKUP 1 ms later; its first Data_Exchange ends the start-up (FreshOutputs).
+  r.start(1, 4500 * kMs, 3, kFnPrimaryRequest, 100);
+  EXPECT_EQ(r.rs.role(1), Role::Primary);
+  r.run_to(4501 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::Backup);
+  r.req(1, 4510 * kMs, std::nullopt, {0x21});
+  EXPECT_EQ(r.rs.outputs()[0], 0x21);
+  const auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_EQ(fresh.size(), 2u);
+  EXPECT_EQ(fresh[1].iface, 1);
+  EXPECT_EQ(fresh[1].at, 4510 * kMs);
+}
+
+TEST(RedundantSlave, AFailedInterfaceStaysFailedAcrossAPowerCycle) {
+  Rig r;
+  redundant_start(r, 100);
+  r.rs.fail_interface(1, 1000 * kMs);
+  r.rs.power_off(1100 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::Off);
+  EXPECT_EQ(r.rs.role(1), Role::Failed);
+  r.rs.power_on(1200 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::SPrimary);
+  EXPECT_EQ(r.rs.role(1), Role::Failed);
+  EXPECT_EQ(r.req(1, 1210 * kMs, dp::kSapSlaveDiag, {}), Bytes{});
+  // Alone, interface 0 still alternates: S_WAITING after Tsprimary (2 s).
+  r.run_to(3200 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::SWaiting);
+}
+
 
 TEST(RedundantSlave, MalformedPrmCmdIsAPrmFault) {
   Rig r;

@@ -68,6 +68,8 @@ class DpPlanner {
     const std::filesystem::path base = std::filesystem::path(m_plan.file).parent_path();
     for (int i = 0; i < proto.dp_master_size(); ++i) plan_master(i);
     for (int i = 0; i < proto.dp_slave_size(); ++i) plan_slave(i, base);
+    for (int i = 0; i < proto.redundant_master_system_size(); ++i) plan_system(i);
+    for (int i = 0; i < proto.switched_station_size(); ++i) plan_switched(i, base);
     derive_line_params();
   }
 
@@ -144,9 +146,19 @@ class DpPlanner {
   }
 
   void plan_slave(int i, const std::filesystem::path& base) {
-    const auto& s = m_plan.proto.dp_slave(i);
+    plan_slave(m_plan.proto.dp_slave(i), "dp_slave", i, base, -1, -1);
+  }
+
+  /// A dp_slave, or one interface of a switched_station (`rep` = "switched_station", the
+  /// synthesised entry `s` carries its line and master); errors point into `rep`[i].
+  void plan_slave(const scenario::DpSlave& s, const char* rep, int i,
+                  const std::filesystem::path& base, int switched, int side) {
+    m_rep = rep;
     DpSlavePlan sp;
     sp.source = i;
+    sp.switched = switched;
+    sp.side = side;
+    sp.repeated = rep;
     sp.line = line_index(s.line());
     sp.address = static_cast<std::uint8_t>(s.address() & 0x7F);
     sp.io = s.inputs();
@@ -162,7 +174,7 @@ class DpPlanner {
           mi = static_cast<int>(k);
       }
       if (mi < 0) {
-        error("dp_slave", i, "master", -1,
+        error(m_rep, i, "master", -1,
               "no dp_master " + std::to_string(s.master()) + " on line \"" + s.line() + "\"");
         ok = false;
       }
@@ -170,7 +182,7 @@ class DpPlanner {
     }
     // The GSD.
     if (s.gsd().empty()) {
-      error("dp_slave", i, nullptr, -1, "dp_slave needs a gsd file");
+      error(m_rep, i, nullptr, -1, "dp_slave needs a gsd file");
       return;
     }
     std::filesystem::path p(s.gsd());
@@ -179,13 +191,13 @@ class DpPlanner {
     auto loaded = devices::load_gsd(p);
     if (!loaded.ok()) {
       std::string why = loaded.errors.empty() ? "cannot be read" : loaded.errors.front().to_string();
-      error("dp_slave", i, "gsd", -1, "GSD file \"" + s.gsd() + "\": " + why);
+      error(m_rep, i, "gsd", -1, "GSD file \"" + s.gsd() + "\": " + why);
       return;
     }
     const devices::GsdFile& g = *loaded.file;
     sp.model = g.info().model_name;
     if (g.is_master()) {
-      error("dp_slave", i, "gsd", -1, "GSD file \"" + s.gsd() + "\" describes a DP master");
+      error(m_rep, i, "gsd", -1, "GSD file \"" + s.gsd() + "\" describes a DP master");
       return;
     }
     if (sp.line >= 0) {
@@ -193,7 +205,7 @@ class DpPlanner {
       if (auto mt = g.max_tsdr(baud)) {
         sp.gsd_max_tsdr = *mt;
       } else {
-        error("dp_slave", i, "gsd", -1,
+        error(m_rep, i, "gsd", -1,
               "\"" + sp.model + "\" (" + s.gsd() + ") does not support " +
                   std::string(bus::baud_name(baud)) + "bit/s of line \"" + s.line() + "\"");
         ok = false;
@@ -201,7 +213,7 @@ class DpPlanner {
       const auto& lp = m_plan.lines[static_cast<std::size_t>(sp.line)].params;
       if (s.has_tsdr_bits() && sp.gsd_max_tsdr != 0 &&
           (s.tsdr_bits() > sp.gsd_max_tsdr || s.tsdr_bits() < lp.min_tsdr)) {
-        error("dp_slave", i, "tsdr_bits", -1,
+        error(m_rep, i, "tsdr_bits", -1,
               "tsdr_bits " + std::to_string(s.tsdr_bits()) + " is outside [min TSDR " +
                   std::to_string(lp.min_tsdr) + ", MaxTsdr " + std::to_string(sp.gsd_max_tsdr) +
                   " of " + s.gsd() + "]");
@@ -216,7 +228,7 @@ class DpPlanner {
       // Name the station kind the GSD declares: a compact station whose GSD offers several
       // variants needs its one module chosen, it is not "modular".
       const bool modular = g.slave_features().modular_station;
-      error("dp_slave", i, nullptr, -1,
+      error(m_rep, i, nullptr, -1,
             modular ? "dp_slave with the modular GSD \"" + s.gsd() +
                           "\" needs a module list (modules: [\"...\"], at most Max_Module = " +
                           std::to_string(g.slave_features().max_module) + ")"
@@ -231,7 +243,7 @@ class DpPlanner {
       } else {
         std::string known;
         for (const auto& gm : g.modules()) known += (known.empty() ? "\"" : ", \"") + gm.name + "\"";
-        error("dp_slave", i, "modules", k,
+        error(m_rep, i, "modules", k,
               "unknown module \"" + s.modules(k) + "\" in " + s.gsd() + " (it has " + known + ")");
         ok = false;
       }
@@ -239,12 +251,12 @@ class DpPlanner {
     if (!ok) return;
     auto check = g.check_modules(mods);
     if (!check.ok()) {
-      error("dp_slave", i, "modules", -1, "module list refused by " + s.gsd() + ": " + check.errors.front());
+      error(m_rep, i, "modules", -1, "module list refused by " + s.gsd() + ": " + check.errors.front());
       return;
     }
     auto prm = g.user_prm_data(mods);
     if (!prm.ok()) {
-      error("dp_slave", i, "modules", -1, "User_Prm_Data of " + s.gsd() + ": " + prm.errors.front());
+      error(m_rep, i, "modules", -1, "User_Prm_Data of " + s.gsd() + ": " + prm.errors.front());
       return;
     }
     sp.gsd_modules = mods;
@@ -274,12 +286,14 @@ class DpPlanner {
       sm.wd_fact_2 = wd.f2;
     }
     sm.user_prm = *prm.value;
+    // A switched station's Set_Prm carries a PrmCmd block; redundancy::MasterSystem writes it.
+    if (switched >= 0) sm.prm_cmd.assign(dp::kPrmCmdBlockLen, 0);
     sm.modules = c.modules;
     sm.min_slave_interval = c.min_slave_interval;
     sm.fail_safe = c.features.fail_safe;
     if (g.dpv1().c1_response_timeout != 0) sm.c1_response_timeout = g.dpv1().c1_response_timeout;
     if (std::string why = dp::build_layout(c, m_layout); !why.empty()) {
-      error("dp_slave", i, "modules", -1, "configuration of " + s.gsd() + ": " + why);
+      error(m_rep, i, "modules", -1, "configuration of " + s.gsd() + ": " + why);
       return;
     }
     if (!plan_io(i, s, sp)) return;
@@ -296,21 +310,21 @@ class DpPlanner {
                                         const char* what) {
     if (by_index) {
       if (index < sp.module_names.size()) return index;
-      error("dp_slave", i, "io", k,
+      error(m_rep, i, "io", k,
             std::string(what) + " module_index " + std::to_string(index) + " is not below the " +
                 std::to_string(sp.module_names.size()) + " modules of the slave");
       return std::nullopt;
     }
     for (std::size_t m = 0; m < sp.module_names.size(); ++m)
       if (sp.module_names[m] == name) return m;
-    error("dp_slave", i, "io", k,
+    error(m_rep, i, "io", k,
           std::string(what) + " module \"" + name + "\" is not one of the slave's modules");
     return std::nullopt;
   }
 
   std::optional<bus::Ticks> io_duration(int i, int k, const std::string& text, const char* what) {
     auto t = bus::parse_duration(text);
-    if (!t) error("dp_slave", i, "io", k, std::string("bad duration \"") + text + "\" for " + what +
+    if (!t) error(m_rep, i, "io", k, std::string("bad duration \"") + text + "\" for " + what +
                                               " (e.g. \"100ms\")");
     return t;
   }
@@ -321,7 +335,7 @@ class DpPlanner {
     for (int k = 0; k < s.io_size(); ++k) {
       const auto& io = s.io(k);
       if (io.module_ref_case() == scenario::DpSlaveIo::MODULE_REF_NOT_SET) {
-        error("dp_slave", i, "io", k, "io needs a module: module: \"name\" or module_index: n");
+        error(m_rep, i, "io", k, "io needs a module: module: \"name\" or module_index: n");
         ok = false;
         continue;
       }
@@ -334,7 +348,7 @@ class DpPlanner {
       DpIoPlan p;
       p.module = *m;
       if (ml.in_len == 0) {
-        error("dp_slave", i, "io", k, "module \"" + sp.module_names[*m] + "\" has no inputs");
+        error(m_rep, i, "io", k, "module \"" + sp.module_names[*m] + "\" has no inputs");
         ok = false;
         continue;
       }
@@ -342,7 +356,7 @@ class DpPlanner {
       p.offset = io.offset();
       p.width = io.has_width() ? io.width() : (io.offset() < ml.in_len ? ml.in_len - io.offset() : 0);
       if (p.width == 0 || p.offset + p.width > ml.in_len) {
-        error("dp_slave", i, "io", k,
+        error(m_rep, i, "io", k,
               "channel offset " + std::to_string(p.offset) + " width " + std::to_string(p.width) +
                   " is outside the " + std::to_string(ml.in_len) + " input octets of module \"" +
                   sp.module_names[*m] + "\"");
@@ -365,7 +379,7 @@ class DpPlanner {
           if (!c.period().empty()) {
             auto t = io_duration(i, k, c.period(), "counter period");
             if (!t || *t == 0) {
-              if (t) error("dp_slave", i, "io", k, "counter period must be longer than 0");
+              if (t) error(m_rep, i, "io", k, "counter period must be longer than 0");
               good = false;
             } else {
               period = *t;
@@ -377,7 +391,7 @@ class DpPlanner {
         case BC::kRamp: {
           const auto& r = io.ramp();
           auto t = r.period().empty() ? std::nullopt : io_duration(i, k, r.period(), "ramp period");
-          if (r.period().empty()) error("dp_slave", i, "io", k, "ramp needs a period");
+          if (r.period().empty()) error(m_rep, i, "io", k, "ramp needs a period");
           if (!t) good = false;
           b = devices::IoBehaviour::ramp(r.min(), r.max(), t.value_or(0));
           break;
@@ -409,7 +423,7 @@ class DpPlanner {
           }
           const std::size_t from = src.value_or(*m);
           if (good && m_layout.modules[from].out_len == 0) {
-            error("dp_slave", i, "io", k,
+            error(m_rep, i, "io", k,
                   "echo source module \"" + sp.module_names[from] + "\" has no outputs");
             good = false;
           }
@@ -417,13 +431,13 @@ class DpPlanner {
           break;
         }
         case BC::BEHAVIOUR_NOT_SET:
-          error("dp_slave", i, "io", k, "io needs a behaviour: constant, counter, ramp, table or echo");
+          error(m_rep, i, "io", k, "io needs a behaviour: constant, counter, ramp, table or echo");
           good = false;
           break;
       }
       if (good) {
         if (std::string why = devices::check_behaviour(b, m_layout.modules.size()); !why.empty()) {
-          error("dp_slave", i, "io", k, why);
+          error(m_rep, i, "io", k, why);
           good = false;
         }
       }
@@ -434,6 +448,164 @@ class DpPlanner {
       sp.io_behaviours.push_back(std::move(p));
     }
     return ok;
+  }
+
+  /// The dp_master at `address` on line `li`, as an index into dp_masters, or -1.
+  int master_at(int li, std::uint32_t address) const {
+    for (std::size_t k = 0; k < m_plan.dp_masters.size(); ++k) {
+      const auto& mm = m_plan.proto.dp_master(m_plan.dp_masters[k].source);
+      if (m_plan.dp_masters[k].line == li && mm.has_address() && mm.address() == address)
+        return static_cast<int>(k);
+    }
+    return -1;
+  }
+
+  void plan_system(int i) {
+    const auto& r = m_plan.proto.redundant_master_system(i);
+    const char* rep = "redundant_master_system";
+    RedundancyPlan rp;
+    rp.source = i;
+    rp.name = r.name();
+    bool ok = true;
+    if (r.name().empty()) {
+      error(rep, i, nullptr, -1, "redundant_master_system needs a name");
+      ok = false;
+    }
+    for (const auto& other : m_plan.redundant_systems)
+      if (!r.name().empty() && other.name == r.name()) {
+        error(rep, i, "name", -1, "redundant_master_system \"" + r.name() + "\" is defined twice");
+        ok = false;
+      }
+    const std::string* lines[2] = {&r.line_a(), &r.line_b()};
+    const bool has[2] = {r.has_master_a(), r.has_master_b()};
+    const std::uint32_t addr[2] = {r.master_a(), r.master_b()};
+    const char* lf[2] = {"line_a", "line_b"};
+    const char* mf[2] = {"master_a", "master_b"};
+    for (int side = 0; side < 2; ++side) {
+      rp.line[side] = line_index(*lines[side]);
+      if (rp.line[side] < 0) {
+        error(rep, i, lf[side], -1,
+              lines[side]->empty() ? std::string(lf[side]) + " is missing"
+                                   : "unknown line \"" + *lines[side] + "\"");
+        ok = false;
+        continue;
+      }
+      if (!has[side]) {
+        error(rep, i, mf[side], -1, std::string(mf[side]) + " (the dp_master's address) is missing");
+        ok = false;
+        continue;
+      }
+      rp.master[side] = master_at(rp.line[side], addr[side]);
+      if (rp.master[side] < 0) {
+        error(rep, i, mf[side], -1, "no dp_master " + std::to_string(addr[side]) + " on line \"" +
+                                        *lines[side] + "\"");
+        ok = false;
+        continue;
+      }
+      for (const auto& other : m_plan.redundant_systems)
+        if (other.master[0] == rp.master[side] || other.master[1] == rp.master[side]) {
+          error(rep, i, mf[side], -1, "dp_master " + std::to_string(addr[side]) + " on line \"" +
+                                          *lines[side] + "\" is already in system \"" +
+                                          other.name + "\"");
+          ok = false;
+        }
+    }
+    if (ok && rp.line[0] == rp.line[1]) {
+      error(rep, i, "line_b", -1, "line_a and line_b must be two different lines");
+      ok = false;
+    }
+    if (ok && m_plan.lines[static_cast<std::size_t>(rp.line[0])].baud !=
+                  m_plan.lines[static_cast<std::size_t>(rp.line[1])].baud) {
+      error(rep, i, "line_b", -1, "the two lines of a redundant master system run at one baud rate");
+      ok = false;
+    }
+    if (!r.output_hold_time().empty()) {
+      if (auto t = ten_ms(rep, i, "output_hold_time", r.output_hold_time())) {
+        if (*t / kTenMs > 65535) {
+          error(rep, i, "output_hold_time", -1, "output_hold_time is over 655.35 s");
+          ok = false;
+        } else {
+          rp.output_hold_10ms = static_cast<std::uint16_t>(*t / kTenMs);
+        }
+      } else {
+        ok = false;
+      }
+    }
+    rp.preferred = r.preferred() == scenario::RedundantMasterSystem::B ? 1 : 0;
+    if (!ok) rp.line[0] = rp.line[1] = -1;  // kept for names, never built
+    m_plan.redundant_systems.push_back(std::move(rp));
+  }
+
+  void plan_switched(int i, const std::filesystem::path& base) {
+    const auto& w = m_plan.proto.switched_station(i);
+    const char* rep = "switched_station";
+    int sys = -1;
+    for (std::size_t k = 0; k < m_plan.redundant_systems.size(); ++k)
+      if (!w.system().empty() && m_plan.redundant_systems[k].name == w.system())
+        sys = static_cast<int>(k);
+    if (sys < 0) {
+      error(rep, i, "system", -1,
+            w.system().empty() ? std::string("switched_station needs a system (a redundant_master_system's name)")
+                               : "no redundant_master_system \"" + w.system() + "\"");
+      return;
+    }
+    RedundancyPlan& rp = m_plan.redundant_systems[static_cast<std::size_t>(sys)];
+    if (rp.line[0] < 0) return;  // the system itself is broken (reported)
+    if (!w.has_address()) {
+      error(rep, i, nullptr, -1, "switched_station needs an address");
+      return;
+    }
+    if (w.address() > dp::kMaxSlaveAddress) {
+      error(rep, i, "address", -1, "switched_station address " + std::to_string(w.address()) +
+                                       " is out of range 0..125");
+      return;
+    }
+    SwitchedPlan swp;
+    swp.source = i;
+    swp.system = sys;
+    swp.address = static_cast<std::uint8_t>(w.address());
+    const int index = static_cast<int>(m_plan.switched.size());
+    for (int side = 0; side < 2; ++side) {
+      scenario::DpSlave d;
+      d.set_address(w.address());
+      d.set_line(m_plan.lines[static_cast<std::size_t>(rp.line[side])].name);
+      d.set_master(m_plan.proto.dp_master(m_plan.dp_masters[static_cast<std::size_t>(rp.master[side])].source).address());
+      d.set_gsd(w.gsd());
+      for (const auto& m : w.modules()) d.add_modules(m);
+      if (w.has_tsdr_bits()) d.set_tsdr_bits(w.tsdr_bits());
+      d.set_inputs(w.inputs());
+      for (const auto& io : w.io()) *d.add_io() = io;
+      const std::size_t before = m_plan.dp_slaves.size();
+      const std::size_t errors_before = m_errors.size();
+      plan_slave(d, rep, i, base, index, side);
+      if (m_plan.dp_slaves.size() == before) return;  // reported
+      swp.slave[side] = static_cast<int>(before);
+      if (side == 1 && m_errors.size() > errors_before) return;
+    }
+    const DpSlavePlan& a = m_plan.dp_slaves[static_cast<std::size_t>(swp.slave[0])];
+    const devices::GsdRedundancy& red = a.gsd->redundancy();
+    if (!red.system_redundancy() || !red.prm_cmd_supp) {
+      error(rep, i, "gsd", -1,
+            "GSD file \"" + w.gsd() + "\" does not declare System Redundancy "
+            "(Slave_Redundancy_supp bit 0 and PrmCmd_supp = 1)");
+      m_plan.dp_slaves.resize(static_cast<std::size_t>(swp.slave[0]));
+      return;
+    }
+    if (!w.switchover_time().empty()) {
+      auto t = bus::parse_duration(w.switchover_time());
+      if (!t || *t == 0) {
+        error(rep, i, "switchover_time", -1,
+              "bad switchover_time \"" + w.switchover_time() + "\" (e.g. \"30ms\")");
+      } else {
+        swp.t_slave_um = *t;
+      }
+    } else if (red.slave_max_switch_over_time != 0) {
+      swp.t_slave_um = static_cast<bus::Ticks>(red.slave_max_switch_over_time) *
+                       devices::GsdRedundancy::kSwitchOverUnitMs * bus::kTicksPerMs;
+      swp.t_slave_um_from_gsd = true;
+    }
+    rp.switched.push_back(index);
+    m_plan.switched.push_back(swp);
   }
 
   void derive_line_params() {
@@ -461,10 +633,10 @@ class DpPlanner {
       for (const auto& s : m_plan.dp_slaves) {
         if (s.line != static_cast<int>(li) || s.gsd_max_tsdr == 0) continue;
         if (s.gsd_max_tsdr > line.params.max_tsdr) {
-          auto [l, c] = m_locate("dp_slave", s.source, nullptr, -1);
+          auto [l, c] = m_locate(s.repeated, s.source, nullptr, -1);
           m_errors.push_back({m_plan.file, l, c,
                               "MaxTsdr " + std::to_string(s.gsd_max_tsdr) + " of " +
-                                  m_plan.proto.dp_slave(s.source).gsd() +
+                                  s.gsd_path +
                                   " is above the max TSDR " + std::to_string(line.params.max_tsdr) +
                                   " given for line \"" + line.name + "\""});
         }
@@ -487,6 +659,7 @@ class DpPlanner {
   std::vector<Diagnostic>& m_errors;
   std::vector<Wd> m_wd;  // per dp_master
   dp::SlaveLayout m_layout;
+  const char* m_rep = "dp_slave";
 };
 
 }  // namespace

@@ -67,7 +67,19 @@ DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params) 
     throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " +
                              (b.errors.empty() ? std::string("cannot be built") : b.errors.front()));
   m_model = std::move(b.model);
-  const dp::SlaveApplication& app = m_model->application();
+  devices::SlaveModel& model = *m_model;
+  apply_io_plan(
+      plan, model.application(),
+      [&](std::size_t m, devices::IoBehaviour beh) { return model.set_behaviour(m, std::move(beh)); },
+      [&](std::size_t m, std::size_t off, std::size_t w, devices::IoBehaviour beh) {
+        return model.add_channel_behaviour(m, off, w, std::move(beh));
+      });
+}
+
+void apply_io_plan(const DpSlavePlan& plan, const dp::SlaveApplication& app,
+                   const std::function<std::string(std::size_t, devices::IoBehaviour)>& set,
+                   const std::function<std::string(std::size_t, std::size_t, std::size_t,
+                                                   devices::IoBehaviour)>& add) {
   std::optional<std::size_t> first_out;
   for (std::size_t m = 0; m < app.modules(); ++m)
     if (app.module(m).out_len > 0 && !first_out) first_out = m;
@@ -80,13 +92,12 @@ DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params) 
     } else if (plan.io == scenario::DpSlave::ECHO && (ml.out_len > 0 || first_out)) {
       beh = devices::IoBehaviour::echo(ml.out_len > 0 ? std::optional<std::size_t>(m) : first_out);
     }
-    if (std::string why = m_model->set_behaviour(m, beh); !why.empty())
+    if (std::string why = set(m, beh); !why.empty())
       throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " + why);
   }
   for (const DpIoPlan& io : plan.io_behaviours) {
-    const std::string why = io.whole ? m_model->set_behaviour(io.module, io.behaviour)
-                                     : m_model->add_channel_behaviour(io.module, io.offset, io.width,
-                                                                      io.behaviour);
+    const std::string why = io.whole ? set(io.module, io.behaviour)
+                                     : add(io.module, io.offset, io.width, io.behaviour);
     if (!why.empty())
       throw std::runtime_error("DP slave " + std::to_string(plan.address) + ": " + why);
   }
@@ -145,17 +156,25 @@ DpMasterReport dp_master_report(const DpMasterNode& node,
                                 const std::vector<const DpSlaveNode*>& slaves,
                                 const std::vector<const DpSlavePlan*>& plans,
                                 const std::string& line, bus::Baud baud) {
-  const dp::Master& m = node.master();
+  std::vector<const dp::SlaveEngine*> engines;
+  for (const DpSlaveNode* n : slaves) engines.push_back(&n->engine());
+  return dp_master_report(node.master(), node.global_controls(), engines, plans, line, baud);
+}
+
+DpMasterReport dp_master_report(const dp::Master& m, std::uint64_t global_controls,
+                                const std::vector<const dp::SlaveEngine*>& engines,
+                                const std::vector<const DpSlavePlan*>& plans,
+                                const std::string& line, bus::Baud baud) {
   DpMasterReport r;
   r.address = m.address();
   r.line = line;
   r.baud = baud;
   r.mode = std::string(dp::to_string(m.mode()));
-  r.global_controls = node.global_controls();
+  r.global_controls = global_controls;
   r.data_control_time = m.params().data_control_time;
-  for (std::size_t i = 0; i < slaves.size(); ++i) {
+  for (std::size_t i = 0; i < engines.size(); ++i) {
     const DpSlavePlan& p = *plans[i];
-    const dp::SlaveEngine& eng = slaves[i]->engine();
+    const dp::SlaveEngine& eng = *engines[i];
     DpSlaveReport s;
     s.address = p.address;
     s.master = p.master;

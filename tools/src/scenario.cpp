@@ -33,6 +33,7 @@ std::string_view to_string(StationKind k) {
     case StationKind::SerialStation: return "serial station";
     case StationKind::DpMaster: return "dp_master";
     case StationKind::DpSlave: return "dp_slave";
+    case StationKind::SwitchedInterface: return "switched_station";
   }
   return "?";
 }
@@ -305,6 +306,14 @@ class Planner {
       entries.push_back({StationKind::DpSlave, i, nested(m_root, sd, "dp_slave", i), p.line(),
                          p.has_address() ? std::optional(p.address()) : std::nullopt});
     }
+    // A switched station sits on both lines of its system, at the place of its entry.
+    for (const auto& swp : plan.switched) {
+      const auto& rp = plan.redundant_systems[static_cast<std::size_t>(swp.system)];
+      for (int side = 0; side < 2; ++side)
+        entries.push_back({StationKind::SwitchedInterface, swp.source,
+                           nested(m_root, sd, "switched_station", swp.source),
+                           plan.lines[static_cast<std::size_t>(rp.line[side])].name, swp.address});
+    }
     // Cable order = order of appearance in the text. Without text, the order above.
     if (m_root.tree != nullptr) {
       std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
@@ -318,7 +327,9 @@ class Planner {
                                 : e.kind == StationKind::Passive ? scenario::PassiveStation::descriptor()
                                 : e.kind == StationKind::DpMaster ? scenario::DpMaster::descriptor()
                                 : e.kind == StationKind::DpSlave  ? scenario::DpSlave::descriptor()
-                                                                  : scenario::Serial::descriptor();
+                                : e.kind == StationKind::SwitchedInterface
+                                    ? scenario::SwitchedStation::descriptor()
+                                    : scenario::Serial::descriptor();
       const std::string what(to_string(e.kind));
       const int li = line_ref(e.where, d, e.line, what);
       const Where aw = at_field(e.where, d, "address");
@@ -332,7 +343,8 @@ class Planner {
         error(aw, "a serial MONITOR has no address (only a STATION has one)");
       } else if (*e.address > kMaxAddress) {
         error(aw, "address " + std::to_string(*e.address) + " is out of range 0..126");
-      } else if (e.kind == StationKind::DpSlave && *e.address > 125) {
+      } else if ((e.kind == StationKind::DpSlave || e.kind == StationKind::SwitchedInterface) &&
+                 *e.address > 125) {
         error(aw, "DP slave address " + std::to_string(*e.address) +
                       " is out of range 0..125 (126 is the address of an unassigned slave)");
       } else {
@@ -480,7 +492,7 @@ class Planner {
     }
     const DpSlavePlan* sp = nullptr;
     for (const auto& d : plan.dp_slaves)
-      if (d.line == li && d.address == s.address()) sp = &d;
+      if (d.switched < 0 && d.line == li && d.address == s.address()) sp = &d;
     if (sp == nullptr) {
       error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_slave " +
                                              std::to_string(s.address()) + " on line " + quoted(ln));
@@ -565,6 +577,55 @@ class Planner {
     return true;
   }
 
+  /// interface_failure / station_power_loss: the switched_station at `address` (on line `li`,
+  /// which must be one of its system's lines; li < 0: by address alone, which must be unique).
+  bool plan_switched_fault(const ScenarioPlan& plan, const scenario::SwitchedStationFault& sf,
+                           const Where& kw, const pb::Descriptor* kd, const char* kind_field,
+                           int li, PlanFault& pf) {
+    if (!sf.has_address()) {
+      error(kw, std::string(kind_field) + " needs the address of a switched_station");
+      return false;
+    }
+    int found = -1;
+    int side = -1;
+    int matches = 0;
+    for (std::size_t k = 0; k < plan.switched.size(); ++k) {
+      const auto& swp = plan.switched[k];
+      if (swp.address != sf.address()) continue;
+      const auto& rp = plan.redundant_systems[static_cast<std::size_t>(swp.system)];
+      if (li >= 0 && rp.line[0] != li && rp.line[1] != li) continue;
+      found = static_cast<int>(k);
+      side = li < 0 ? 0 : (rp.line[0] == li ? 0 : 1);
+      ++matches;
+    }
+    const std::string where =
+        li >= 0 ? " on line " + quoted(plan.lines[static_cast<std::size_t>(li)].name) : std::string();
+    if (found < 0) {
+      error(at_field(kw, kd, "address"), std::string(kind_field) + ": no switched_station " +
+                                             std::to_string(sf.address()) + where);
+      return false;
+    }
+    if (matches > 1) {
+      error(at_field(kw, kd, "address"), std::string(kind_field) + ": switched_station " +
+                                             std::to_string(sf.address()) +
+                                             " is in several systems: name its line");
+      return false;
+    }
+    const auto& swp = plan.switched[static_cast<std::size_t>(found)];
+    const auto& rp = plan.redundant_systems[static_cast<std::size_t>(swp.system)];
+    pf.switched = found;
+    pf.system = swp.system;
+    pf.side = side;
+    pf.line = rp.line[side];
+    pf.a = plan.lines[static_cast<std::size_t>(pf.line)].position_of(swp.address);
+    const std::string& ln = plan.lines[static_cast<std::size_t>(pf.line)].name;
+    pf.description = pf.kind == PlanFault::Kind::InterfaceFailure
+                         ? "failure of the line " + ln + " interface of switched station " +
+                               std::to_string(swp.address)
+                         : "power loss of switched station " + std::to_string(swp.address);
+    return true;
+  }
+
   void plan_faults(ScenarioPlan& plan) {
     const auto* sd = scenario::Scenario::descriptor();
     const auto* fd = scenario::Fault::descriptor();
@@ -614,6 +675,10 @@ class Planner {
         case FK::kChannelDiag: pf.kind = K::ChannelDiag; line_name = f.channel_diag().line(); kind_field = "channel_diag"; break;
         case FK::kModulePull: pf.kind = K::ModulePull; line_name = f.module_pull().line(); kind_field = "module_pull"; break;
         case FK::kProcessAlarm: pf.kind = K::ProcessAlarm; line_name = f.process_alarm().line(); kind_field = "process_alarm"; break;
+        case FK::kInterfaceFailure: pf.kind = K::InterfaceFailure; line_name = f.interface_failure().line(); kind_field = "interface_failure"; break;
+        case FK::kStationPowerLoss: pf.kind = K::StationPowerLoss; line_name = f.station_power_loss().line(); kind_field = "station_power_loss"; break;
+        case FK::kMasterFailure: pf.kind = K::MasterFailure; line_name = f.master_failure().line(); kind_field = "master_failure"; break;
+        case FK::kMasterStop: pf.kind = K::MasterStop; line_name = f.master_stop().line(); kind_field = "master_stop"; break;
         case FK::KIND_NOT_SET:
           // The message predates the DP slave faults; tests and users match it as it is.
           error(w, "fault needs a kind: cable_cut, short_circuit, noise, power_loss, "
@@ -622,6 +687,12 @@ class Planner {
       }
       const Where kw = nested(w, fd, kind_field);
       const pb::Descriptor* kd = fd->FindFieldByName(kind_field)->message_type();
+      if (pf.kind == K::StationPowerLoss && line_name.empty()) {
+        // The station is found by its address alone; the fault belongs to its line A.
+        if (!plan_switched_fault(plan, f.station_power_loss(), kw, kd, kind_field, -1, pf)) continue;
+        if (ok) plan.faults.push_back(std::move(pf));
+        continue;
+      }
       const int li = line_ref(kw, kd, line_name, kind_field);
       if (li < 0) continue;
       pf.line = li;
@@ -682,6 +753,40 @@ class Planner {
         case K::ProcessAlarm:
           if (!plan_slave_fault(plan, f, kw, kd, kind_field, li, pf)) continue;
           break;
+        case K::InterfaceFailure:
+        case K::StationPowerLoss: {
+          const auto& sf = pf.kind == K::InterfaceFailure ? f.interface_failure() : f.station_power_loss();
+          if (!plan_switched_fault(plan, sf, kw, kd, kind_field, li, pf)) continue;
+          break;
+        }
+        case K::MasterFailure:
+        case K::MasterStop: {
+          const auto& mf = pf.kind == K::MasterFailure ? f.master_failure() : f.master_stop();
+          if (!mf.has_address()) {
+            error(kw, std::string(kind_field) + " needs the address of a dp_master");
+            continue;
+          }
+          for (std::size_t k = 0; k < plan.dp_masters.size(); ++k)
+            if (plan.dp_masters[k].line == li && plan.dp_masters[k].params.address == mf.address())
+              pf.dp_master = static_cast<int>(k);
+          if (pf.dp_master < 0) {
+            error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_master " +
+                                                   std::to_string(mf.address()) + " on line " +
+                                                   quoted(ln));
+            continue;
+          }
+          for (std::size_t k = 0; k < plan.redundant_systems.size(); ++k)
+            for (int side = 0; side < 2; ++side)
+              if (plan.redundant_systems[k].master[side] == pf.dp_master) {
+                pf.system = static_cast<int>(k);
+                pf.side = side;
+              }
+          pf.a = plan.lines[static_cast<std::size_t>(li)].position_of(
+              static_cast<std::uint8_t>(mf.address()));
+          pf.description = std::string(pf.kind == K::MasterFailure ? "failure" : "stop") +
+                           " of dp_master " + std::to_string(mf.address()) + " on line " + ln;
+          break;
+        }
       }
       if (ok) plan.faults.push_back(std::move(pf));
     }

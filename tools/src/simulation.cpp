@@ -54,6 +54,10 @@ struct Simulation::Station {
   std::unique_ptr<DpMasterNode> dp_master;
   std::unique_ptr<DpSlaveNode> dp_slave;
   const DpSlavePlan* dp_slave_plan = nullptr;
+  // A side of a redundant master system (kind DpMaster) or a switched station's interface.
+  RedundantSystemNode* red = nullptr;
+  int red_side = -1;
+  int switched = -1;  ///< index into ScenarioPlan::switched
 };
 
 struct Simulation::LineState {
@@ -67,7 +71,18 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
     : m_plan(plan), m_opts(opts) {
   m_duration = opts.duration ? opts.duration : plan.duration;
   m_seed = opts.seed ? *opts.seed : plan.seed;
+  for (std::size_t k = 0; k < m_plan.redundant_systems.size(); ++k) {
+    const RedundancyPlan& rp = m_plan.redundant_systems[k];
+    const fdl::BusParams params[2] = {m_plan.lines.at(static_cast<std::size_t>(rp.line[0])).params,
+                                      m_plan.lines.at(static_cast<std::size_t>(rp.line[1])).params};
+    m_redundant.push_back(std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params));
+  }
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
+  for (auto& node : m_redundant) {
+    node->set_lines(m_lines.at(static_cast<std::size_t>(node->line(0)))->line.get(),
+                    m_lines.at(static_cast<std::size_t>(node->line(1)))->line.get());
+    node->set_capture(m_opts.capture);
+  }
   std::string why;
   auto probes = plan_capture_probes(m_plan, m_opts.probe, &why);
   if (!probes && m_opts.capture != nullptr) throw std::runtime_error(why);
@@ -167,16 +182,39 @@ void Simulation::build_line(std::size_t li) {
       case StationKind::DpMaster: {
         const auto it = std::find_if(m_plan.dp_masters.begin(), m_plan.dp_masters.end(),
                                      [&](const DpMasterPlan& m) { return m.source == ps.source; });
-        st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
+        const int mi = static_cast<int>(it - m_plan.dp_masters.begin());
         label = "dp master " + std::to_string(st.address);
+        for (auto& node : m_redundant)
+          if (const int side = node->side_of_master(mi); side >= 0) {
+            st.red = node.get();
+            st.red_side = side;
+          }
+        if (st.red != nullptr) {
+          st.position = st.red->model().attach(st.red_side, *ls->line, label);
+          break;
+        }
+        st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
         st.position = ls->line->attach(st.dp_master->station(), label);
         break;
       }
+      case StationKind::SwitchedInterface: {
+        const auto it = std::find_if(m_plan.switched.begin(), m_plan.switched.end(),
+                                     [&](const SwitchedPlan& w) { return w.source == ps.source; });
+        st.switched = static_cast<int>(it - m_plan.switched.begin());
+        st.red = m_redundant.at(static_cast<std::size_t>(it->system)).get();
+        st.red_side = st.red->line(0) == static_cast<int>(li) ? 0 : 1;
+        label = "switched station " + std::to_string(st.address) + (st.red_side == 0 ? " (A)" : " (B)");
+        st.position = st.red->station(st.switched)->attach(st.red_side, *ls->line, label);
+        break;
+      }
       case StationKind::DpSlave: {
-        const auto it = std::find_if(m_plan.dp_slaves.begin(), m_plan.dp_slaves.end(),
-                                     [&](const DpSlavePlan& s) { return s.source == ps.source; });
-        st.dp_slave = std::make_unique<DpSlaveNode>(*it, ps.params);
-        st.dp_slave_plan = &*it;
+        // Switched stations' interfaces are DpSlavePlans too, with sources of their own list.
+        const auto it2 = std::find_if(m_plan.dp_slaves.begin(), m_plan.dp_slaves.end(),
+                                      [&](const DpSlavePlan& s) {
+                                        return s.switched < 0 && s.source == ps.source;
+                                      });
+        st.dp_slave = std::make_unique<DpSlaveNode>(*it2, ps.params);
+        st.dp_slave_plan = &*it2;
         label = "dp slave " + std::to_string(st.address);
         st.position = ls->line->attach(st.dp_slave->station(), label);
         break;
@@ -281,8 +319,13 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
-  bus::Line& l = *m_lines.at(static_cast<std::size_t>(f.line))->line;
+  LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
+  bus::Line& l = *ls.line;
   using K = PlanFault::Kind;
+  // Every redundant system that the fault concerns notes it first (switchover measurements).
+  for (auto& node : m_redundant)
+    if (node->index() == f.system || node->line(0) == f.line || node->line(1) == f.line)
+      node->note_fault(m_sched.now(), f, on);
   switch (f.kind) {
     case K::CableCut: l.set_cut_between(f.a, f.b, on); break;
     case K::ShortCircuit: l.set_short_circuit(on); break;
@@ -294,6 +337,23 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
     case K::ChannelDiag:
     case K::ModulePull:
     case K::ProcessAlarm: apply_slave_fault(f, on); break;
+    case K::InterfaceFailure:
+    case K::StationPowerLoss:
+    case K::MasterFailure:
+    case K::MasterStop: {
+      std::string text = on ? f.description : "repair of " + f.description;
+      if (f.system >= 0) {
+        text = m_redundant.at(static_cast<std::size_t>(f.system))->apply(f, on);
+      } else if (f.kind == K::MasterFailure) {
+        l.set_power(f.a, !on);
+      } else if (f.kind == K::MasterStop) {
+        for (auto& s : ls.stations)
+          if (s.dp_master && s.position == f.a)
+            s.dp_master->master().set_mode(on ? dp::MasterMode::Stop : dp::MasterMode::Operate);
+      }
+      ls.stats.faults.push_back({m_sched.now(), std::move(text)});
+      break;
+    }
   }
 }
 
@@ -404,23 +464,34 @@ Report Simulation::report(double wall_seconds) const {
     // What the wire showed, whoever sent it (a master behind a pty too).
     for (int a = 0; a < 128; ++a) live[a] = std::max<int>(live[a], ls.stats.heard[a]);
     for (const Station& s : ls.stations) {
-      if (!s.dp_master) continue;
+      const bool red_master = s.red != nullptr && s.switched < 0;
+      if (!s.dp_master && !red_master) continue;
+      const fdl::ActiveStation& as =
+          red_master ? s.red->model().station(s.red_side) : s.dp_master->station();
+      const dp::Master& m = red_master ? s.red->model().master(s.red_side) : s.dp_master->master();
       // A DP master is a ring member like any FDL master: its live list counts too.
       if (ls.line->powered(s.position)) {
-        const fdl::ActiveStation& as = s.dp_master->station();
         live[s.address] = std::max(live[s.address], as.in_ring() ? int(fdl::StationType::MasterInRing)
                                                                  : int(fdl::StationType::MasterNotReady));
         for (const auto& [addr, type] : as.live_list())
           if (addr < 128) live[addr] = std::max(live[addr], int(type));
       }
-      std::vector<const DpSlaveNode*> nodes;
+      std::vector<const dp::SlaveEngine*> engines;
       std::vector<const DpSlavePlan*> plans;
       for (const Station& t : ls.stations) {
-        if (!t.dp_slave || t.dp_slave_plan->master != s.address) continue;
-        nodes.push_back(t.dp_slave.get());
-        plans.push_back(t.dp_slave_plan);
+        if (t.dp_slave && t.dp_slave_plan->master == s.address) {
+          engines.push_back(&t.dp_slave->engine());
+          plans.push_back(t.dp_slave_plan);
+        } else if (t.switched >= 0 && red_master && t.red == s.red) {
+          const SwitchedPlan& swp = m_plan.switched.at(static_cast<std::size_t>(t.switched));
+          auto& model = const_cast<RedundantSystemNode*>(t.red)->station(t.switched)->redundant_slave();
+          engines.push_back(&model.engine(t.red_side));
+          plans.push_back(&m_plan.dp_slaves.at(static_cast<std::size_t>(swp.slave[t.red_side])));
+        }
       }
-      r.dp_masters.push_back(dp_master_report(*s.dp_master, nodes, plans, pl.name, pl.baud));
+      const std::uint64_t gc =
+          red_master ? s.red->model().global_controls(s.red_side) : s.dp_master->global_controls();
+      r.dp_masters.push_back(dp_master_report(m, gc, engines, plans, pl.name, pl.baud));
     }
     for (int a = 0; a < 128; ++a)
       if (live[a] >= 0)
@@ -434,6 +505,7 @@ Report Simulation::report(double wall_seconds) const {
     }
     r.lines.push_back(std::move(lr));
   }
+  for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
   return r;
 }
 

@@ -2,6 +2,9 @@
 #include "pbvbus/redundancy/redundant_slave.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+
+#include "pbvbus/dp/sap.hpp"
 
 namespace pbvbus::redundancy {
 
@@ -13,6 +16,7 @@ std::string_view to_string(Role r) {
     case Role::Backup: return "BACKUP";
     case Role::BpSwitchover: return "BP_SWITCHOVER";
     case Role::Failed: return "FAILED";
+    case Role::Off: return "OFF";
   }
   return "?";
 }
@@ -32,7 +36,7 @@ class RedundantSlave::Port final : public fdl::ResponderUser {
   }
   void on_request(const fdl::Indication& ind, fdl::Reply& reply) override {
     m_rs.on_time(ind.now);
-    if (!m_rs.alive(m_i)) {
+    if (!m_rs.m_powered || !m_rs.alive(m_i)) {  // a dead station or a failed interface
       reply.none();
       return;
     }
@@ -53,6 +57,10 @@ class RedundantSlave::Port final : public fdl::ResponderUser {
 
 RedundantSlave::RedundantSlave(dp::SlaveConfig cfg, RedundantSlaveParams p)
     : m_p(p), m_hold_time(p.output_hold) {
+  // A live partner answers a switchover request after 2 × link_delay; a shorter timeout would
+  // make the requester PRIMARY while the partner still is: two primaries.
+  if (m_p.switch_timeout <= 2 * m_p.link_delay)
+    throw std::invalid_argument("switch_timeout must exceed 2 x link_delay");
   cfg.features.dpv1 = true;
   cfg.features.prm_cmd = cfg.features.prm_structure = true;
   for (int i = 0; i < 2; ++i) {
@@ -60,6 +68,10 @@ RedundantSlave::RedundantSlave(dp::SlaveConfig cfg, RedundantSlaveParams p)
     c.on_prm_cmd = [this, i](const dp::PrmCmdView& v) { return handle_prm_cmd(i, v); };
     m_if[i].engine = std::make_unique<dp::SlaveEngine>(std::move(c));
     m_if[i].port = std::make_unique<Port>(*this, i);
+    m_if[i].engine->application().on_alarm_ack(
+        [this, i](std::uint8_t type, std::uint8_t slot, std::uint8_t seq) {
+          alarm_acked(i, type, slot, seq);
+        });
   }
   m_out.assign(m_if[0].engine->layout().outputs, 0);
   m_scratch.assign(m_out.size(), 0);
@@ -78,6 +90,7 @@ int RedundantSlave::primary() const {
 RedState RedundantSlave::red_state(int i) const {
   const Iface& f = m_if[i];
   RedState s;
+  if (f.role == Role::Off) return s;  // no power: nothing to report (nobody reads it either)
   if (f.role == Role::Failed) {  // a failed interface is known only as defective
     s.hardware_defective = true;
     return s;
@@ -106,17 +119,54 @@ void RedundantSlave::emit(RedEvent::Kind k, bus::Ticks at, int iface, Role from,
 
 void RedundantSlave::power_on(bus::Ticks now) {
   m_powered = true;
+  m_link.clear();
+  m_hold_deadline = bus::kNever;
+  m_fresh_pending = true;  // the first outputs of the first PRIMARY end the start-up
   for (int i = 0; i < 2; ++i) {
-    m_if[i].role = i == 0 ? Role::SPrimary : Role::SWaiting;
-    m_if[i].last_heard = now;
-    m_if[i].next_heartbeat = now;
-    m_if[i].partner_lost = false;
+    Iface& f = m_if[i];
+    // A cold start: the engine restarts (Wait_Prm) and forgets the last PrmCmd; the
+    // Prm_Cmd_Ack of a previous life must not show in the new diagnosis.
+    f.engine->on_power_on(now);
+    f.engine->application().clear_status(kStatusPrmCmdAck, 0);
+    f.baudrate_found = f.master_state_clear = f.was_data_exch = f.ack_pending = false;
+    f.cmd_spec = f.cmd_function = 0;
+    f.switch_deadline = bus::kNever;
+    f.last_heard = now;
+    f.next_heartbeat = now;
+    f.partner_lost = false;
+    if (f.role == Role::Failed) continue;  // a defective interface stays defective
+    const Role from = f.role;
+    f.role = i == 0 ? Role::SPrimary : Role::SWaiting;
+    // The first power-on is the start state, not a change; a return from power_off() is.
+    if (from == Role::Off) emit(RedEvent::Kind::RoleChanged, now, i, from, f.role);
   }
   m_decided = false;
   m_swapped = false;
   m_tsprimary = m_p.tsprimary_start;
   m_alternate_at = now + m_tsprimary;
   refresh_status();
+}
+
+void RedundantSlave::power_off(bus::Ticks now) {
+  if (!m_powered) return;
+  on_time(now);
+  // A dead station drives nothing: outputs 0 at once. That is not a hold expiring (no event)
+  // and not a pulse: no module is powered to show one.
+  std::fill(m_out.begin(), m_out.end(), 0);
+  m_hold_deadline = bus::kNever;
+  m_alternate_at = bus::kNever;
+  m_fresh_pending = false;
+  m_link.clear();    // messages on the internal link die with it
+  m_alarms.clear();  // volatile: a restarted station has no alarms to repeat
+  for (int i = 0; i < 2; ++i) {
+    Iface& f = m_if[i];
+    f.switch_deadline = bus::kNever;
+    if (f.role == Role::Failed) continue;
+    const Role from = f.role;
+    f.role = Role::Off;
+    emit(RedEvent::Kind::RoleChanged, now, i, from, Role::Off);
+  }
+  m_powered = false;
 }
 
 bus::Ticks RedundantSlave::next_deadline() const {
@@ -126,6 +176,7 @@ bus::Ticks RedundantSlave::next_deadline() const {
   for (const auto& f : m_if) {
     t = std::min(t, f.engine->next_deadline());
     if (f.role == Role::Failed) continue;
+    if (f.role == Role::BpSwitchover) t = std::min(t, f.switch_deadline);
     t = std::min(t, f.next_heartbeat);
     if (!f.partner_lost) t = std::min(t, f.last_heard + m_p.supervision);
   }
@@ -161,6 +212,17 @@ void RedundantSlave::on_time(bus::Ticks now) {
           set_role(i, Role::Primary, t);
         }
       }
+      if (f.role == Role::BpSwitchover && f.switch_deadline <= t) {
+        // No take-over within switch_timeout: the partner has failed without the supervision
+        // noticing yet. Count it lost and take over, as a real IM does (command carried out:
+        // Prm_Cmd_Ack as at a take-over).
+        if (!f.partner_lost) {
+          f.partner_lost = true;
+          emit(RedEvent::Kind::PartnerLost, t, i);
+        }
+        f.ack_pending = true;
+        set_role(i, Role::Primary, t);
+      }
     }
     if (m_alternate_at <= t) {
       for (int i = 0; i < 2; ++i) {
@@ -176,6 +238,7 @@ void RedundantSlave::on_time(bus::Ticks now) {
       emit(RedEvent::Kind::OutputHoldExpired, t, std::max(primary(), 0));
     }
     refresh_status();
+    sync_alarms(t);
   }
 }
 
@@ -227,6 +290,7 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
   const Role from = f.role;
   if (from == r) return;
   f.role = r;
+  f.switch_deadline = r == Role::BpSwitchover ? now + m_p.switch_timeout : bus::kNever;
   bool swapped = false;
   if (from == Role::Primary) lose_primary(now);
   if (r == Role::Primary) {
@@ -250,9 +314,10 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
 
 void RedundantSlave::lose_primary(bus::Ticks now) {
   if (m_hold_deadline == bus::kNever) m_hold_deadline = now + m_hold_time;
+  m_fresh_pending = true;
 }
 
-void RedundantSlave::take_outputs(int i) {
+void RedundantSlave::take_outputs(int i, bus::Ticks now) {
   auto& app = m_if[i].engine->application();
   for (std::size_t m = 0; m < app.modules(); ++m) {
     const auto& ml = app.module(m);
@@ -261,6 +326,10 @@ void RedundantSlave::take_outputs(int i) {
   }
   std::copy(m_scratch.begin(), m_scratch.end(), m_out.begin());
   m_hold_deadline = bus::kNever;
+  if (m_fresh_pending) {
+    m_fresh_pending = false;
+    emit(RedEvent::Kind::FreshOutputs, now, i);
+  }
 }
 
 bool RedundantSlave::partner_in_dx(int i) const {
@@ -294,9 +363,10 @@ void RedundantSlave::after_request(int i, bus::Ticks now, std::uint64_t dx_befor
   const auto& st = f.engine->stats();
   const bool dx_ok = st.data_exchange != dx_before && st.refused == rs_before &&
                      f.engine->state() == dp::SlaveState::DataExch;
-  if (dx_ok && f.role == Role::Primary) take_outputs(i);
+  if (dx_ok && f.role == Role::Primary) take_outputs(i, now);
   check_primary_lost_master(now);
   refresh_status();
+  sync_alarms(now);
 }
 
 dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) {
@@ -313,19 +383,25 @@ dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) 
       case Role::Primary: set_ack(i); break;
       case Role::Backup:
       case Role::SWaiting:
-      case Role::SPrimary:
-        // With a live PRIMARY partner (e.g. this interface was just repaired and restarts in
+      case Role::SPrimary: {
+        // With a PRIMARY partner (e.g. this interface was just repaired and restarts in
         // S_WAITING while the other carries the process), Primary_Request is a commanded
-        // switchover through the partner, never a second primary.
-        if (alive(1 - i) && !f.partner_lost && m_if[1 - i].role == Role::Primary) {
+        // switchover through the partner, never a second primary. A partner that has failed
+        // without being counted lost yet is, for this interface, still what it was: it asks,
+        // gets no answer and takes over after switch_timeout.
+        const Iface& partner = m_if[1 - i];
+        const Role believed = partner.role == Role::Failed ? partner.failed_from : partner.role;
+        if (!f.partner_lost && believed == Role::Primary) {
           set_role(i, Role::BpSwitchover, v.now);
           send(i, Msg::SwitchReq, v.now);
         } else {
           set_role(i, Role::Primary, v.now);
         }
         break;
+      }
       case Role::BpSwitchover:
-      case Role::Failed: break;
+      case Role::Failed:
+      case Role::Off: break;
     }
   } else {
     set_ack(i);
@@ -360,20 +436,106 @@ void RedundantSlave::refresh_status() {
 
 void RedundantSlave::fail_interface(int i, bus::Ticks now) {
   on_time(now);
+  if (m_if[i].role != Role::Failed) m_if[i].failed_from = m_if[i].role;
   set_role(i, Role::Failed, now);
   m_if[i].was_data_exch = false;
+  sync_alarms(now);
 }
 
 void RedundantSlave::repair_interface(int i, bus::Ticks now) {
   on_time(now);
   Iface& f = m_if[i];
   if (f.role != Role::Failed) return;
+  if (!m_powered) {  // repaired while the station has no power: it starts with the station
+    f.role = Role::Off;
+    emit(RedEvent::Kind::RoleChanged, now, i, Role::Failed, Role::Off);
+    return;
+  }
   f.engine->on_power_on(now);  // the interface restarts: Wait_Prm
   f.baudrate_found = f.master_state_clear = f.ack_pending = false;
   f.last_heard = now;
   f.partner_lost = false;
   f.next_heartbeat = now;
   set_role(i, Role::SWaiting, now);
+  sync_alarms(now);
+}
+
+// --- DP-V1 alarms over the active channel -----------------------------------------------------------
+
+dp::AlarmResult RedundantSlave::raise_alarm(std::uint8_t type, std::uint8_t slot,
+                                            dp::AlarmSpec spec, bool add_ack,
+                                            std::span<const std::uint8_t> data, bus::Ticks now,
+                                            std::uint8_t* seq_nr) {
+  if (dp::alarm_enable_bit(type) == 0 || data.size() > 59) return dp::AlarmResult::BadArgument;
+  if (!m_powered) return dp::AlarmResult::Closed;  // a dead station raises nothing
+  if (m_alarms.size() >= kMaxStationAlarms) return dp::AlarmResult::LimitExpired;
+  on_time(now);
+  StationAlarm a;
+  a.type = type;
+  a.slot = slot;
+  a.spec = spec;
+  a.add_ack = add_ack;
+  a.data.assign(data.begin(), data.end());
+  m_alarms.push_back(std::move(a));
+  sync_alarms(now);
+  if (seq_nr && m_alarms.back().iface >= 0) *seq_nr = m_alarms.back().seq;
+  return dp::AlarmResult::Ok;
+}
+
+void RedundantSlave::sync_alarms(bus::Ticks now) {
+  if (!m_powered || m_alarms.empty()) return;
+  const int p = primary();
+  for (auto& a : m_alarms) {
+    if (a.iface < 0) continue;
+    dp::SlaveEngine& e = *m_if[a.iface].engine;
+    // The engine drops its alarms whenever it leaves (or re-enters) Data_Exch.
+    const bool there =
+        e.state() == dp::SlaveState::DataExch && e.stats().data_exch_entries == a.dx_entry;
+    if (a.iface != p && there) {
+      // No longer the PRIMARY: take it out of that diagnosis (the only way the dp layer offers
+      // is an Alarm_Ack from the engine's owner, played internally; see the header).
+      const std::array<std::uint8_t, 4> pdu{dp::kFnAlarmAck, a.slot, a.type,
+                                            dp::alarm_specifier(a.seq, a.add_ack, a.spec)};
+      fdl::Indication ind;
+      ind.now = now;
+      ind.sa = e.master_address();
+      ind.da = 0;  // any unicast address: the engine does not check its own
+      ind.fn = fdl::RequestFn::SrdHigh;
+      ind.dsap = dp::kSapC1Alarm;
+      ind.ssap = dp::kSapMs1;
+      ind.data = pdu;
+      fdl::Reply ignored;
+      m_withdrawing = true;
+      e.on_request(ind, ignored);
+      m_withdrawing = false;
+    }
+    if (a.iface != p || !there) a.iface = -1;
+  }
+  if (p < 0) return;
+  dp::SlaveEngine& e = *m_if[p].engine;
+  for (auto& a : m_alarms) {
+    if (a.iface >= 0) continue;
+    std::uint8_t seq = 0;
+    const dp::AlarmResult r =
+        e.application().raise_alarm(a.type, a.slot, a.spec, a.add_ack, a.data, &seq);
+    if (r == dp::AlarmResult::Ok) {
+      a.iface = p;
+      a.seq = seq;
+      a.dx_entry = e.stats().data_exch_entries;
+    } else if (r == dp::AlarmResult::Closed) {
+      break;  // not in Data_Exch with DP-V1: none fits; a type or limit refusal may let others
+    }
+  }
+}
+
+void RedundantSlave::alarm_acked(int i, std::uint8_t type, std::uint8_t slot, std::uint8_t seq) {
+  if (m_withdrawing) return;  // our own withdrawal, not the master's acknowledgement
+  const auto it = std::find_if(m_alarms.begin(), m_alarms.end(), [&](const StationAlarm& a) {
+    return a.iface == i && a.type == type && a.slot == slot && a.seq == seq;
+  });
+  if (it == m_alarms.end()) return;  // not one of the station's (raised on the engine directly)
+  m_alarms.erase(it);
+  ++m_alarms_acked;
 }
 
 }  // namespace pbvbus::redundancy

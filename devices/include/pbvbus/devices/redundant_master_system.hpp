@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,8 @@ namespace pbvbus::devices {
 
 struct RedundantMasterSystemOptions {
   dp::MasterParams master[2];  ///< line A's and line B's master (addresses may be equal)
-  fdl::BusParams bus_params;   ///< both lines' parameters
+  fdl::BusParams bus_params;   ///< both lines' parameters (line A's, if bus_params_b is set)
+  std::optional<fdl::BusParams> bus_params_b;  ///< line B's, when they differ (e.g. TTR)
   redundancy::MasterSystemParams system;
 };
 
@@ -59,6 +61,8 @@ class RedundantMasterSystemModel {
   const fdl::ActiveStation& station(int line) const;
   dp::Master& master(int line);
   const dp::Master& master(int line) const;
+  /// Global_Control telegrams line l's master has sent.
+  std::uint64_t global_controls(int line) const;
   redundancy::MasterSystem& system() { return *m_system; }
   const redundancy::MasterSystem& system() const { return *m_system; }
 

@@ -32,8 +32,15 @@
 //   Line::attach() leaves the transceiver to the caller.
 // - Power: the backplane (RedundantSlave) powers on with the first interface device the line
 //   powers; powering one attachment off silences that interface's FDL station only (the
-//   backplane has its own supply). Station power loss = both attachments off: not modelled as
-//   such yet (the RedundantSlave keeps its state).
+//   backplane has its own supply). Station power loss is power_off_station(): the
+//   RedundantSlave's power_off (both interfaces silent, backplane outputs 0, link messages lost),
+//   both FDL stations off (FDL Status silent too, FCBs forgotten) and, for devices attached with
+//   attach(), both transceivers off as fail_interface() does. power_on_station() undoes it: a
+//   cold start of the station (S_PRIMARY/S_WAITING alternation, engines in Wait_Prm); the
+//   masters re-parameterise it and the next Primary_Request chooses the PRIMARY. A failed
+//   interface stays failed (and its transceiver off) across the power cycle.
+// - Alarms: raise_alarm() goes to RedundantSlave::raise_alarm (on the PRIMARY only, kept until
+//   acknowledged through the PRIMARY, raised again on a new PRIMARY; see redundant_slave.hpp).
 // - T_SLAVE_UM: the GSD's Slave_Max_Switch_Over_Time (unit 10 ms, assumption in gsd.hpp).
 // - Flying Redundancy (options.redundancy.mode = Flying; §G.1): both interface devices go on ONE
 //   line; interface 0 starts at `address` (A), interface 1 at A + 64. Refused unless the GSD's
@@ -123,6 +130,16 @@ class SwitchedStationModel {
   // --- Faults (bus thread, at the current virtual time of the lines)
   void fail_interface(int i);
   void repair_interface(int i);
+  /// Station power loss and return (both interfaces, the backplane, the internal link).
+  void power_off_station();
+  void power_on_station();
+  bool station_powered() const { return m_rs->powered(); }
+
+  // --- DP-V1 alarms over the active channel (bus thread; as dp::SlaveApplication::raise_alarm)
+  dp::AlarmResult raise_alarm(std::uint8_t type, std::uint8_t slot, dp::AlarmSpec spec,
+                              bool add_ack, std::span<const std::uint8_t> data = {},
+                              std::uint8_t* seq_nr = nullptr);
+  std::size_t alarms_outstanding() const { return m_rs->alarms_outstanding(); }
 
  private:
   class Iface;

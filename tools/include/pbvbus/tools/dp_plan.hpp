@@ -35,10 +35,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/io_behaviour.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_config.hpp"
@@ -85,6 +87,34 @@ struct DpSlavePlan {
   std::size_t outputs = 0;
   scenario::DpSlave::Inputs io = scenario::DpSlave::COUNTER;
   std::vector<DpIoPlan> io_behaviours;  ///< the `io` entries, in file order
+  /// One interface of a switched_station (source = its index there, not a dp_slave's): the
+  /// index into ScenarioPlan::switched and the side (0 = line A, 1 = line B); -1 otherwise.
+  int switched = -1;
+  int side = -1;
+  const char* repeated = "dp_slave";  ///< the Scenario field `source` indexes
+};
+
+/// A switched_station: planned as one DpSlavePlan per line (`slave`), built as one
+/// devices::SwitchedStationModel.
+struct SwitchedPlan {
+  int source = 0;  ///< index into Scenario.switched_station
+  int system = -1; ///< index into ScenarioPlan::redundant_systems
+  std::uint8_t address = 0;
+  int slave[2] = {-1, -1};  ///< indices into ScenarioPlan::dp_slaves (line A, line B)
+  /// T_SLAVE_UM: the scenario's switchover_time, else the GSD's Slave_Max_Switch_Over_Time.
+  std::optional<bus::Ticks> t_slave_um;
+  bool t_slave_um_from_gsd = false;
+};
+
+/// A redundant_master_system: two dp_masters (one per line) as one logical master system.
+struct RedundancyPlan {
+  int source = 0;  ///< index into Scenario.redundant_master_system
+  std::string name;
+  int line[2] = {-1, -1};    ///< indices into ScenarioPlan::lines
+  int master[2] = {-1, -1};  ///< indices into ScenarioPlan::dp_masters
+  std::uint16_t output_hold_10ms = 100;
+  int preferred = 0;
+  std::vector<int> switched;  ///< indices into ScenarioPlan::switched, file order
 };
 
 struct DpMasterPlan {

@@ -21,6 +21,7 @@
 // pbvbus master is configured for it — the only view there is with a master outside pbvbus.
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <span>
 #include <memory>
@@ -64,6 +65,15 @@ class DpMasterNode final : public fdl::InitiatorUser {
   std::uint64_t m_global_controls = 0;
   std::vector<std::uint8_t> m_buf;
 };
+
+/// The I/O behaviours of a planned slave (its `inputs` default per input module, then its `io`
+/// entries) through a model's set_behaviour/add_channel_behaviour; throws std::runtime_error
+/// if the model refuses one (the loader checks the same). Shared by SlaveModel and
+/// SwitchedStationModel.
+void apply_io_plan(const DpSlavePlan& plan, const dp::SlaveApplication& app,
+                   const std::function<std::string(std::size_t, devices::IoBehaviour)>& set,
+                   const std::function<std::string(std::size_t, std::size_t, std::size_t,
+                                                   devices::IoBehaviour)>& add);
 
 /// A DP slave: devices::SlaveModel (PassiveStation + SlaveEngine + I/O behaviours).
 class DpSlaveNode {
@@ -138,6 +148,12 @@ struct DpMasterReport {
 std::vector<std::string> diag_bit_names(std::span<const std::uint8_t> diag);
 
 DpMasterReport dp_master_report(const DpMasterNode& m, const std::vector<const DpSlaveNode*>& slaves,
+                                const std::vector<const DpSlavePlan*>& plans,
+                                const std::string& line, bus::Baud baud);
+/// The same for any dp::Master (one side of a redundant system): `engines[i]` is the slave
+/// engine that answers plans[i] on this line (a switched station's interface).
+DpMasterReport dp_master_report(const dp::Master& m, std::uint64_t global_controls,
+                                const std::vector<const dp::SlaveEngine*>& engines,
                                 const std::vector<const DpSlavePlan*>& plans,
                                 const std::string& line, bus::Baud baud);
 

@@ -86,7 +86,24 @@
 //       "refused": int,             // of those, answered RS
 //       "prm_faults","cfg_faults","data_exch_entries","watchdog_expiries": int,
 //       "fdl": { "requests","replies","repeats","fdl_status","dropped_errors",
-//                "dropped_tsyn": int } } ] }
+//                "dropped_tsyn": int } } ],
+//     "redundancy": [ {             // every redundant_master_system (docs/redundancy.md)
+//       "name": str, "lines": [str, str], "masters": [int, int],
+//       "t_tr_ns": [int, int], "recognition_ns": [int, int],   // the planner's (line A, B)
+//       "system_bound_ns": [int, int],                        // a whole line lost (short)
+//       "stations": [ { "address": int, "model": str, "modules": [str],
+//                       "active": str|null,                   // the active channel's line
+//                       "roles": [str, str],                  // interface A, B: "PRIMARY" ...
+//                       "redundancy_lost","failed","outputs_held": bool,
+//                       "outputs": "hex octets",              // the backplane
+//                       "t_slave_um_ns": int|null, "bound_ns": [int, int] } ],
+//       "events": [ { "time_ns": int, "ob": int, "code": "W#16#73A3"|null, "kind": str,
+//                     "line": str, "station": int|null, "cause": str, "from": str|null } ],
+//       "switchovers": [ { "station": int, "from": str|null, "to": str, "cause": str,
+//                          "system_level": bool, "fault": str, "fault_ns": int,
+//                          "commanded_ns": int, "fresh_ns": int|null,
+//                          "measured_ns": int|null, "bound_ns": int, "exceeded": bool } ],
+//       "exceeded": int } ] }
 //
 // A DP slave's "requests" count each request that reached its DP layer once, from any master
 // (FCB repeats are answered by its FDL layer and counted under "fdl"."repeats"), so they match
@@ -115,6 +132,7 @@
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/dp_system.hpp"
 #include "pbvbus/tools/line_stats.hpp"
+#include "pbvbus/tools/redundancy_system.hpp"
 
 namespace pbvbus::tools {
 
@@ -197,6 +215,7 @@ struct Report {
   std::vector<LineReport> lines;
   std::vector<DpMasterReport> dp_masters;
   std::vector<DpSlaveView> dp_slaves;
+  std::vector<RedundancyReport> redundancy;  ///< redundant master systems (issue 7)
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

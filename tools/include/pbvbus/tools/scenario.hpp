@@ -45,7 +45,15 @@ struct Diagnostic {
   std::string str() const;
 };
 
-enum class StationKind : std::uint8_t { Master, Passive, SerialMonitor, SerialStation, DpMaster, DpSlave };
+enum class StationKind : std::uint8_t {
+  Master,
+  Passive,
+  SerialMonitor,
+  SerialStation,
+  DpMaster,
+  DpSlave,
+  SwitchedInterface,  ///< one interface of a switched_station (source = its index)
+};
 std::string_view to_string(StationKind k);
 
 /// A station in cable order.
@@ -85,7 +93,12 @@ struct PlanFault {
     SlaveMute,
     ChannelDiag,
     ModulePull,
-    ProcessAlarm
+    ProcessAlarm,
+    // Switched I/O: applied through the redundant system's models.
+    InterfaceFailure,  ///< `switched`, `side`
+    StationPowerLoss,  ///< `switched`
+    MasterFailure,     ///< `dp_master` (and `side`/`system` if it is part of a system)
+    MasterStop,
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -104,6 +117,10 @@ struct PlanFault {
   /// the identifier has inputs, else output), as a configuration tool would show them.
   bool word_channel = false;
   bool output_channel = false;
+  int switched = -1;   ///< index into ScenarioPlan::switched
+  int side = -1;       ///< 0 = line A, 1 = line B of the redundant system
+  int dp_master = -1;  ///< index into ScenarioPlan::dp_masters
+  int system = -1;     ///< index into ScenarioPlan::redundant_systems, or -1
 };
 
 struct ScenarioPlan {
@@ -116,6 +133,8 @@ struct ScenarioPlan {
   std::vector<PlanFault> faults;  ///< ordered by time of occurrence
   std::vector<DpMasterPlan> dp_masters;  ///< in file order (dp_plan.hpp)
   std::vector<DpSlavePlan> dp_slaves;    ///< in file order, valid ones only
+  std::vector<RedundancyPlan> redundant_systems;  ///< in file order
+  std::vector<SwitchedPlan> switched;             ///< in file order, valid ones only
 };
 
 struct LoadResult {

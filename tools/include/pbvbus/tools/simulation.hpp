@@ -30,6 +30,7 @@
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/tools/capture_probes.hpp"
+#include "pbvbus/tools/redundancy_system.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
@@ -78,6 +79,10 @@ class Simulation {
   const DpMasterNode* dp_master(std::size_t li, std::uint8_t addr) const;
   DpMasterNode* dp_master(std::size_t li, std::uint8_t addr);
   const DpSlaveNode* dp_slave(std::size_t li, std::uint8_t addr) const;
+  /// The redundant_master_system nodes, in file order.
+  std::size_t redundant_system_count() const { return m_redundant.size(); }
+  RedundantSystemNode& redundant_system(std::size_t i) { return *m_redundant.at(i); }
+  const RedundantSystemNode& redundant_system(std::size_t i) const { return *m_redundant.at(i); }
 
   /// Whether something outside the process is attached (a pty): then the run must be paced.
   bool has_external_attachments() const { return !m_serial.empty(); }
@@ -117,6 +122,9 @@ class Simulation {
   // Declared after the scheduler and before the lines: destroyed after every door, before the
   // scheduler it drives.
   std::unique_ptr<bus::PacedRunner> m_runner;
+  // Redundant master systems own devices on several lines: built before the lines, destroyed
+  // after them.
+  std::vector<std::unique_ptr<RedundantSystemNode>> m_redundant;
   std::vector<std::unique_ptr<LineState>> m_lines;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;

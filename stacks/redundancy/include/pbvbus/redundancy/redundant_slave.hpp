@@ -26,7 +26,14 @@
 // - Commanded switchover: Primary_Request to the BACKUP → BP_SWITCHOVER, switchover request to
 //   the primary; on arrival the primary becomes BACKUP (outputs held) and sends take-over; on
 //   its arrival the requester becomes PRIMARY and sets Prm_Cmd_Ack. 2 × link_delay. Primary_
-//   Request to the primary: acknowledged, no change. With the partner lost: PRIMARY at once.
+//   Request to the primary: acknowledged, no change. With the partner lost (counted by the
+//   supervision or a switchover timeout): PRIMARY at once. A partner that has failed but is not
+//   yet counted lost is taken for what it was before the failure (it failed silently).
+//   Switchover request timeout: a partner that has failed silently (not yet counted lost by the
+//   supervision) never answers; the requester waits `switch_timeout` (10 ms) after the
+//   Primary_Request, then counts the partner lost (PartnerLost) and becomes PRIMARY (Prm_Cmd_Ack
+//   as at a take-over). switch_timeout must exceed 2 × link_delay (else a live partner would be
+//   overtaken: two primaries); the constructor throws std::invalid_argument otherwise.
 // - Autonomous switchover (System Redundancy lets the slave switch on error, §G.1): when the
 //   PRIMARY interface's engine leaves Data_Exch (watchdog expiry, new Set_Prm, ...) while the
 //   partner's is in Data_Exch, it becomes BACKUP and sends take-over (1 × link_delay); when the
@@ -38,6 +45,34 @@
 //   first Data_Exchange, and at most Output_Hold_Time (from the last PrmCmd, else
 //   `output_hold` = 1 s); then they go to the safe state (0) and stay there until fresh outputs
 //   arrive (event OutputHoldExpired). The backup's outputs never reach the backplane.
+//   Event FreshOutputs (iface = whose outputs) at the instant the backplane takes the first
+//   accepted Data_Exchange outputs after start-up or after the primary role was lost or its
+//   engine left Data_Exch (= the end of the hold, whether or not the hold had expired to 0):
+//   "from the fault to the first fresh output on the new active channel" ends there.
+// - Station power: power_off(now) is a dead station: both interfaces answer nothing (the owner
+//   silences the FDL stations), the backplane drives nothing (outputs 0, no hold, no event),
+//   link messages in flight are lost, roles Off, queued alarms are forgotten (volatile memory).
+//   power_on(now) is a cold start as at the first power-on: both engines restart (Wait_Prm),
+//   Prm_Cmd_Ack cleared, interface 0 S_PRIMARY, interface 1 S_WAITING, Tsprimary from 2 s. An
+//   interface failed with fail_interface() stays FAILED across a power cycle (a defective IM is
+//   not cured by switching off); repair_interface() is the way back.
+// - DP-V1 alarms (S6, S8: interrupts only over the active channel, none lost): raise_alarm()
+//   keeps the alarm in the station until the master acknowledges it through the interface that
+//   is PRIMARY. It is raised on the PRIMARY interface's engine only (the backup's diagnosis never
+//   carries it); with no PRIMARY (start-up, both failed, switchover in progress) or a PRIMARY
+//   that cannot take it yet (not in Data_Exch with DP-V1, Alarm_Mode limit, type not enabled)
+//   it waits in the station and is raised when one can. When the PRIMARY role moves before the
+//   acknowledgement, the alarm is withdrawn from the old interface's engine and raised again on
+//   the new PRIMARY (same type, slot, specifier bits, Add_Ack and data). The new engine assigns
+//   its own Seq_Nr: acceptable, because a Seq_Nr only pairs an alarm with its Alarm_Ack within
+//   ONE master-slave relation (§E.5), and the new PRIMARY's master has never seen the old
+//   interface's number. The same happens when the PRIMARY's engine drops its alarms by leaving
+//   Data_Exch (watchdog, re-parameterisation): raised again when it is back.
+//   Withdrawal without a dp change: SlaveApplication has no call to remove an alarm, so the
+//   station plays an internal Alarm_Ack (`5C slot type specifier` to SAP 50, from the engine's
+//   owner) into the old engine; side effect: that engine's watchdog restarts at that instant
+//   (as at any request from its owner) and its request counters count it. A
+//   SlaveApplication::withdraw_alarm() would remove both.
 // - Inputs and diagnosis: write_inputs() writes both interfaces' images; device diagnosis is
 //   set on both through each engine's application().
 // - Status blocks: Red_Status (0x9F) is kept current in both interfaces' diagnosis (Red_State_1
@@ -76,6 +111,7 @@ enum class Role : std::uint8_t {
   Backup,
   BpSwitchover,  ///< backup asked the primary to hand over (Primary_Request), waiting
   Failed,        ///< injected interface failure: silent on the bus and on the link
+  Off,           ///< the station has no power (power_off)
 };
 std::string_view to_string(Role r);
 
@@ -96,11 +132,20 @@ struct RedundantSlaveParams {
   bus::Ticks tsprimary_start = 2000 * bus::kTicksPerMs;
   bus::Ticks tsprimary_max = 32000 * bus::kTicksPerMs;
   bus::Ticks output_hold = 1000 * bus::kTicksPerMs;  ///< until a PrmCmd sets Output_Hold_Time
+  /// BP_SWITCHOVER without the partner's take-over for this long → PRIMARY (> 2 × link_delay).
+  bus::Ticks switch_timeout = 10 * bus::kTicksPerMs;
   bool autonomous_switchover = true;
 };
 
 struct RedEvent {
-  enum class Kind : std::uint8_t { RoleChanged, PartnerLost, PartnerBack, OutputHoldExpired, AddressSwap };
+  enum class Kind : std::uint8_t {
+    RoleChanged,
+    PartnerLost,
+    PartnerBack,
+    OutputHoldExpired,
+    AddressSwap,
+    FreshOutputs,  ///< first accepted outputs after start-up or a primary change (end of hold)
+  };
   Kind kind = Kind::RoleChanged;
   bus::Ticks at = 0;
   int iface = 0;  ///< the interface concerned (for PartnerLost/Back: the one that noticed)
@@ -142,11 +187,27 @@ class RedundantSlave {
 
   void on_event(std::function<void(const RedEvent&)> cb) { m_cb = std::move(cb); }
 
+  // DP-V1 alarms over the active channel (bus thread). Arguments as
+  // dp::SlaveApplication::raise_alarm; BadArgument for a type or length the engine would refuse,
+  // LimitExpired with kMaxStationAlarms unacknowledged, else Ok: kept until acknowledged
+  // through the PRIMARY. *seq_nr is set when the alarm went into the PRIMARY's diagnosis at once.
+  static constexpr std::size_t kMaxStationAlarms = 32;
+  dp::AlarmResult raise_alarm(std::uint8_t type, std::uint8_t slot, dp::AlarmSpec spec,
+                              bool add_ack, std::span<const std::uint8_t> data, bus::Ticks now,
+                              std::uint8_t* seq_nr = nullptr);
+  /// Alarms raised and not yet acknowledged through the PRIMARY.
+  std::size_t alarms_outstanding() const { return m_alarms.size(); }
+  /// Alarms acknowledged through the PRIMARY since construction.
+  std::uint64_t alarms_acknowledged() const { return m_alarms_acked; }
+
   // Fault injection.
   void fail_interface(int i, bus::Ticks now);
   void repair_interface(int i, bus::Ticks now);
 
   void power_on(bus::Ticks now);
+  /// Station power loss (both interfaces and the backplane); power_on() brings it back.
+  void power_off(bus::Ticks now);
+  bool powered() const { return m_powered; }
   bus::Ticks next_deadline() const;
   void on_time(bus::Ticks now);
 
@@ -173,6 +234,20 @@ class RedundantSlave {
     std::uint8_t cmd_spec = 0;      ///< specifier octet of the last PrmCmd
     std::uint8_t cmd_function = 0;  ///< Function of the last PrmCmd
     std::int32_t status_cache = -1;
+    bus::Ticks switch_deadline = bus::kNever;  ///< BP_SWITCHOVER: give up waiting for take-over
+    Role failed_from = Role::SWaiting;  ///< the role before fail_interface(): what the partner
+                                        ///< believes until it counts this interface lost
+  };
+  /// An alarm the station keeps until the PRIMARY's master acknowledges it.
+  struct StationAlarm {
+    std::uint8_t type = 0;
+    std::uint8_t slot = 0;
+    dp::AlarmSpec spec = dp::AlarmSpec::None;
+    bool add_ack = false;
+    std::vector<std::uint8_t> data;
+    int iface = -1;           ///< the engine whose diagnosis carries it, -1 = waiting
+    std::uint8_t seq = 0;     ///< the Seq_Nr that engine assigned
+    std::uint64_t dx_entry = 0;  ///< that engine's data_exch_entries when raised there
   };
 
   dp::PrmCmdResult handle_prm_cmd(int i, const dp::PrmCmdView& v);
@@ -183,12 +258,16 @@ class RedundantSlave {
   void set_role(int i, Role r, bus::Ticks now);
   void check_primary_lost_master(bus::Ticks now);
   void lose_primary(bus::Ticks now);  ///< backplane: start the hold
-  void take_outputs(int i);
+  void take_outputs(int i, bus::Ticks now);  ///< FreshOutputs when it ends a hold/start-up
   void refresh_status();
   void set_ack(int i);
+  /// Alarms: withdraw from non-PRIMARY engines, notice the ones an engine dropped, raise the
+  /// waiting ones on the PRIMARY. After every request and every on_time() step.
+  void sync_alarms(bus::Ticks now);
+  void alarm_acked(int i, std::uint8_t type, std::uint8_t slot, std::uint8_t seq);
   void emit(RedEvent::Kind k, bus::Ticks at, int iface, Role from = Role::SWaiting,
             Role to = Role::SWaiting);
-  bool alive(int i) const { return m_if[i].role != Role::Failed; }
+  bool alive(int i) const { return m_if[i].role != Role::Failed && m_if[i].role != Role::Off; }
   bool partner_in_dx(int i) const;
 
   RedundantSlaveParams m_p;
@@ -202,6 +281,10 @@ class RedundantSlave {
   bus::Ticks m_tsprimary = 0;
   bus::Ticks m_alternate_at = bus::kNever;
   bool m_powered = false;
+  bool m_fresh_pending = false;  ///< the next outputs taken end a hold / the start-up
+  std::vector<StationAlarm> m_alarms;
+  std::uint64_t m_alarms_acked = 0;
+  bool m_withdrawing = false;  ///< an internal Alarm_Ack is running: not the master's
   bool m_swapped = false;  ///< Flying: interface 1 at A, interface 0 at A + 64
   std::function<void(const RedEvent&)> m_cb;
 };

@@ -10,6 +10,8 @@
 //     virt_s (virtual seconds simulated), virt_s_per_wall_s, max fault/repair latency (ms).
 //   One iteration (the campaign is one long run); mismatches are printed to stderr.
 //
+// PBVBUS_CAMPAIGN_SEED and PBVBUS_CAMPAIGN_FAULTS override the seed and the number of
+// injections (sweeps, reproductions).
 // The GSD files are found through PBVBUS_GSD_DIR, else examples/gsd under the current
 // directory, else <executable>/../../examples/gsd (build/bin/pbvbus_bench in the source tree).
 // Figures and the command are in docs/benchmarks.md.
@@ -42,6 +44,10 @@ void BM_SwitchoverCampaign(benchmark::State& state) {
   devices::CampaignOptions o;
   o.seed = static_cast<std::uint64_t>(state.range(0));
   o.faults = static_cast<int>(state.range(1));
+  // Reproductions and sweeps without rebuilding: PBVBUS_CAMPAIGN_SEED / _FAULTS override.
+  if (const char* e = std::getenv("PBVBUS_CAMPAIGN_SEED")) o.seed = std::stoull(e);
+  if (const char* e = std::getenv("PBVBUS_CAMPAIGN_FAULTS")) o.faults = std::stoi(e);
+  state.SetLabel("seed " + std::to_string(o.seed));
   o.gsd_dir = gsd_dir();
   devices::CampaignResult r;
   for (auto _ : state) {

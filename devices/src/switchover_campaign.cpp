@@ -216,6 +216,19 @@ class Campaign {
   Sampler m_sampler;
   std::vector<Step> m_steps;
   CampaignResult m_r;
+
+  // Alarms (S8): payload = a 4-octet id; each must reach exactly one master, the active line's.
+  struct AlarmRec {
+    std::uint8_t station = 0;
+    bus::Ticks raised = 0;
+    int deliveries = 0;
+    std::string lines;
+  };
+  std::vector<AlarmRec> m_alarms;
+  std::uint32_t m_alarm_id = 0;
+  void maybe_raise_alarm(double p);
+  void on_master_event(int line, const dp::MasterEvent& e);
+  void count_alarms();
 };
 
 void Sampler::on_frame(const bus::TapFrame& f) { camp.sample(f); }
@@ -282,6 +295,11 @@ void Campaign::build() {
     for (const auto& s : m_sw) m.system().write_outputs(s.address, 1, b);
     for (const auto& o : m_one) m.system().write_outputs(o.address, 0, b);
   });
+  if (m_o.alarms) {
+    m_r.alarms_supported = true;
+    m_sys->set_master_event_handler(
+        [this](int l, const dp::MasterEvent& e) { on_master_event(l, e); });
+  }
   // Cable order on each line: master, switched stations, one-sided slaves.
   for (int l = 0; l < 2; ++l) m_sys->attach(l, *m_bus[l], "master");
   for (auto& s : m_sw)
@@ -462,7 +480,11 @@ void Campaign::after_fault(bus::Ticks t0) {
 
 void Campaign::after_repair(bus::Ticks t0, bus::Ticks settle) {
   const bus::Ticks sat = settle_step();
-  run_to(std::max(t0 + settle, sat) + draw(m_o.gap_min, m_o.gap_max));
+  const bus::Ticks end = std::max(t0 + settle, sat) + draw(m_o.gap_min, m_o.gap_max);
+  // An alarm at a random time of the gap (the repaired channel may still be starting up).
+  run_to(draw(sat, end));
+  maybe_raise_alarm(0.3);
+  run_to(end);
 }
 
 void Campaign::cycle(CampaignFault f) {
@@ -616,6 +638,80 @@ void Campaign::hidden_cycle() {
   run_to(t1 + 500 * kMs + draw(m_o.gap_min, m_o.gap_max));
 }
 
+void Campaign::maybe_raise_alarm(double p) {
+  if (!m_o.alarms || std::uniform_real_distribution<double>(0, 1)(m_rng) >= p) return;
+  const int k = draw_int(0, static_cast<int>(m_sw.size()) - 1);
+  const std::uint32_t id = ++m_alarm_id;
+  const Bytes data{static_cast<std::uint8_t>(id >> 24), static_cast<std::uint8_t>(id >> 16),
+                   static_cast<std::uint8_t>(id >> 8), static_cast<std::uint8_t>(id)};
+  // Diagnostic alarm, slot 2 (the output module), appears.
+  const auto res = m_sw[k].model->raise_alarm(1, 2, dp::AlarmSpec::Appears, false, data);
+  if (res != dp::AlarmResult::Ok) {
+    m_r.mismatches.push_back(fmt_time(now()) + ": " + sw_name(k) + " refused alarm " +
+                             std::to_string(id) + " (result " +
+                             std::to_string(static_cast<int>(res)) + ")");
+    return;
+  }
+  if (m_alarms.size() < id) m_alarms.resize(id);
+  m_alarms[id - 1] = {m_sw[k].address, now(), 0, {}};
+  ++m_r.alarms_raised;
+}
+
+void Campaign::on_master_event(int line, const dp::MasterEvent& e) {
+  if (e.kind != dp::MasterEvent::Kind::Alarm) return;
+  // Compared by (station, slot, type, payload): the Seq_Nr may change on a repeat.
+  if (e.alarm_type != 1 || e.alarm_slot != 2 || e.alarm_data.size() != 4) {
+    m_r.mismatches.push_back(fmt_time(e.time) + ": an alarm nobody raised from station " +
+                             std::to_string(e.slave));
+    return;
+  }
+  const std::uint32_t id = (std::uint32_t{e.alarm_data[0]} << 24) |
+                           (std::uint32_t{e.alarm_data[1]} << 16) |
+                           (std::uint32_t{e.alarm_data[2]} << 8) | e.alarm_data[3];
+  if (id == 0 || id > m_alarms.size() || m_alarms[id - 1].station != e.slave) {
+    m_r.mismatches.push_back(fmt_time(e.time) + ": alarm " + std::to_string(id) +
+                             " from station " + std::to_string(e.slave) + " was never raised");
+    return;
+  }
+  AlarmRec& a = m_alarms[id - 1];
+  ++a.deliveries;
+  a.lines += (a.lines.empty() ? "" : ",") + std::to_string(line) + "@" + fmt_time(e.time);
+  // Only the active channel carries alarms (S6): the line the observer expects active.
+  for (std::size_t k = 0; k < m_sw.size(); ++k)
+    if (m_sw[k].address == e.slave && m_sw[k].act >= 0 && m_sw[k].act != line)
+      m_r.mismatches.push_back(fmt_time(e.time) + ": alarm " + std::to_string(id) + " of " +
+                               sw_name(static_cast<int>(k)) + " delivered on line " +
+                               std::to_string(line) + ", expected active line " +
+                               std::to_string(m_sw[k].act));
+}
+
+void Campaign::count_alarms() {
+  for (std::size_t i = 0; i < m_alarms.size(); ++i) {
+    const AlarmRec& a = m_alarms[i];
+    if (a.station == 0) continue;  // refused
+    if (a.deliveries == 1) {
+      ++m_r.alarms_delivered;
+      continue;
+    }
+    if (a.deliveries == 0) ++m_r.alarms_lost;
+    else ++m_r.alarms_duplicated;
+    // The steps around it: the one it was raised in and the next one.
+    std::string ctx;
+    for (std::size_t si = 0; si < m_steps.size(); ++si)
+      if (m_steps[si].at <= a.raised &&
+          (si + 1 == m_steps.size() || m_steps[si + 1].at > a.raised)) {
+        ctx = "; raised after '" + m_steps[si].what + "' (" + fmt_time(m_steps[si].at) + ")";
+        if (si + 1 < m_steps.size())
+          ctx += ", before '" + m_steps[si + 1].what + "' (" + fmt_time(m_steps[si + 1].at) + ")";
+      }
+    m_r.mismatches.push_back(fmt_time(a.raised) + ": alarm " + std::to_string(i + 1) +
+                             " of station " + std::to_string(a.station) + " delivered " +
+                             std::to_string(a.deliveries) + " times" +
+                             (a.lines.empty() ? std::string() : " (line@time: " + a.lines + ")") +
+                             ctx);
+  }
+}
+
 void Campaign::match_all(CampaignResult& r) {
   std::vector<SystemEvent> ev;
   for (const auto& e : m_sys->system().events())
@@ -689,6 +785,9 @@ CampaignResult Campaign::run() {
     wait_recovered();
     check_active();
     const auto f = static_cast<CampaignFault>(pick(m_rng));
+    // An alarm just before the fault (0..3 ms), on a random station.
+    maybe_raise_alarm(0.5);
+    run_to(now() + draw(0, 3 * kMs));
     if (index == m_o.tamper.hidden_fault_at) {
       hidden_cycle();
       m_r.faults -= 1;  // not counted as campaign injections
@@ -701,8 +800,9 @@ CampaignResult Campaign::run() {
   }
   wait_recovered();
   check_active();
-  run_to(now() + 200 * kMs);
+  run_to(now() + 500 * kMs);
   match_all(m_r);
+  count_alarms();
   m_r.switchovers = m_sys->system().switchovers();
   const std::uint16_t codes[6] = {0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3, 0x38C3};
   for (int c = 0; c < 6; ++c) m_r.events[c] = {codes[c], 0};

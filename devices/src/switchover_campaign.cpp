@@ -198,7 +198,7 @@ class Campaign {
   void hidden_cycle();
   void fail_iface(int k, int l, bool tell = true);
   void repair_iface(int k, int l, bool tell = true);
-  void after_fault(bus::Ticks t0);
+  void after_fault(bus::Ticks t0, bus::Ticks max_dwell = 0);
   void after_repair(bus::Ticks t0, bus::Ticks settle);
   std::string sw_name(int k) const { return "station " + std::to_string(m_sw[k].address); }
 
@@ -473,9 +473,10 @@ void Campaign::repair_iface(int k, int l, bool tell) {
   m_sw[k].model->repair_interface(l);
 }
 
-void Campaign::after_fault(bus::Ticks t0) {
+void Campaign::after_fault(bus::Ticks t0, bus::Ticks max_dwell) {
   const bus::Ticks sat = settle_step();
-  run_to(std::max(t0 + draw(m_o.fault_min, m_o.fault_max), sat + 20 * kMs));
+  const bus::Ticks hi = max_dwell > m_o.fault_min ? max_dwell : m_o.fault_max;
+  run_to(std::max(t0 + draw(m_o.fault_min, hi), sat + 20 * kMs));
 }
 
 void Campaign::after_repair(bus::Ticks t0, bus::Ticks settle) {
@@ -534,7 +535,7 @@ void Campaign::cycle(CampaignFault f) {
         m_steps.back().at = t0;
         m_steps.back().ev_index = ev0;
         ++m_r.faults;  // two injections
-        after_fault(t0);
+        after_fault(t0, m_o.both_down_max);
       } else {
         begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(first), false,
                    derive(before, false));
@@ -544,7 +545,7 @@ void Campaign::cycle(CampaignFault f) {
         begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(1 - first) +
                        " too",
                    false, derive(before, false));
-        after_fault(now());
+        after_fault(now(), m_o.both_down_max);
       }
       // Repairs one by one, in random order.
       const int r1 = draw_int(0, 1);

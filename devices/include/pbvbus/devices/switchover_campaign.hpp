@@ -97,6 +97,9 @@ struct CampaignOptions {
   std::array<int, kCampaignFaultKinds> weights{3, 3, 2, 2, 2, 2, 2, 2};
   bus::Ticks fault_min = 100 * bus::kTicksPerMs, fault_max = 600 * bus::kTicksPerMs;
   bus::Ticks gap_min = 200 * bus::kTicksPerMs, gap_max = 800 * bus::kTicksPerMs;
+  /// How long a station may stay without any channel (F11, F24): up to beyond the
+  /// Output_Hold_Time (1 s), so the safe state (outputs 0) is reached now and then.
+  bus::Ticks both_down_max = 1500 * bus::kTicksPerMs;
   bus::Ticks f24_min = 50 * bus::kTicksPerUs, f24_max = 500 * bus::kTicksPerUs;
   bus::Ticks recognition = 50 * bus::kTicksPerMs;  ///< window for a fault's events
   bus::Ticks startup = 2000 * bus::kTicksPerMs;    ///< window for a repair's events

@@ -7,7 +7,8 @@
 //
 //   BM_SwitchoverCampaign/<seed>/<faults>   counters: faults, repairs, pulses, mismatches,
 //     events, expected_events, samples, switchovers, alarms raised/delivered/lost/duplicated,
-//     virt_s (virtual seconds simulated), virt_s_per_wall_s, virt_s_per_cpu_s (std::clock), max fault/repair latency (ms).
+//     virt_s (virtual seconds simulated), virt_s_per_wall_s, virt_s_per_cpu_s (std::clock), max
+//     fault/repair latency (ms).
 //   One iteration (the campaign is one long run); mismatches are printed to stderr.
 //
 // PBVBUS_CAMPAIGN_SEED and PBVBUS_CAMPAIGN_FAULTS override the seed and the number of
@@ -79,8 +80,7 @@ void BM_SwitchoverCampaign(benchmark::State& state) {
   state.counters["virt_s"] = virt;
   state.counters["virt_s_per_wall_s"] = r.wall_seconds > 0 ? virt / r.wall_seconds : 0;
   state.counters["virt_s_per_cpu_s"] = cpu_s > 0 ? virt / cpu_s : 0;
-  state.counters["max_fault_lat_ms"] =
-      static_cast<double>(r.max_fault_latency) / bus::kTicksPerMs;
+  state.counters["max_fault_lat_ms"] = static_cast<double>(r.max_fault_latency) / bus::kTicksPerMs;
   state.counters["max_repair_lat_ms"] =
       static_cast<double>(r.max_repair_latency) / bus::kTicksPerMs;
 }

@@ -21,14 +21,22 @@ namespace pbvbus::devices {
 
 std::string_view to_string(CampaignFault f) {
   switch (f) {
-    case CampaignFault::ActiveInterface: return "active interface (F10)";
-    case CampaignFault::PassiveInterface: return "passive interface (F10)";
-    case CampaignFault::SecondInterface: return "second interface (F11)";
-    case CampaignFault::CableCut: return "cable cut (F13)";
-    case CampaignFault::ShortCircuit: return "short circuit (F14)";
-    case CampaignFault::MasterStop: return "master stop (F14)";
-    case CampaignFault::MasterFailure: return "master failure (F9)";
-    case CampaignFault::SwitchoverLoss: return "loss during switchover (F24)";
+    case CampaignFault::ActiveInterface:
+      return "active interface (F10)";
+    case CampaignFault::PassiveInterface:
+      return "passive interface (F10)";
+    case CampaignFault::SecondInterface:
+      return "second interface (F11)";
+    case CampaignFault::CableCut:
+      return "cable cut (F13)";
+    case CampaignFault::ShortCircuit:
+      return "short circuit (F14)";
+    case CampaignFault::MasterStop:
+      return "master stop (F14)";
+    case CampaignFault::MasterFailure:
+      return "master failure (F9)";
+    case CampaignFault::SwitchoverLoss:
+      return "loss during switchover (F24)";
   }
   return "?";
 }
@@ -54,9 +62,10 @@ std::string CampaignResult::summary() const {
     << " safe-state " << safe_state_samples << "; alarms raised " << alarms_raised << " delivered "
     << alarms_delivered << " lost " << alarms_lost << " duplicated " << alarms_duplicated
     << "; mismatches " << mismatches.size() << "; max latency fault "
-    << max_fault_latency / bus::kTicksPerUs << " us, repair " << max_repair_latency / bus::kTicksPerUs
-    << " us; simulated " << static_cast<double>(simulated) / bus::kTicksPerMs / 1000.0 << " s in "
-    << wall_seconds << " s wall; frames " << frames;
+    << max_fault_latency / bus::kTicksPerUs << " us, repair "
+    << max_repair_latency / bus::kTicksPerUs << " us; simulated "
+    << static_cast<double>(simulated) / bus::kTicksPerMs / 1000.0 << " s in " << wall_seconds
+    << " s wall; frames " << frames;
   return o.str();
 }
 
@@ -104,7 +113,9 @@ GsdFile load(const std::string& dir, const char* name) {
 std::vector<ModuleChoice> switched_modules() {
   return {ModuleChoice::named("16DI DC24V"), ModuleChoice::named("16DO DC24V/0.5A")};
 }
-std::vector<ModuleChoice> plain_modules() { return {ModuleChoice::named("16DI/16DO DC24V")}; }
+std::vector<ModuleChoice> plain_modules() {
+  return {ModuleChoice::named("16DI/16DO DC24V")};
+}
 
 class Campaign;
 
@@ -231,7 +242,9 @@ class Campaign {
   void count_alarms();
 };
 
-void Sampler::on_frame(const bus::TapFrame& f) { camp.sample(f); }
+void Sampler::on_frame(const bus::TapFrame& f) {
+  camp.sample(f);
+}
 
 void Campaign::build() {
   const GsdFile fast = load(m_o.gsd_dir, "PBVB0A10.gsd");
@@ -331,8 +344,10 @@ void Campaign::sample(const bus::TapFrame& f) {
     if (no_channel) s.exempt = true;
     std::string bad;
     if (v == 0) {
-      if (s.exempt) ++m_r.safe_state_samples;
-      else bad = "outputs 0";
+      if (s.exempt)
+        ++m_r.safe_state_samples;
+      else
+        bad = "outputs 0";
     } else {
       if (static_cast<std::uint16_t>(v - s.last) >= 0x8000) bad = "older value";
       // A new value after a channel is back ends the safe-state allowance (a held old value
@@ -360,16 +375,21 @@ std::vector<Expect> Campaign::derive(const Snapshot& before, bool silent) {
       // The other channel's reachability at the moment of this change: for two changes in one
       // step, the later one sees the earlier one (the caller orders single changes).
       const bool other = now_r[1 - l];
-      if (!now_r[l]) ex.push_back({std::uint16_t(other ? 0x73A3 : 0x39C4), l, m_sw[k].address});
-      else ex.push_back({std::uint16_t(other ? 0x72A3 : 0x38C4), l, m_sw[k].address});
+      if (!now_r[l])
+        ex.push_back({std::uint16_t(other ? 0x73A3 : 0x39C4), l, m_sw[k].address});
+      else
+        ex.push_back({std::uint16_t(other ? 0x72A3 : 0x38C4), l, m_sw[k].address});
     }
     // The expected active line: away from an unreachable one, to the first one back.
     Sw& s = m_sw[k];
     if (s.act >= 0 && !now_r[s.act]) s.act = now_r[1 - s.act] ? 1 - s.act : -1;
     if (s.act < 0) {
-      if (now_r[0] && !now_r[1]) s.act = 0;
-      else if (now_r[1] && !now_r[0]) s.act = 1;
-      else if (now_r[0] && now_r[1]) s.act = m_sw[k].model->primary();  // both at once: either
+      if (now_r[0] && !now_r[1])
+        s.act = 0;
+      else if (now_r[1] && !now_r[0])
+        s.act = 1;
+      else if (now_r[0] && now_r[1])
+        s.act = m_sw[k].model->primary();  // both at once: either
     }
   }
   for (std::size_t j = 0; j < m_one.size(); ++j) {
@@ -391,8 +411,10 @@ void Campaign::begin_step(std::string what, bool repair, std::vector<Expect> ex,
   s.ev_index = m_sys->system().events().size();
   m_r.expected_events += static_cast<int>(s.expect.size());
   m_steps.push_back(std::move(s));
-  if (repair) ++m_r.repairs;
-  else ++m_r.faults;
+  if (repair)
+    ++m_r.repairs;
+  else
+    ++m_r.faults;
 }
 
 bool Campaign::satisfied(const Step& s) const {
@@ -446,7 +468,8 @@ void Campaign::wait_recovered() {
   if (!recovered())
     m_r.mismatches.push_back(fmt_time(now()) + ": after '" + m_steps.back().what +
                              "': the system did not return to data exchange on every channel "
-                             "within " + fmt_time(m_o.recover_limit));
+                             "within " +
+                             fmt_time(m_o.recover_limit));
 }
 
 void Campaign::check_active() {
@@ -455,11 +478,10 @@ void Campaign::check_active() {
     const int prim = s.model->primary();
     const int sys = m_sys->system().active(s.address);
     if (prim != s.act || sys != s.act)
-      m_r.mismatches.push_back(fmt_time(now()) + ": after '" + m_steps.back().what + "': " +
-                               sw_name(static_cast<int>(k)) + " expected active line " +
-                               std::to_string(s.act) + ", station primary " +
-                               std::to_string(prim) + ", MasterSystem active " +
-                               std::to_string(sys));
+      m_r.mismatches.push_back(fmt_time(now()) + ": after '" + m_steps.back().what +
+                               "': " + sw_name(static_cast<int>(k)) + " expected active line " +
+                               std::to_string(s.act) + ", station primary " + std::to_string(prim) +
+                               ", MasterSystem active " + std::to_string(sys));
   }
 }
 
@@ -528,8 +550,8 @@ void Campaign::cycle(CampaignFault f) {
         auto ex2 = derive(mid, false);
         ex.insert(ex.end(), ex2.begin(), ex2.end());
         for (auto& e : ex) e.line = -1;  // which master notices first is not a rule
-        begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(first) +
-                       ", then " + std::to_string(1 - first) + " after " +
+        begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(first) + ", then " +
+                       std::to_string(1 - first) + " after " +
                        std::to_string(d / bus::kTicksPerUs) + " us",
                    false, ex, true);
         m_steps.back().at = t0;
@@ -542,8 +564,7 @@ void Campaign::cycle(CampaignFault f) {
         after_fault(t0);
         before = snapshot();
         fail_iface(k, 1 - first);
-        begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(1 - first) +
-                       " too",
+        begin_step(name + ": " + sw_name(k) + " interface " + std::to_string(1 - first) + " too",
                    false, derive(before, false));
         after_fault(now(), m_o.both_down_max);
       }
@@ -670,8 +691,8 @@ void Campaign::on_master_event(int line, const dp::MasterEvent& e) {
                            (std::uint32_t{e.alarm_data[1]} << 16) |
                            (std::uint32_t{e.alarm_data[2]} << 8) | e.alarm_data[3];
   if (id == 0 || id > m_alarms.size() || m_alarms[id - 1].station != e.slave) {
-    m_r.mismatches.push_back(fmt_time(e.time) + ": alarm " + std::to_string(id) +
-                             " from station " + std::to_string(e.slave) + " was never raised");
+    m_r.mismatches.push_back(fmt_time(e.time) + ": alarm " + std::to_string(id) + " from station " +
+                             std::to_string(e.slave) + " was never raised");
     return;
   }
   AlarmRec& a = m_alarms[id - 1];
@@ -694,8 +715,10 @@ void Campaign::count_alarms() {
       ++m_r.alarms_delivered;
       continue;
     }
-    if (a.deliveries == 0) ++m_r.alarms_lost;
-    else ++m_r.alarms_duplicated;
+    if (a.deliveries == 0)
+      ++m_r.alarms_lost;
+    else
+      ++m_r.alarms_duplicated;
     // The steps around it: the one it was raised in and the next one.
     std::string ctx;
     for (std::size_t si = 0; si < m_steps.size(); ++si)
@@ -705,11 +728,10 @@ void Campaign::count_alarms() {
         if (si + 1 < m_steps.size())
           ctx += ", before '" + m_steps[si + 1].what + "' (" + fmt_time(m_steps[si + 1].at) + ")";
       }
-    m_r.mismatches.push_back(fmt_time(a.raised) + ": alarm " + std::to_string(i + 1) +
-                             " of station " + std::to_string(a.station) + " delivered " +
-                             std::to_string(a.deliveries) + " times" +
-                             (a.lines.empty() ? std::string() : " (line@time: " + a.lines + ")") +
-                             ctx);
+    m_r.mismatches.push_back(
+        fmt_time(a.raised) + ": alarm " + std::to_string(i + 1) + " of station " +
+        std::to_string(a.station) + " delivered " + std::to_string(a.deliveries) + " times" +
+        (a.lines.empty() ? std::string() : " (line@time: " + a.lines + ")") + ctx);
   }
 }
 
@@ -758,8 +780,7 @@ void Campaign::match_all(CampaignResult& r) {
       late.push_back("both events on line " + std::to_string(f24_lines[0]));
     if (missing.empty() && late.empty() && extra.empty()) continue;
     std::string m = fmt_time(s.at) + ": " + s.what + ": expected {";
-    for (std::size_t j = 0; j < s.expect.size(); ++j)
-      m += (j ? ", " : "") + fmt(s.expect[j]);
+    for (std::size_t j = 0; j < s.expect.size(); ++j) m += (j ? ", " : "") + fmt(s.expect[j]);
     m += "}, observed {";
     for (std::size_t j = 0; j < seen.size(); ++j)
       m += (j ? ", " : "") + fmt({seen[j].code(), seen[j].line, seen[j].station}) + " +" +
@@ -812,8 +833,7 @@ CampaignResult Campaign::run() {
       if (e.s7() && e.code() == c) ++n;
   m_r.simulated = now();
   m_r.frames = m_bus[0]->stats().frames + m_bus[1]->stats().frames;
-  m_r.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  m_r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
   return m_r;
 }
 

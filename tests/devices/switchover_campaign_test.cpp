@@ -5,6 +5,8 @@
 // MasterSystem raised. The observer's own tests: a fault it is not told about, a doctored event
 // list and a program that writes 0 once must each be caught. The full campaign (>= 1000) is
 // bench/switchover_campaign_bench.cpp.
+#include "pbvbus/devices/switchover_campaign.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,7 +19,6 @@
 #include "pbvbus/devices/redundant_master_system.hpp"
 #include "pbvbus/devices/slave_model.hpp"
 #include "pbvbus/devices/switched_station.hpp"
-#include "pbvbus/devices/switchover_campaign.hpp"
 
 namespace pbvbus::devices {
 namespace {
@@ -69,8 +70,8 @@ TEST(SwitchoverCampaign, ReducedCampaignHasNoPulseAndNoMismatch) {
   EXPECT_EQ(r.alarms_lost, 0);
   EXPECT_EQ(r.alarms_delivered + r.alarms_duplicated, r.alarms_raised);
   EXPECT_EQ(static_cast<std::size_t>(r.alarms_duplicated),
-            static_cast<std::size_t>(std::count_if(r.mismatches.begin(), r.mismatches.end(),
-                                                   duplicate_alarm)));
+            static_cast<std::size_t>(
+                std::count_if(r.mismatches.begin(), r.mismatches.end(), duplicate_alarm)));
 }
 
 // The observer is not told about one fault (a passive interface failure and its repair): the
@@ -195,8 +196,8 @@ TEST(SwitchoverCampaign, DISABLED_AlarmReadJustBeforeTheActiveInterfaceFailsIsDe
   sched.run_until(700 * bus::kTicksPerMs);
   EXPECT_EQ(b.model->primary(), 1);
   EXPECT_EQ(alarms.size(), 1u) << "read on line 0 at " << alarms.front().second / bus::kTicksPerUs
-                               << " us, delivered again on line " << alarms.back().first
-                               << " at " << alarms.back().second / bus::kTicksPerUs << " us";
+                               << " us, delivered again on line " << alarms.back().first << " at "
+                               << alarms.back().second / bus::kTicksPerUs << " us";
 }
 
 }  // namespace

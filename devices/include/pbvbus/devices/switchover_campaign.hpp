@@ -89,7 +89,7 @@ struct CampaignOptions {
   std::uint64_t seed = 1;
   int faults = 1000;  ///< injections (faults + repairs) to reach; the last cycle is completed
   bus::Baud baud = bus::Baud::k1_5M;
-  int switched = 4;   ///< switched stations (>= 2: the second is PBVB0A11)
+  int switched = 4;  ///< switched stations (>= 2: the second is PBVB0A11)
   int one_sided_per_line = 1;
   std::string gsd_dir;  ///< where PBVB0A10/0A11/0A01.gsd are (e.g. <source>/examples/gsd)
   bool alarms = true;   ///< raise DP-V1 alarms (when the station model supports them)
@@ -109,17 +109,17 @@ struct CampaignOptions {
 
 struct CampaignResult {
   std::array<int, kCampaignFaultKinds> drawn{};  ///< fault cycles per kind
-  int faults = 0;   ///< fault injections (an F11/F24 cycle injects two)
-  int repairs = 0;  ///< repair injections
-  std::uint64_t switchovers = 0;  ///< MasterSystem::switchovers()
+  int faults = 0;                      ///< fault injections (an F11/F24 cycle injects two)
+  int repairs = 0;                     ///< repair injections
+  std::uint64_t switchovers = 0;       ///< MasterSystem::switchovers()
   std::uint64_t station_switches = 0;  ///< primary-interface changes seen on the stations
   /// S7 events raised by the MasterSystem, by code (0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3,
   /// 0x38C3), and the ones the observer expected.
   std::array<std::pair<std::uint16_t, int>, 6> events{};
   int expected_events = 0;
-  std::uint64_t output_samples = 0;  ///< backplane samples checked
-  std::uint64_t pulses = 0;          ///< 0 outputs or older values (must be 0)
-  std::uint64_t safe_state_samples = 0;  ///< 0 while the station had no channel (expected)
+  std::uint64_t output_samples = 0;        ///< backplane samples checked
+  std::uint64_t pulses = 0;                ///< 0 outputs or older values (must be 0)
+  std::uint64_t safe_state_samples = 0;    ///< 0 while the station had no channel (expected)
   std::vector<std::string> pulse_reports;  ///< the first few pulses
   // Alarms (S8)
   bool alarms_supported = false;

@@ -46,6 +46,14 @@
 // station has no reachable channel, until its first non-zero value afterwards: the safe state
 // after Output_Hold_Time is expected then), never an older counter value (compared modulo
 // 2^16).
+// Alarms (S8, options.alarms): a DP-V1 alarm (Diagnostic, slot 2, payload = a 4-octet id) on a
+// random switched station 0..3 ms before a fault (probability 0.5) and at a random time of the
+// gap after a repair (0.3), through SwitchedStationModel::raise_alarm. Each must be reported
+// exactly once as a dp::MasterEvent::Kind::Alarm (the masters' event handler), compared by
+// (station, slot, type, payload) as the Seq_Nr may change on a repeat, and on the line the
+// observer expects active; 0 deliveries = lost, more = duplicated (each also a mismatch).
+// Known finding (docs/benchmarks.md): an alarm read by the active line's master just before
+// that channel is lost is delivered again through the new active channel.
 //
 // Tamper options exist for the observer's own tests (a fault it is not told about, a doctored
 // event list, a program glitch writing 0): each must make it report a mismatch or a pulse.

@@ -310,8 +310,19 @@ void Campaign::build() {
   });
   if (m_o.alarms) {
     m_r.alarms_supported = true;
-    m_sys->set_master_event_handler(
-        [this](int l, const dp::MasterEvent& e) { on_master_event(l, e); });
+    // What the program receives: the system's alarms (each once; a station's repeat after a
+    // switchover is recognised there). The masters' own Alarm events may show a repeat.
+    m_sys->system().on_alarm([this](const redundancy::SystemAlarm& a) {
+      dp::MasterEvent e;
+      e.kind = dp::MasterEvent::Kind::Alarm;
+      e.time = a.time;
+      e.slave = a.station;
+      e.alarm_type = a.type;
+      e.alarm_slot = a.slot;
+      e.alarm_specifier = a.specifier;
+      e.alarm_data = a.data;
+      on_master_event(a.line, e);
+    });
   }
   // Cable order on each line: master, switched stations, one-sided slaves.
   for (int l = 0; l < 2; ++l) m_sys->attach(l, *m_bus[l], "master");

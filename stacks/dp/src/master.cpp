@@ -43,6 +43,7 @@ std::string_view to_string(MasterEvent::Kind k) {
     case MasterEvent::Kind::ModeChange: return "mode change";
     case MasterEvent::Kind::DataExchangeEntered: return "data exchange entered";
     case MasterEvent::Kind::PrmCmdDone: return "PrmCmd done";
+    case MasterEvent::Kind::AlarmAcknowledged: return "alarm acknowledged";
   }
   return "?";
 }
@@ -658,12 +659,23 @@ void Master::on_acyclic(Slave& s, const Confirmation& con) {
   finish_job(s, AcyclicStatus::NotAvailable, con.now);
 }
 
-void Master::finish_job(Slave& s, AcyclicStatus st, bus::Ticks /*now*/, Dpv1Error err,
+void Master::finish_job(Slave& s, AcyclicStatus st, bus::Ticks now, Dpv1Error err,
                         std::span<const std::uint8_t> data) {
   if (s.jobs.empty()) return;
   Job j = std::move(s.jobs.front());
   s.jobs.pop_front();
   if (j.internal && st == AcyclicStatus::Ok) ++s.stats.alarm_acks;
+  if (j.fn == kFnAlarmAck && st == AcyclicStatus::Ok) {
+    // The slave has it: redundancy::MasterSystem knows then that no repeat can follow.
+    MasterEvent e;
+    e.kind = MasterEvent::Kind::AlarmAcknowledged;
+    e.time = now;
+    e.slave = s.p.address;
+    e.alarm_type = j.index;
+    e.alarm_slot = j.slot;
+    e.alarm_specifier = j.length;
+    emit(e);
+  }
   if (!j.cb) return;
   AcyclicResult r;
   r.id = j.id;

@@ -185,8 +185,55 @@ void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {
     case K::Diagnosis:
       if (s->switched) observe_red_status(*s, line, e.diag);
       break;
+    case K::Alarm: on_alarm_event(*s, line, e); break;
+    case K::AlarmAcknowledged: on_alarm_ack(*s, line, e); break;
     default: break;
   }
+}
+
+void MasterSystem::on_alarm_event(Station& s, int line, const dp::MasterEvent& e) {
+  const std::uint8_t spec = e.alarm_specifier & 0x03;
+  const std::uint8_t seq = dp::alarm_seq_nr(e.alarm_specifier);
+  // Orphans past the window are no longer expected to come back.
+  std::erase_if(s.unacked, [&](const Station::Unacked& u) {
+    return u.orphaned != bus::kNever && e.time - u.orphaned > m_p.alarm_repeat_window;
+  });
+  for (auto& u : s.unacked) {
+    if (u.type != e.alarm_type || u.slot != e.alarm_slot || u.spec != spec) continue;
+    if (u.orphaned == bus::kNever && u.line == line) continue;  // a new one on the same channel
+    if (!std::equal(u.data.begin(), u.data.end(), e.alarm_data.begin(), e.alarm_data.end())) continue;
+    // The station's repeat on its new primary: its master acknowledges it; the program has it.
+    u.line = line;
+    u.seq = seq;
+    u.orphaned = bus::kNever;
+    ++m_alarm_repeats;
+    return;
+  }
+  Station::Unacked u;
+  u.line = line;
+  u.type = e.alarm_type;
+  u.slot = e.alarm_slot;
+  u.seq = seq;
+  u.spec = spec;
+  u.data.assign(e.alarm_data.begin(), e.alarm_data.end());
+  s.unacked.push_back(std::move(u));
+  SystemAlarm a;
+  a.time = e.time;
+  a.station = s.address;
+  a.line = line;
+  a.type = e.alarm_type;
+  a.slot = e.alarm_slot;
+  a.specifier = e.alarm_specifier;
+  a.data.assign(e.alarm_data.begin(), e.alarm_data.end());
+  m_alarms.push_back(a);
+  if (m_alarm_cb) m_alarm_cb(m_alarms.back());
+}
+
+void MasterSystem::on_alarm_ack(Station& s, int line, const dp::MasterEvent& e) {
+  const std::uint8_t seq = dp::alarm_seq_nr(e.alarm_specifier);
+  std::erase_if(s.unacked, [&](const Station::Unacked& u) {
+    return u.line == line && u.type == e.alarm_type && u.slot == e.alarm_slot && u.seq == seq;
+  });
 }
 
 void MasterSystem::observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag) {
@@ -243,6 +290,9 @@ void MasterSystem::channel_down(Station& s, int line, bus::Ticks now, bool repor
   const bool was_up = s.up[line];
   s.up[line] = false;
   s.down[line] = true;
+  // Alarms read on this channel and not yet acknowledged may come again from the station.
+  for (auto& u : s.unacked)
+    if (u.line == line && u.orphaned == bus::kNever) u.orphaned = now;
   if (!s.switched) {
     if (!s.failed) {
       s.failed = true;

@@ -183,6 +183,7 @@ struct MasterEvent {
     DataExchangeEntered,  ///< the slave reached data exchange (every start-up, after any
                           ///< StationReturn); no S7 event of its own
     PrmCmdDone,      ///< a pure PrmCmd Set_Prm was acknowledged (the slave stays in DX)
+    AlarmAcknowledged,  ///< a positive Alarm_Ack response (alarm_type/slot/specifier as sent)
   };
   enum class Cause : std::uint8_t {
     None,

@@ -52,6 +52,15 @@
 //   can never bring an older one. Inputs (and the diagnosis the program uses) come from the
 //   active channel's master image (active_image()).
 // - Seq_Nr: one counter per station, incremented for every PrmCmd that changes a block.
+// - Alarms (S8, "no interrupt lost, none twice"): the station raises an alarm on its PRIMARY
+//   only and raises it again on the new PRIMARY when the primary changes before the master's
+//   Alarm_Ack reached it (RedundantSlave). The system delivers each alarm to the program once
+//   (on_alarm/alarms()): an alarm read on a channel stays "unacknowledged" until that master's
+//   Alarm_Ack is confirmed (dp AlarmAcknowledged); if its channel goes down first, the same
+//   alarm (type, slot, specifier bits, data) from the station within `alarm_repeat_window`
+//   is the station's repeat: acknowledged by its master as usual, not delivered again. DP-V1
+//   allows one outstanding alarm per type and slot, so a second one with the same type and slot
+//   before the first is acknowledged can only be that repeat.
 
 #include <array>
 #include <cstdint>
@@ -81,6 +90,18 @@ struct MasterSystemParams {
   std::uint16_t output_hold_time = 100;  ///< PrmCmd Output_Hold_Time, 10 ms units (1 s)
   bus::Ticks switch_supervision = 200 * bus::kTicksPerMs;
   int switch_attempts = 2;
+  bus::Ticks alarm_repeat_window = 2000 * bus::kTicksPerMs;
+};
+
+/// A DP-V1 alarm as the program receives it (once, from the active channel).
+struct SystemAlarm {
+  bus::Ticks time = 0;
+  std::uint8_t station = 0;
+  int line = -1;
+  std::uint8_t type = 0;
+  std::uint8_t slot = 0;
+  std::uint8_t specifier = 0;
+  std::vector<std::uint8_t> data;
 };
 
 /// Why a whole line is lost.
@@ -164,6 +185,10 @@ class MasterSystem {
   const dp::MasterImage* active_image(std::uint8_t address) const;
 
   void on_event(std::function<void(const SystemEvent&)> cb) { m_cb = std::move(cb); }
+  void on_alarm(std::function<void(const SystemAlarm&)> cb) { m_alarm_cb = std::move(cb); }
+  const std::vector<SystemAlarm>& alarms() const { return m_alarms; }
+  /// Alarms a station raised again after a switchover that were recognised and not delivered.
+  std::uint64_t alarm_repeats() const { return m_alarm_repeats; }
   const std::vector<SystemEvent>& events() const { return m_events; }
   std::uint64_t switchovers() const { return m_switchovers; }
 
@@ -185,6 +210,13 @@ class MasterSystem {
     bool failed = false;          ///< 39C4 reported, 38C4 owed
     bool silent_red_lost = false; ///< lost in a 39C3 line loss: the return is silent too
     bool silent_failed = false;
+    struct Unacked {
+      int line = -1;
+      std::uint8_t type = 0, slot = 0, seq = 0, spec = 0;
+      std::vector<std::uint8_t> data;
+      bus::Ticks orphaned = bus::kNever;  ///< its channel went down before the ack
+    };
+    std::vector<Unacked> unacked;
   };
 
   Station* find(std::uint8_t address);
@@ -193,6 +225,8 @@ class MasterSystem {
                     SystemEvent::Cause cause = SystemEvent::Cause::ChannelFailure);
   void channel_up(Station& s, int line, bus::Ticks now, std::span<const std::uint8_t> diag);
   void observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag);
+  void on_alarm_event(Station& s, int line, const dp::MasterEvent& e);
+  void on_alarm_ack(Station& s, int line, const dp::MasterEvent& e);
   void switch_to(Station& s, int line, bus::Ticks now, SystemEvent::Cause cause);
   std::array<std::uint8_t, kPrmCmdLen> block(const Station& s, bool primary_request) const;
   bool reporting(int line) const;
@@ -210,6 +244,9 @@ class MasterSystem {
   std::vector<SystemEvent> m_events;
   std::function<void(const SystemEvent&)> m_cb;
   std::uint64_t m_switchovers = 0;
+  std::function<void(const SystemAlarm&)> m_alarm_cb;
+  std::vector<SystemAlarm> m_alarms;
+  std::uint64_t m_alarm_repeats = 0;
 };
 
 }  // namespace pbvbus::redundancy

@@ -551,3 +551,82 @@ TEST(RedundantMasterSystem, StartUpWithoutLineAUsesB) {
 
 }  // namespace
 }  // namespace pbvbus::devices
+
+namespace pbvbus::devices {
+namespace {
+
+// S6/S8 for data records: a Read goes over the active channel only; when the active interface
+// fails while the job is under way, the system repeats it over the new active channel and the
+// caller gets one result, from line B.
+TEST(RedundantMasterSystem, DataRecordGoesOverTheActiveChannelAndSurvivesASwitchover) {
+  System s;
+  s.start();
+  s.run_until(150 * kMs);
+  // Steady state: the record job runs on line A only.
+  std::vector<dp::AcyclicResult> got;
+  ASSERT_NE(s.ms().read(kFast, 0, 1, 8, [&](const dp::AcyclicResult& r) { got.push_back(r); },
+                        s.sched.now()),
+            0u);
+  s.run_until(200 * kMs);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_TRUE(got[0].status == dp::AcyclicStatus::Ok || got[0].status == dp::AcyclicStatus::Negative)
+      << dp::to_string(got[0].status);
+  EXPECT_EQ(s.ms().record_repeats(), 0u);
+
+  // A job interrupted by the failure of the active interface: repeated on B, one result.
+  got.clear();
+  const auto id = s.ms().read(kFast, 0, 1, 8, [&](const dp::AcyclicResult& r) { got.push_back(r); },
+                              s.sched.now());
+  ASSERT_NE(id, 0u);
+  s.station(kFast).fail_interface(0);
+  s.run_until(600 * kMs);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(got[0].id, id);
+  EXPECT_TRUE(got[0].status == dp::AcyclicStatus::Ok || got[0].status == dp::AcyclicStatus::Negative)
+      << dp::to_string(got[0].status);
+  EXPECT_EQ(s.ms().record_repeats(), 1u);
+  EXPECT_EQ(s.ms().active(kFast), 1);
+  // With no active channel at all the system refuses at once.
+  s.station(kFast).fail_interface(1);
+  s.run_until(800 * kMs);
+  EXPECT_EQ(s.ms().read(kFast, 0, 1, 8, [](const dp::AcyclicResult&) {}, s.sched.now()), 0u);
+}
+
+}  // namespace
+}  // namespace pbvbus::devices
+
+namespace pbvbus::devices {
+namespace {
+
+// S11 at the master-system level: one side's master out (the other CPU in Solo): the remaining
+// master reaches every switched station (all active on its line) and its one-sided slave; the
+// failed side reaches none. No switchover is needed when the failed side was the passive one.
+TEST(RedundantMasterSystem, SoloSideReachesEverySwitchedStation) {
+  System s;
+  s.start();
+  s.run_until(150 * kMs);
+  s.sys->fail_master(1);
+  s.run_until(1500 * kMs);
+  EXPECT_EQ(s.ms().switchovers(), 0u);
+  for (std::uint8_t a : {kFast, kSlow}) {
+    EXPECT_EQ(s.ms().active(a), 0) << int(a);
+    EXPECT_EQ(s.station(a).primary(), 0) << int(a);
+    EXPECT_EQ(s.sys->master(0).slave_state(a), dp::SlaveStatusState::DataExchange);
+    EXPECT_FALSE(s.ms().channel_up(a, 1));
+    // The passive interface lost its master: its watchdog took it out of data exchange.
+    EXPECT_NE(s.station(a).redundant_slave().engine(1).state(), dp::SlaveState::DataExch);
+  }
+  EXPECT_EQ(s.sys->master(0).slave_state(kOneA), dp::SlaveStatusState::DataExchange);
+  EXPECT_EQ(s.ms().active(kOneB), -1);
+  // F9 on the passive side: 73A3 per switched station, 39C4 for its one-sided slave.
+  int r73 = 0, r39 = 0;
+  for (const auto& e : s.s7()) {
+    if (e.kind == K::RedundancyLoss && e.line == 1) ++r73;
+    if (e.kind == K::StationFailure && e.station == kOneB) ++r39;
+  }
+  EXPECT_EQ(r73, 2);
+  EXPECT_EQ(r39, 1);
+}
+
+}  // namespace
+}  // namespace pbvbus::devices

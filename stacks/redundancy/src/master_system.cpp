@@ -169,6 +169,7 @@ void MasterSystem::emit(SystemEvent::Kind k, bus::Ticks t, int line, std::uint8_
 
 void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {
   if (line != 0 && line != 1) return;
+  m_now = std::max(m_now, e.time);
   using K = dp::MasterEvent::Kind;
   if (e.kind == K::ModeChange) {
     const bool running = e.mode == dp::MasterMode::Clear || e.mode == dp::MasterMode::Operate;
@@ -370,10 +371,113 @@ void MasterSystem::line_back(int line, bus::Ticks now) {
 bus::Ticks MasterSystem::next_deadline() const {
   bus::Ticks t = bus::kNever;
   for (const auto& s : m_st) t = std::min(t, s.deadline);
+  // A record job waiting for a channel is looked at every call (its wait ends with a channel).
+  for (const auto& r : m_records)
+    if (r.line < 0) t = std::min(t, r.waiting_since);
   return t;
 }
 
+std::uint32_t MasterSystem::read(std::uint8_t address, std::uint8_t slot, std::uint8_t index,
+                                 std::uint8_t length, dp::AcyclicCallback cb, bus::Ticks now) {
+  Record r;
+  r.address = address;
+  r.slot = slot;
+  r.index = index;
+  r.length = length;
+  r.cb = std::move(cb);
+  if (!start_record(r, now)) return 0;
+  r.id = m_next_record++;
+  m_records.push_back(std::move(r));
+  return m_records.back().id;
+}
+
+std::uint32_t MasterSystem::write(std::uint8_t address, std::uint8_t slot, std::uint8_t index,
+                                  std::span<const std::uint8_t> data, dp::AcyclicCallback cb,
+                                  bus::Ticks now) {
+  Record r;
+  r.address = address;
+  r.write = true;
+  r.slot = slot;
+  r.index = index;
+  r.data.assign(data.begin(), data.end());
+  r.cb = std::move(cb);
+  if (!start_record(r, now)) return 0;
+  r.id = m_next_record++;
+  m_records.push_back(std::move(r));
+  return m_records.back().id;
+}
+
+bool MasterSystem::start_record(Record& r, bus::Ticks now) {
+  const int line = active(r.address);
+  if (line < 0) return false;
+  // The id is not known yet for a new job: the callback finds it by the master's job id.
+  const std::uint32_t sys_id = r.id != 0 ? r.id : m_next_record;
+  auto done = [this, sys_id](const dp::AcyclicResult& res) { record_done(sys_id, res); };
+  const std::uint32_t mid =
+      r.write ? m_master[line]->write(r.address, r.slot, r.index, r.data, std::move(done))
+              : m_master[line]->read(r.address, r.slot, r.index, r.length, std::move(done));
+  if (mid == 0) return false;
+  r.line = line;
+  r.waiting_since = bus::kNever;
+  ++r.attempts;
+  (void)now;
+  return true;
+}
+
+void MasterSystem::record_done(std::uint32_t id, const dp::AcyclicResult& res) {
+  auto it = std::find_if(m_records.begin(), m_records.end(),
+                         [id](const Record& r) { return r.id == id; });
+  if (it == m_records.end()) return;
+  using St = dp::AcyclicStatus;
+  const bool interrupted = res.status == St::NoResponse || res.status == St::NotAvailable ||
+                           res.status == St::Timeout || res.status == St::Rejected;
+  if (interrupted && it->attempts < m_p.record_attempts) {
+    // Wait for the station's (new) active channel; retry_records() starts it again.
+    it->line = -1;
+    it->waiting_since = m_now;
+    return;
+  }
+  Record r = std::move(*it);
+  m_records.erase(it);
+  dp::AcyclicResult out = res;
+  out.id = r.id;
+  if (r.cb) r.cb(out);
+}
+
+void MasterSystem::retry_records(bus::Ticks now) {
+  for (std::size_t i = 0; i < m_records.size();) {
+    Record& r = m_records[i];
+    if (r.line >= 0) {
+      ++i;
+      continue;
+    }
+    const int line = active(r.address);
+    const bool channel = line >= 0 && switching_to(r.address) < 0;
+    if (channel && start_record(r, now)) {
+      ++m_record_repeats;
+      ++i;
+      continue;
+    }
+    if (now - r.waiting_since >= m_p.record_wait) {
+      Record done = std::move(r);
+      m_records.erase(m_records.begin() + static_cast<std::ptrdiff_t>(i));
+      dp::AcyclicResult res;
+      res.id = done.id;
+      res.slave = done.address;
+      res.fn = done.write ? dp::kFnWrite : dp::kFnRead;
+      res.slot = done.slot;
+      res.index = done.index;
+      res.status = dp::AcyclicStatus::NotAvailable;
+      if (done.cb) done.cb(res);
+      continue;
+    }
+    ++i;
+  }
+}
+
 void MasterSystem::on_time(bus::Ticks now) {
+  m_now = now;
+  retry_records(now);
   for (auto& s : m_st) {
     if (s.deadline > now) continue;
     s.deadline = bus::kNever;

@@ -61,6 +61,12 @@
 //   is the station's repeat: acknowledged by its master as usual, not delivered again. DP-V1
 //   allows one outstanding alarm per type and slot, so a second one with the same type and slot
 //   before the first is acknowledged can only be that repeat.
+// - Data records (S6, S8): read()/write() go to the active channel's master (MSAC_C1). A job
+//   the switchover interrupts (NoResponse, NotAvailable, Timeout or Rejected on the old
+//   channel) is repeated on the new active channel as soon as the station shows one, at most
+//   `record_attempts` times in all; the callback runs once, with the final result (id = the
+//   system's job id). A Read is idempotent; a Write repeated after an interruption may reach the
+//   station twice — as on the S7-400H, where the record job is repeated by the system.
 
 #include <array>
 #include <cstdint>
@@ -91,6 +97,8 @@ struct MasterSystemParams {
   bus::Ticks switch_supervision = 200 * bus::kTicksPerMs;
   int switch_attempts = 2;
   bus::Ticks alarm_repeat_window = 2000 * bus::kTicksPerMs;
+  int record_attempts = 3;
+  bus::Ticks record_wait = 2000 * bus::kTicksPerMs;  ///< for a new active channel, then failed
 };
 
 /// A DP-V1 alarm as the program receives it (once, from the active channel).
@@ -189,6 +197,15 @@ class MasterSystem {
   const std::vector<SystemAlarm>& alarms() const { return m_alarms; }
   /// Alarms a station raised again after a switchover that were recognised and not delivered.
   std::uint64_t alarm_repeats() const { return m_alarm_repeats; }
+
+  /// DP-V1 MSAC_C1 Read/Write over the active channel (see above). Returns the job id (> 0),
+  /// or 0 if the station has no active channel or its master refuses the request now.
+  std::uint32_t read(std::uint8_t address, std::uint8_t slot, std::uint8_t index,
+                     std::uint8_t length, dp::AcyclicCallback cb, bus::Ticks now);
+  std::uint32_t write(std::uint8_t address, std::uint8_t slot, std::uint8_t index,
+                      std::span<const std::uint8_t> data, dp::AcyclicCallback cb, bus::Ticks now);
+  /// Record jobs repeated on a new channel after an interruption.
+  std::uint64_t record_repeats() const { return m_record_repeats; }
   const std::vector<SystemEvent>& events() const { return m_events; }
   std::uint64_t switchovers() const { return m_switchovers; }
 
@@ -227,6 +244,20 @@ class MasterSystem {
   void observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag);
   void on_alarm_event(Station& s, int line, const dp::MasterEvent& e);
   void on_alarm_ack(Station& s, int line, const dp::MasterEvent& e);
+  struct Record {
+    std::uint32_t id = 0;
+    std::uint8_t address = 0;
+    bool write = false;
+    std::uint8_t slot = 0, index = 0, length = 0;
+    std::vector<std::uint8_t> data;
+    dp::AcyclicCallback cb;
+    int attempts = 0;
+    int line = -1;                      ///< where it runs now (-1: waiting for a channel)
+    bus::Ticks waiting_since = bus::kNever;
+  };
+  bool start_record(Record& r, bus::Ticks now);
+  void record_done(std::uint32_t id, const dp::AcyclicResult& res);
+  void retry_records(bus::Ticks now);
   void switch_to(Station& s, int line, bus::Ticks now, SystemEvent::Cause cause);
   std::array<std::uint8_t, kPrmCmdLen> block(const Station& s, bool primary_request) const;
   bool reporting(int line) const;
@@ -247,6 +278,10 @@ class MasterSystem {
   std::function<void(const SystemAlarm&)> m_alarm_cb;
   std::vector<SystemAlarm> m_alarms;
   std::uint64_t m_alarm_repeats = 0;
+  std::vector<Record> m_records;
+  std::uint32_t m_next_record = 1;
+  std::uint64_t m_record_repeats = 0;
+  bus::Ticks m_now = 0;
 };
 
 }  // namespace pbvbus::redundancy

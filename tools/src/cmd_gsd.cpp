@@ -51,16 +51,7 @@ std::string hex_list(const GsdBytes& bytes, const char* sep) {
   return s;
 }
 
-std::string hex_plain(const GsdBytes& bytes) {
-  std::string s;
-  char buf[4];
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", bytes[i]);
-    if (i) s += ' ';
-    s += buf;
-  }
-  return s;
-}
+std::string hex_plain(const GsdBytes& bytes) { return hex_octets(bytes); }
 
 std::string hex16(std::uint16_t v) {
   char buf[8];

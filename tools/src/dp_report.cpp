@@ -11,16 +11,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-std::string hex(const std::vector<std::uint8_t>& v) {
-  std::string s;
-  char buf[4];
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", v[i]);
-    if (i) s += ' ';
-    s += buf;
-  }
-  return s;
-}
+std::string hex(const std::vector<std::uint8_t>& v) { return hex_octets(v); }
 
 }  // namespace
 

@@ -37,4 +37,16 @@ std::string format_us(bus::Ticks t) {
   return buf;
 }
 
+std::string hex_octets(std::span<const std::uint8_t> v) {
+  static constexpr char kDigits[] = "0123456789ABCDEF";
+  std::string s;
+  s.reserve(v.size() * 3);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (i) s += ' ';
+    s += kDigits[v[i] >> 4];
+    s += kDigits[v[i] & 0x0F];
+  }
+  return s;
+}
+
 }  // namespace pbvbus::tools

@@ -9,16 +9,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-std::string hex(const std::vector<std::uint8_t>& v) {
-  std::string out;
-  char b[4];
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    std::snprintf(b, sizeof b, "%02X", v[i]);
-    if (i) out += ' ';
-    out += b;
-  }
-  return out;
-}
+std::string hex(const std::vector<std::uint8_t>& v) { return hex_octets(v); }
 
 std::string code_text(std::uint16_t code) {
   char b[16];

@@ -8,6 +8,7 @@
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/tools/dp_system.hpp"
+#include "pbvbus/tools/timing_plan.hpp"
 
 namespace pbvbus::tools {
 
@@ -27,26 +28,12 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
   const RedundancyPlan& rp = this->plan();
   devices::RedundantMasterSystemOptions o;
   std::vector<dp::SlaveParams> slaves[2];
-  std::vector<redundancy::PlannedSlave> timing;
   for (int side = 0; side < 2; ++side) {
     const DpMasterPlan& mp = plan.dp_masters.at(static_cast<std::size_t>(rp.master[side]));
     o.master[side] = mp.params;
     for (int k : mp.slaves) {
       const DpSlavePlan& sp = plan.dp_slaves.at(static_cast<std::size_t>(k));
       slaves[side].push_back(sp.params);
-      if (sp.switched >= 0 && side == 1) continue;  // once per switched station
-      redundancy::PlannedSlave ps;
-      ps.address = sp.address;
-      ps.name = sp.model;
-      ps.in_len = sp.inputs;
-      ps.out_len = sp.outputs;
-      ps.max_tsdr_bits = sp.gsd_max_tsdr;
-      ps.max_diag_len = sp.config.max_diag_len;
-      ps.switched = sp.switched >= 0;
-      ps.line = side;
-      if (sp.switched >= 0)
-        ps.t_slave_um = plan.switched.at(static_cast<std::size_t>(sp.switched)).t_slave_um;
-      timing.push_back(ps);
     }
   }
   m_program = plan.dp_masters.at(static_cast<std::size_t>(rp.master[0])).outputs;
@@ -61,7 +48,7 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
   }
   try {
     m_model = std::make_unique<devices::RedundantMasterSystemModel>(o, slaves[0], slaves[1], refs);
-    m_timing = redundancy::plan_switchover(params[0], timing);
+    m_timing = redundancy::plan_switchover(params[0], planned_slaves_of_system(plan, system));
   } catch (const std::exception& e) {
     throw std::runtime_error("redundant master system \"" + rp.name + "\": " + e.what());
   }

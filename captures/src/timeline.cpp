@@ -232,6 +232,75 @@ void finish_lane(LaneWork& w, std::int64_t from, i128 to) {
   }
 }
 
+/// Lane index of every line index that Redundancy records name (timeline.hpp, "Active channel").
+int lane_of_line(int line, const std::vector<TimelineEvent>& events,
+                 const std::vector<LaneWork>& lanes) {
+  if (line < 0) return -1;
+  auto stem = [](const std::string& n) { return n.substr(0, n.find('@')); };
+  for (const TimelineEvent& e : events) {
+    if (e.record.category != EventCategory::Line || e.record.line != line) continue;
+    const auto colon = e.record.text.find(": ");
+    if (colon == std::string::npos || colon == 0) continue;
+    const std::string name = e.record.text.substr(0, colon);
+    for (std::size_t i = 0; i < lanes.size(); ++i) {
+      const std::string& n = lanes[i].lane.name;
+      if (n == name || (n.size() > name.size() && n.compare(0, name.size(), name) == 0 &&
+                        n[name.size()] == '@'))
+        return static_cast<int>(i);
+    }
+    return -1;  // the line's name is known but no lane carries it
+  }
+  int group = -1;
+  for (std::size_t i = 0; i < lanes.size(); ++i) {
+    if (i == 0 || stem(lanes[i].lane.name) != stem(lanes[i - 1].lane.name)) ++group;
+    if (group == line) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+/// The active-channel spans of the switched stations over the whole capture (timeline.hpp).
+std::vector<ActiveChannelSpan> active_channels(const std::vector<TimelineEvent>& events,
+                                               const std::vector<LaneWork>& lanes,
+                                               std::int64_t end) {
+  constexpr std::uint16_t kStationFailure = 2, kSwitchover = 6;
+  std::set<int> switched;
+  for (const TimelineEvent& e : events)
+    if (e.record.category == EventCategory::Redundancy && e.record.code == kSwitchover &&
+        e.record.a >= 0)
+      switched.insert(e.record.a);
+  std::map<int, int> lane_cache;
+  auto lane_for = [&](int line) {
+    auto it = lane_cache.find(line);
+    if (it == lane_cache.end()) it = lane_cache.emplace(line, lane_of_line(line, events, lanes)).first;
+    return it->second;
+  };
+  std::vector<ActiveChannelSpan> out;
+  for (int station : switched) {
+    std::vector<ActiveChannelSpan> row;
+    auto enter = [&](int line, std::int64_t t) {
+      if (!row.empty()) {
+        ActiveChannelSpan& cur = row.back();
+        if (cur.line == line) return;
+        cur.end_ns = std::max(cur.start_ns, t);
+        if (cur.end_ns == cur.start_ns) row.pop_back();
+        if (!row.empty() && row.back().line == line) return;  // back to the one before
+      }
+      row.push_back({station, line, line < 0 ? -1 : lane_for(line), t, t});
+    };
+    for (const TimelineEvent& e : events) {  // in time order
+      const EventRecord& r = e.record;
+      if (r.category != EventCategory::Redundancy || r.a != station) continue;
+      if (r.code == kSwitchover)
+        enter(r.line < 0 ? -1 : r.line, e.ts_ns);
+      else if (r.code == kStationFailure || row.empty())
+        enter(-1, e.ts_ns);
+    }
+    if (!row.empty()) row.back().end_ns = std::max(row.back().start_ns, end);
+    out.insert(out.end(), row.begin(), row.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(FrameKind k) {
@@ -360,13 +429,16 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     return std::nullopt;
   }
   tl.to_ns = saturate(to);
+  std::stable_sort(events.begin(), events.end(), [](const TimelineEvent& a, const TimelineEvent& b) {
+    return a.ts_ns < b.ts_ns;
+  });
+  for (const ActiveChannelSpan& s : active_channels(events, lanes, tl.last_ns))
+    if (s.start_ns < to && (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
+      tl.active_channels.push_back(s);
   for (LaneWork& w : lanes) {
     finish_lane(w, tl.from_ns, to);
     tl.lanes.push_back(std::move(w.lane));
   }
-  std::stable_sort(events.begin(), events.end(), [](const TimelineEvent& a, const TimelineEvent& b) {
-    return a.ts_ns < b.ts_ns;
-  });
   for (TimelineEvent& e : events)
     if (e.ts_ns >= tl.from_ns && e.ts_ns < to) tl.events.push_back(std::move(e));
   return tl;

@@ -261,8 +261,8 @@ class LineLanes {
       }
       return -1;  // the line's name is known but no lane carries it
     }
-    return static_cast<std::size_t>(line) < m_groups.size() ? m_groups[static_cast<std::size_t>(line)]
-                                                              : -1;
+    const auto g = static_cast<std::size_t>(line);
+    return g < m_groups.size() ? m_groups[g] : -1;
   }
 
  private:
@@ -454,7 +454,8 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     return a.ts_ns < b.ts_ns;
   });
   for (const ActiveChannelSpan& s : active_channels(events, lanes, tl.last_ns))
-    if (s.start_ns < to && (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
+    if (s.start_ns < to &&
+        (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
       tl.active_channels.push_back(s);
   for (LaneWork& w : lanes) {
     finish_lane(w, tl.from_ns, to);

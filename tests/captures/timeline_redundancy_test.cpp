@@ -56,7 +56,8 @@ Bytes make_capture() {
   c.event(5, red(kSwitchover, 3, 0, "switchover of switched station 3 to line DP_A (start-up)"));
   c.event(5, red(kSwitchover, 6, 0, "switchover of switched station 6 to line DP_A (start-up)"));
   c.event(1000, red(kLoss, 3, 0, "OB 70 W#16#73A3 redundancy loss: switched station 3, line DP_A"));
-  c.event(1000, red(kSwitchover, 3, 1, "switchover of switched station 3 to line DP_B (channel failure)"));
+  c.event(1000,
+          red(kSwitchover, 3, 1, "switchover of switched station 3 to line DP_B (channel failure)"));
   c.event(2000, red(kFailure, 6, 1, "OB 86 W#16#39C4 station failure: switched station 6, line DP_B"));
   // A one-sided slave's failure and the master system's events make no row.
   c.event(2100, red(kFailure, 10, 0, "OB 86 W#16#39C4 station failure: slave 10, line DP_A"));

@@ -1,7 +1,8 @@
 #pragma once
 // The model behind `pbvbus timeline CAPTURE` (issue 6, "a picture of the bus"): a capture read
 // into lanes of frames with their times on the wire, who held the token when, the DP cycle of
-// every slave, the events, and (issue 7) the active channel of every switched station. timeline_render.hpp draws it as HTML or SVG.
+// every slave, the events, and (issue 7) the active channel of every switched station.
+// timeline_render.hpp draws it as HTML or SVG.
 //
 // Decisions:
 //  - One lane per interface with link type USER0 (147) or PROFIBUS_DL (257), in interface
@@ -51,6 +52,8 @@
 //    the station's first Redundancy record of any kind, with no active channel until the first
 //    switchover; a station failure (code 2) means no active channel until the next switchover;
 //    other codes change nothing. The last span lasts to last_ns (the end of the capture).
+//    A pbvbus run writes no record for the channel a station starts on (its first Set_Prm
+//    makes line A active), so such a station's row starts with its first fault's records.
 //    Consecutive spans of the same line are one span; a span that another record at the same
 //    instant replaces (zero length, not the last) is dropped. A line index names a lane as a
 //    Line event does: the Line event records (category 1) of that line index start their text
@@ -60,11 +63,11 @@
 //    index order) and the Nth group's first lane is line N's. A line index with no such lane
 //    keeps its index with line_lane = -1. Worked out on the whole capture like the token spans.
 //  - Window [from_ns, to_ns): frames, token spans and active-channel spans that overlap it,
-//    polls and events that start in it. Without a window: from the earliest record to 1 ns after the end of the
-//    latest frame or event (so that what happens last is inside; to_ns saturates at the int64
-//    limit, and a window ending there includes it). Token spans and cycle times are worked
-//    out on the whole capture first, so a window does not change them; the per-slave summary
-//    covers the polls in the window. Times are the capture's own (virtual time since the start
+//    polls and events that start in it. Without a window: from the earliest record to 1 ns
+//    after the end of the latest frame or event (so that what happens last is inside; to_ns
+//    saturates at the int64 limit, and a window ending there includes it). Token spans, active
+//    channels and cycle times are worked out on the whole capture first, so a window does not
+//    change them; the per-slave summary covers the polls in the window. Times are the capture's own (virtual time since the start
 //    of the run for pbvbus captures).
 //  - Errors: anything the reader rejects (not pcapng, truncated or malformed block) fails the
 //    whole build with the reader's message and offset: a partial picture of a broken file would

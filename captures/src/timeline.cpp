@@ -232,6 +232,96 @@ void finish_lane(LaneWork& w, std::int64_t from, i128 to) {
   }
 }
 
+/// Line index -> lane index as timeline.hpp ("Active channel") says, for the line indices that
+/// Redundancy records name. One pass over the events and the lanes.
+class LineLanes {
+ public:
+  LineLanes(const std::vector<TimelineEvent>& events, const std::vector<LaneWork>& lanes)
+      : m_lanes(lanes) {
+    for (const TimelineEvent& e : events) {
+      if (e.record.category != EventCategory::Line || e.record.line < 0) continue;
+      const auto colon = e.record.text.find(": ");
+      if (colon == std::string::npos || colon == 0) continue;
+      m_names.try_emplace(e.record.line, e.record.text.substr(0, colon));
+    }
+    for (std::size_t i = 0; i < lanes.size(); ++i)
+      if (i == 0 || stem(lanes[i].lane.name) != stem(lanes[i - 1].lane.name))
+        m_groups.push_back(static_cast<int>(i));
+  }
+  int lane(int line) const {
+    if (line < 0) return -1;
+    const auto it = m_names.find(line);
+    if (it != m_names.end()) {
+      const std::string& name = it->second;
+      for (std::size_t i = 0; i < m_lanes.size(); ++i) {
+        const std::string& n = m_lanes[i].lane.name;
+        if (n == name || (n.size() > name.size() && n.compare(0, name.size(), name) == 0 &&
+                          n[name.size()] == '@'))
+          return static_cast<int>(i);
+      }
+      return -1;  // the line's name is known but no lane carries it
+    }
+    const auto g = static_cast<std::size_t>(line);
+    return g < m_groups.size() ? m_groups[g] : -1;
+  }
+
+ private:
+  static std::string stem(const std::string& n) { return n.substr(0, n.find('@')); }
+  const std::vector<LaneWork>& m_lanes;
+  std::map<int, std::string> m_names;
+  std::vector<int> m_groups;  ///< first lane of each group of lanes of one line
+};
+
+/// The active-channel spans of the switched stations over the whole capture (timeline.hpp);
+/// `events` in time order.
+std::vector<ActiveChannelSpan> active_channels(const std::vector<TimelineEvent>& events,
+                                               const std::vector<LaneWork>& lanes,
+                                               std::int64_t end) {
+  constexpr std::uint16_t kStationFailure = 2, kSwitchover = 6;
+  auto redundancy = [](const EventRecord& r) {
+    return r.category == EventCategory::Redundancy && r.a >= 0;
+  };
+  std::map<int, std::vector<ActiveChannelSpan>> rows;  // the switched stations
+  for (const TimelineEvent& e : events)
+    if (redundancy(e.record) && e.record.code == kSwitchover) rows.try_emplace(e.record.a);
+  if (rows.empty()) return {};
+  const LineLanes line_lanes(events, lanes);
+  std::map<int, int> lane_cache;
+  auto lane_for = [&](int line) {
+    auto it = lane_cache.find(line);
+    if (it == lane_cache.end()) it = lane_cache.emplace(line, line_lanes.lane(line)).first;
+    return it->second;
+  };
+  for (const TimelineEvent& e : events) {
+    const EventRecord& r = e.record;
+    if (!redundancy(r)) continue;
+    const auto it = rows.find(r.a);
+    if (it == rows.end()) continue;
+    std::vector<ActiveChannelSpan>& row = it->second;
+    int line;
+    if (r.code == kSwitchover)
+      line = r.line < 0 ? -1 : r.line;
+    else if (r.code == kStationFailure || row.empty())
+      line = -1;
+    else
+      continue;
+    if (!row.empty()) {
+      ActiveChannelSpan& cur = row.back();
+      if (cur.line == line) continue;
+      cur.end_ns = std::max(cur.start_ns, e.ts_ns);
+      if (cur.end_ns == cur.start_ns) row.pop_back();   // replaced at the same instant
+      if (!row.empty() && row.back().line == line) continue;  // back to the one before
+    }
+    row.push_back({r.a, line, line < 0 ? -1 : lane_for(line), e.ts_ns, e.ts_ns});
+  }
+  std::vector<ActiveChannelSpan> out;
+  for (auto& [station, row] : rows) {
+    if (!row.empty()) row.back().end_ns = std::max(row.back().start_ns, end);
+    out.insert(out.end(), row.begin(), row.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(FrameKind k) {
@@ -360,13 +450,17 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     return std::nullopt;
   }
   tl.to_ns = saturate(to);
+  std::stable_sort(events.begin(), events.end(), [](const TimelineEvent& a, const TimelineEvent& b) {
+    return a.ts_ns < b.ts_ns;
+  });
+  for (const ActiveChannelSpan& s : active_channels(events, lanes, tl.last_ns))
+    if (s.start_ns < to &&
+        (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
+      tl.active_channels.push_back(s);
   for (LaneWork& w : lanes) {
     finish_lane(w, tl.from_ns, to);
     tl.lanes.push_back(std::move(w.lane));
   }
-  std::stable_sort(events.begin(), events.end(), [](const TimelineEvent& a, const TimelineEvent& b) {
-    return a.ts_ns < b.ts_ns;
-  });
   for (TimelineEvent& e : events)
     if (e.ts_ns >= tl.from_ns && e.ts_ns < to) tl.events.push_back(std::move(e));
   return tl;

@@ -47,6 +47,9 @@ const HOLDER_COLOURS = ['#f6bd60', '#90caf9', '#b8e0a0', '#f7a8c4', '#cdb4f0', '
   '#f4a582', '#c7d2fe', '#d9ed92', '#e5c3a6', '#a5d8ff'];
 const EVENT_COLOURS = { fault: '#e8590c', repair: '#2b8a3e', event: '#5f3dc4' };
 const DX_OK = '#3f9b57', DX_MISS = '#e03131';
+// Colours of the lanes in the active-channel rows (by lane index).
+const LANE_COLOURS = ['#1c7ed6', '#f59f00', '#0ca678', '#ae3ec9', '#d6336c', '#74b816'];
+const ROW_AC = 14;
 const LABEL_W = 210, AXIS_H = 34, EV_H = 46, PAD_R = 18;
 const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18;
 const MIN_SPAN = 100;  // ns: a few bit times even at 12 Mbit/s
@@ -136,6 +139,10 @@ const holderColour = {};
 holders.forEach((h, i) => { holderColour[h] = HOLDER_COLOURS[i % HOLDER_COLOURS.length]; });
 const events = D.ev.map(e => ({ t: e[0], style: e[1], cat: e[2], text: e[3] }));
 const evTimes = Float64Array.from(events.map(e => e.t));
+// Active channel per switched station: spans [start, end, lane, line].
+const acRows = (D.ac || []).map(R => ({ a: R.a, s: R.s }));
+function laneColour(i) { return LANE_COLOURS[i % LANE_COLOURS.length]; }
+let acY = 0;
 
 // ---- view -------------------------------------------------------------------------------
 const full = [D.span[0], D.span[1]];
@@ -185,6 +192,8 @@ function layout() {
     L.h = L.yD + L.dx.length * ROW_DX - y;
     y += L.h + LANE_GAP;
   }
+  acY = y;
+  if (acRows.length) y += acRows.length * ROW_AC + LANE_GAP;
   totalH = y;
 }
 layout();
@@ -367,12 +376,45 @@ function drawDx(s, L) {
 
 function drawLabels(s, L) {
   s.push(`<rect x="0" y="${L.y - 6}" width="${LABEL_W - 8}" height="${L.h + 12}" fill="#f7f8fa"><title>${esc(`interface ${L.iface}: ${L.name} \u2014 ${L.desc || 'no description'}, ${speedText(L.speed)}`)}</title></rect>`);
+  if (acRows.length) s.push(`<rect class="lane-colour" x="3" y="${L.yF + 1}" width="4" height="${ROW_FRAMES - 2}" fill="${laneColour(lanes.indexOf(L))}"/>`);
   s.push(`<text x="12" y="${L.yF + 13}" font-size="14" font-weight="600" fill="#1d2126">${esc(L.name || '(no name)')}</text>`);
   s.push(`<text x="12" y="${L.yF + 27}" font-size="11" fill="#68717d">${esc(speedText(L.speed))} \u00b7 if ${L.iface}</text>`);
   const r = (y, t) => s.push(`<text x="${LABEL_W - 12}" y="${y}" text-anchor="end" font-size="11" fill="#495057">${esc(t)}</text>`);
   r(L.yT + 13, 'token holder');
   r(L.yR + 14, ref && ref.lane === L ? 'bit times from ref' : 'bit times');
   L.dx.forEach((S, j) => r(L.yD + j * ROW_DX + 11, 'DX slave ' + S.a));
+}
+
+function acLineName(sp) {
+  if (sp[3] < 0) return 'none';
+  return sp[2] >= 0 ? (lanes[sp[2]].name || 'line ' + sp[3]) : 'line ' + sp[3] + ' (no lane)';
+}
+function acText(R, sp) {
+  return `STATION ${R.a} ACTIVE CHANNEL   ${sp[3] < 0 ? 'none' : acLineName(sp)}\n` +
+    `from ${fmtAbs(sp[0], 9)}\nto   ${fmtAbs(sp[1], 9)}\nfor  ${fmtDur(sp[1] - sp[0])}`;
+}
+function drawActive(s) {
+  if (!acRows.length) return;
+  s.push('<g class="active-channels">');
+  s.push(`<rect x="0" y="${acY - 6}" width="${LABEL_W - 8}" height="${acRows.length * ROW_AC + 12}" fill="#f7f8fa"/>`);
+  acRows.forEach((R, j) => {
+    const y = acY + j * ROW_AC;
+    s.push(`<g class="active-channel" data-station="${R.a}">`);
+    s.push(`<text x="${LABEL_W - 12}" y="${y + 11}" text-anchor="end" font-size="11" fill="#495057">station ${R.a} active</text>`);
+    s.push(`<g clip-path="url(#plotclip)"><rect x="${plotX}" y="${y}" width="${plotW}" height="${ROW_AC - 1}" fill="${j % 2 ? '#fbfbfc' : '#f4f6f8'}"/>`);
+    for (const sp of R.s) {
+      if (sp[1] < v0 || sp[0] > v1) continue;
+      const xa = Math.max(plotX, X(sp[0])), xb = Math.min(plotX + plotW, X(sp[1]));
+      const w = Math.max(1, xb - xa);
+      const fill = sp[2] >= 0 ? laneColour(sp[2]) : 'url(#achatch)';
+      s.push(`<rect class="ac-span" data-line="${sp[3]}" data-lane="${sp[2] >= 0 ? esc(lanes[sp[2]].name) : ''}" x="${xa.toFixed(2)}" y="${y + 2}" width="${w.toFixed(2)}" height="${ROW_AC - 5}" fill="${fill}"><title>${esc(acText(R, sp))}</title></rect>`);
+      const label = acLineName(sp);
+      if (w > label.length * 6.2 + 8)
+        s.push(`<text x="${(xa + 4).toFixed(2)}" y="${y + ROW_AC - 4}" font-size="10" fill="${sp[2] >= 0 ? '#fff' : '#495057'}">${esc(label)}</text>`);
+    }
+    s.push('</g></g>');
+  });
+  s.push('</g>');
 }
 
 function drawEvents(s) {
@@ -406,7 +448,9 @@ function render() {
   plotX = LABEL_W; plotW = W - LABEL_W - PAD_R; scale = plotW / (v1 - v0);
   drawnFrames = 0;
   const s = [];
-  s.push(`<defs><clipPath id="plotclip"><rect x="${plotX}" y="0" width="${plotW}" height="${totalH}"/></clipPath></defs>`);
+  s.push(`<defs><clipPath id="plotclip"><rect x="${plotX}" y="0" width="${plotW}" height="${totalH}"/></clipPath>` +
+    '<pattern id="achatch" width="6" height="6" patternUnits="userSpaceOnUse" patternTransform="rotate(45)">' +
+    '<rect width="6" height="6" fill="#f1f3f5"/><line x1="0" y1="0" x2="0" y2="6" stroke="#adb5bd" stroke-width="2"/></pattern></defs>');
   drawAxis(s);
   for (const L of lanes) {
     s.push(`<g class="lane" data-lane="${esc(L.name)}" data-interface="${L.iface}" data-frames="${L.start.length}">`);
@@ -415,6 +459,7 @@ function render() {
     drawFrames(s, L); drawToken(s, L); drawRuler(s, L); drawDx(s, L);
     s.push('</g></g>');
   }
+  drawActive(s);
   s.push('<g class="events" clip-path="url(#plotclip)">');
   drawEvents(s);
   s.push('</g>');
@@ -427,6 +472,7 @@ function render() {
   document.body.dataset.rendered = '1';
   document.body.dataset.framesDrawn = String(drawnFrames);
   document.body.dataset.lanes = String(lanes.length);
+  document.body.dataset.activeRows = String(acRows.length);
   if (history.replaceState) history.replaceState(null, '', '#v=' + Math.round(v0) + ',' + Math.round(v1));
 }
 
@@ -481,6 +527,11 @@ function hitTest(x, y) {
   if (x < plotX || x > plotX + plotW) return null;
   const t = T(x), tol = 3 / scale;
   if (y >= AXIS_H && y < AXIS_H + EV_H) return eventText(t, tol);
+  if (acRows.length && y >= acY && y < acY + acRows.length * ROW_AC) {
+    const R = acRows[Math.floor((y - acY) / ROW_AC)];
+    for (const sp of R.s) if (t >= sp[0] - tol && t <= sp[1] + tol) return acText(R, sp);
+    return null;
+  }
   for (const L of lanes) {
     if (y < L.y || y >= L.y + L.h) continue;
     if (y < L.yF + ROW_FRAMES) {
@@ -614,6 +665,11 @@ window.addEventListener('resize', schedule);
   parts.push('<span><b>DP cycle</b></span>');
   parts.push(`<span><span class="vl" style="background:${DX_OK}"></span>answered</span>`);
   parts.push(`<span><span class="vl" style="background:${DX_MISS}"></span>no answer</span>`);
+  if (acRows.length) {
+    parts.push('<span><b>active channel</b></span>');
+    lanes.forEach((L, i) => parts.push(`<span><span class="sw" style="background:${laneColour(i)}"></span>${esc(L.name || '(no name)')}</span>`));
+    parts.push('<span><span class="sw" style="background:repeating-linear-gradient(45deg,#adb5bd 0 2px,#f1f3f5 2px 5px)"></span>none</span>');
+  }
   parts.push('<span><b>events</b></span>');
   for (const k of ['fault', 'repair', 'event']) parts.push(`<span><span class="vl" style="background:${EVENT_COLOURS[k]}"></span>${k}</span>`);
   document.getElementById('legend').innerHTML = parts.join('');

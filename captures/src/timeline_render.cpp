@@ -221,6 +221,9 @@ std::int64_t rel(std::int64_t t, std::int64_t origin) {
 const char* const kKindColour[] = {"#8446c2", "#2468c9", "#2f9e48", "#13a3b4", "#e03131"};
 const char* const kHolderColour[] = {"#f6bd60", "#90caf9", "#b8e0a0", "#f7a8c4", "#cdb4f0", "#ffe08a",
                                      "#9fd8cb", "#f4a582", "#c7d2fe", "#d9ed92", "#e5c3a6", "#a5d8ff"};
+/// Colours of the lanes in the active-channel rows (as the page's LANE_COLOURS).
+const char* const kLaneColour[] = {"#1c7ed6", "#f59f00", "#0ca678", "#ae3ec9", "#d6336c", "#74b816"};
+const char* lane_colour(int lane) { return kLaneColour[static_cast<std::size_t>(lane) % 6]; }
 const char* event_colour(EventStyle s) {
   switch (s) {
     case EventStyle::Fault:
@@ -362,12 +365,25 @@ std::string page_json(const Timeline& tl, std::int64_t origin, std::int64_t view
           "\"," + json_str(to_string(e.record.category)) + "," + json_str(e.record.text) + "]";
   }
   ev += "]";
+  // Active channels (timeline.hpp): one row per switched station, spans [start, end, lane,
+  // line] in page time; lane -1 = none (or no lane for the line), line -1 = none.
+  std::string ac = "[";
+  for (std::size_t i = 0; i < tl.active_channels.size(); ++i) {
+    const ActiveChannelSpan& s = tl.active_channels[i];
+    const bool fresh = i == 0 || tl.active_channels[i - 1].station != s.station;
+    if (fresh) ac += std::string(i ? "]}," : "") + "{\"a\":" + std::to_string(s.station) + ",\"s\":[";
+    else ac += ',';
+    ac += "[" + std::to_string(rel(s.start_ns, origin)) + "," + std::to_string(rel(s.end_ns, origin)) +
+          "," + std::to_string(s.line_lane) + "," + std::to_string(s.line) + "]";
+  }
+  if (!tl.active_channels.empty()) ac += "]}";
+  ac += "]";
   std::string o = "{\"v\":1,\"origin\":\"" + std::to_string(origin) + "\",\"span\":[" +
                   std::to_string(rel(tl.from_ns, origin)) + "," + std::to_string(rel(tl.to_ns, origin)) +
                   "],\"view\":[" + std::to_string(rel(view_from, origin)) + "," +
                   std::to_string(rel(view_to, origin)) + "],";
   tables.write(o);
-  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + "}";
+  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + ",\"ac\":" + ac + "}";
   return o;
 }
 
@@ -381,6 +397,7 @@ std::uint64_t count_frames(const Timeline& tl) {
 
 constexpr int kLabelW = 210, kPadR = 18, kHeadH = 52, kAxisH = 34, kEvH = 46;
 constexpr int kRowFrames = 30, kRowToken = 18, kRowRuler = 20, kRowDx = 14, kLaneGap = 18;
+constexpr int kRowAc = 14;
 
 std::int64_t nice_step(double raw) {
   if (!(raw > 1)) return 1;
@@ -656,6 +673,50 @@ void svg_events(SvgCtx& c, const Timeline& tl, int y_top, int y_bottom) {
   }
 }
 
+std::string ac_line_name(const Timeline& tl, const ActiveChannelSpan& s) {
+  if (s.line < 0) return "none";
+  if (s.line_lane < 0 || static_cast<std::size_t>(s.line_lane) >= tl.lanes.size())
+    return "line " + std::to_string(s.line) + " (no lane)";
+  const std::string& n = tl.lanes[static_cast<std::size_t>(s.line_lane)].name;
+  return n.empty() ? "line " + std::to_string(s.line) : sanitize_utf8(n);
+}
+
+/// One row per switched station from y0 (timeline.hpp "Active channel").
+void svg_active(SvgCtx& c, const Timeline& tl, int y0) {
+  int row = -1;
+  for (std::size_t i = 0; i < tl.active_channels.size(); ++i) {
+    const ActiveChannelSpan& s = tl.active_channels[i];
+    if (i == 0 || tl.active_channels[i - 1].station != s.station) {
+      if (row >= 0) c.o += "</g></g>\n";
+      ++row;
+      const int yr = y0 + row * kRowAc;
+      c.o += "<g class=\"active-channel\" data-station=\"" + std::to_string(s.station) + "\">\n";
+      c.o += "<text x=\"" + std::to_string(kLabelW - 12) + "\" y=\"" + std::to_string(yr + 11) +
+             "\" text-anchor=\"end\" font-size=\"11\" fill=\"#495057\">station " +
+             std::to_string(s.station) + " active</text>\n<g clip-path=\"url(#plotclip)\">\n";
+      c.o += "<rect x=\"" + num(c.plot_x) + "\" y=\"" + std::to_string(yr) + "\" width=\"" +
+             num(c.plot_w) + "\" height=\"" + std::to_string(kRowAc - 1) + "\" fill=\"" +
+             (row % 2 ? "#fbfbfc" : "#f4f6f8") + "\"/>\n";
+    }
+    const int yr = y0 + row * kRowAc;
+    const double xa = c.clampx(c.x(s.start_ns)), xb = c.clampx(c.x(s.end_ns));
+    const double w = std::max(1.0, xb - xa);
+    const std::string name = ac_line_name(tl, s);
+    const std::string title = "station " + std::to_string(s.station) + " active channel: " + name +
+                              "\nfrom " + fmt_abs(s.start_ns, 9) + "\nto " + fmt_abs(s.end_ns, 9) +
+                              " (" + fmt_dur(diff(s.start_ns, s.end_ns)) + ")";
+    c.o += "<rect class=\"ac-span\" x=\"" + num(xa) + "\" y=\"" + std::to_string(yr + 2) +
+           "\" width=\"" + num(w) + "\" height=\"" + std::to_string(kRowAc - 5) + "\" fill=\"" +
+           (s.line_lane >= 0 ? std::string(lane_colour(s.line_lane)) : std::string("url(#achatch)")) +
+           "\"><title>" + xml(title) + "</title></rect>\n";
+    if (w > static_cast<double>(name.size()) * 6.2 + 8)
+      c.o += "<text x=\"" + num(xa + 4) + "\" y=\"" + std::to_string(yr + kRowAc - 4) +
+             "\" font-size=\"10\" fill=\"" + (s.line_lane >= 0 ? "#fff" : "#495057") + "\">" +
+             xml(name) + "</text>\n";
+  }
+  if (row >= 0) c.o += "</g></g>\n";
+}
+
 std::string cycle_text(const SlaveCycles& S, std::uint64_t speed) {
   std::set<int> masters;
   for (const DxPoll& p : S.polls) masters.insert(p.master);
@@ -812,6 +873,11 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     y += kRowFrames + 3 + kRowToken + 2 + kRowRuler + static_cast<int>(L.slaves.size()) * kRowDx +
          kLaneGap;
   }
+  const int ac_y = y;
+  int ac_rows = 0;
+  for (std::size_t i = 0; i < tl.active_channels.size(); ++i)
+    if (i == 0 || tl.active_channels[i - 1].station != tl.active_channels[i].station) ++ac_rows;
+  if (ac_rows) y += ac_rows * kRowAc + kLaneGap;
   const int lanes_end = y;
   std::vector<std::string> summary;
   for (const auto& L : tl.lanes) {
@@ -834,7 +900,11 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   c.o += "<rect x=\"0\" y=\"0\" width=\"" + std::to_string(width) + "\" height=\"" +
          std::to_string(height) + "\" fill=\"#ffffff\"/>\n";
   c.o += "<defs><clipPath id=\"plotclip\"><rect x=\"" + num(c.plot_x) + "\" y=\"0\" width=\"" +
-         num(c.plot_w) + "\" height=\"" + std::to_string(height) + "\"/></clipPath></defs>\n";
+         num(c.plot_w) + "\" height=\"" + std::to_string(height) +
+         "\"/></clipPath><pattern id=\"achatch\" width=\"6\" height=\"6\" "
+         "patternUnits=\"userSpaceOnUse\" patternTransform=\"rotate(45)\"><rect width=\"6\" "
+         "height=\"6\" fill=\"#f1f3f5\"/><line x1=\"0\" y1=\"0\" x2=\"0\" y2=\"6\" "
+         "stroke=\"#adb5bd\" stroke-width=\"2\"/></pattern></defs>\n";
   // Title and legend.
   c.o += "<text x=\"12\" y=\"20\" font-size=\"15\" font-weight=\"600\" fill=\"#1d2126\">pbvbus timeline \u2014 " +
          xml(opts.title.empty() ? std::string("capture") : opts.title) + "  <tspan font-weight=\"400\" fill=\"#68717d\">" +
@@ -864,6 +934,12 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     head("DP cycle");
     sw("#3f9b57", "answered", true);
     sw("#e03131", "no answer", true);
+    if (ac_rows) {
+      head("active channel");
+      for (std::size_t li = 0; li < tl.lanes.size(); ++li)
+        sw(lane_colour(static_cast<int>(li)), tl.lanes[li].name, false);
+      sw("url(#achatch)", "none", false);
+    }
     head("events");
     sw(event_colour(EventStyle::Fault), "fault", true);
     sw(event_colour(EventStyle::Repair), "repair", true);
@@ -913,6 +989,10 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
                (L.description.empty() ? std::string("no description") : L.description) + ", " +
                speed_text(L.speed)) +
            "</title></rect>\n";
+    if (ac_rows)
+      c.o += "<rect class=\"lane-colour\" x=\"3\" y=\"" + std::to_string(ly + 1) +
+             "\" width=\"4\" height=\"" + std::to_string(kRowFrames - 2) + "\" fill=\"" +
+             lane_colour(static_cast<int>(li)) + "\"/>\n";
     c.o += "<text x=\"12\" y=\"" + std::to_string(ly + 13) +
            "\" font-size=\"14\" font-weight=\"600\" fill=\"#1d2126\">" +
            xml(L.name.empty() ? std::string("(no name)") : L.name) + "</text>\n";
@@ -933,6 +1013,11 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     svg_ruler(c, L, yr);
     svg_dx(c, L, yd);
     c.o += "</g>\n</g>\n";
+  }
+  if (ac_rows) {
+    c.o += "<g class=\"active-channels\">\n";
+    svg_active(c, tl, ac_y);
+    c.o += "</g>\n";
   }
   c.o += "<g class=\"events\" clip-path=\"url(#plotclip)\">\n";
   svg_events(c, tl, kHeadH + kAxisH + 2, lanes_end - kLaneGap + 4);

@@ -2,7 +2,8 @@
 // headless Chromium takes a screenshot (a 1400x900 PNG with many colours, decoded with Python's
 // zlib) and dumps the DOM after the page script ran (body data-rendered="1", the lane group, the
 // DP cycle table, the fault marker); opened at a window of 150 µs through the URL fragment, the
-// page shows a bit-time axis, which it does not at the wide first view.
+// page shows a bit-time axis, which it does not at the wide first view. The page of a
+// switched-io run (10 s) draws one active-channel row per switched station (issue 7).
 //
 // Skipped, with the reason, when no Chromium is installed (Debian: apt-get install chromium);
 // PBVBUS_CHROMIUM may name the browser binary.
@@ -106,15 +107,14 @@ for y in range(h):
 print(w, h, len(seen))
 )PY";
 
+constexpr const char* kNoChromium =
+    "chromium is not installed (Debian: apt-get install chromium; or set PBVBUS_CHROMIUM): the "
+    "timeline page is not checked in a browser";
+
 class TimelineBrowser : public ::testing::Test {
  protected:
   void SetUp() override {
-    m_chromium = find_chromium();
-    if (m_chromium.empty())
-      GTEST_SKIP() << "chromium is not installed (Debian: apt-get install chromium; or set "
-                      "PBVBUS_CHROMIUM): the timeline page is not checked in a browser";
-    m_dir = fs::temp_directory_path() / ("timeline_browser_" + std::to_string(::getpid()));
-    fs::create_directories(m_dir);
+    if (!start()) GTEST_SKIP() << kNoChromium;
     const std::string capture = (m_dir / "mm.pcapng").string();
     std::ostringstream out, err;
     ASSERT_EQ(cmd_run({PBVBUS_SOURCE_DIR "/examples/multimaster.textproto", "--capture", capture,
@@ -125,6 +125,14 @@ class TimelineBrowser : public ::testing::Test {
     m_html = (m_dir / "mm.html").string();
     ASSERT_EQ(cmd_timeline({capture, "-o", m_html, "--from", "1990ms", "--to", "2030ms"}, out, err), 0)
         << err.str();
+  }
+  /// Finds chromium (false without) and makes the temp directory.
+  bool start() {
+    m_chromium = find_chromium();
+    if (m_chromium.empty()) return false;
+    m_dir = fs::temp_directory_path() / ("timeline_browser_" + std::to_string(::getpid()));
+    fs::create_directories(m_dir);
+    return true;
   }
   void TearDown() override {
     std::error_code ec;
@@ -204,6 +212,58 @@ TEST_F(TimelineBrowser, BitTimeAxisAtHighZoom) {
   EXPECT_GE(ticks, 5u);
   // Frames this wide carry their labels: the token passes 2 -> 3 that master 3 no longer takes.
   EXPECT_NE(svg.find("tok 2\u21923</text>"), std::string::npos);
+}
+
+/// The page of a run of examples/switched-io.textproto (10 s).
+class TimelineBrowserSwitched : public TimelineBrowser {
+ protected:
+  void SetUp() override {
+    if (!start()) GTEST_SKIP() << kNoChromium;
+    const std::string capture = (m_dir / "sw.pcapng").string();
+    std::ostringstream out, err;
+    ASSERT_EQ(cmd_run({PBVBUS_SOURCE_DIR "/examples/switched-io.textproto", "--capture", capture,
+                       "--quiet"},
+                      out, err),
+              0)
+        << err.str();
+    m_html = (m_dir / "sw.html").string();
+    ASSERT_EQ(cmd_timeline({capture, "-o", m_html}, out, err), 0) << err.str();
+  }
+};
+
+std::size_t count(const std::string& s, const std::string& what) {
+  std::size_t n = 0;
+  for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+  return n;
+}
+
+TEST_F(TimelineBrowserSwitched, ScriptDrawsTheActiveChannelRows) {
+  const auto [rc, dom] = chromium("--dump-dom", "file://" + m_html);
+  ASSERT_EQ(rc, 0);
+  EXPECT_NE(dom.find("data-rendered=\"1\""), std::string::npos) << "the page script did not run";
+  EXPECT_NE(dom.find("data-active-rows=\"4\""), std::string::npos);
+  const std::string svg = svg_of(dom);
+  ASSERT_NE(svg, "");
+  EXPECT_EQ(count(svg, "<g class=\"active-channel\" data-station="), 4u);
+  for (const char* st : {"3", "4", "5", "6"}) {
+    EXPECT_NE(svg.find(std::string("<g class=\"active-channel\" data-station=\"") + st + "\">"),
+              std::string::npos)
+        << st;
+    EXPECT_NE(svg.find(std::string(">station ") + st + " active</text>"), std::string::npos) << st;
+  }
+  // Spans on both lines, in their lanes' colours, and station 4's time without a channel
+  // (2.3 s .. 2.6 s) hatched; the first view is the whole run, so every span is drawn.
+  const std::size_t a = count(svg, "class=\"ac-span\" data-line=\"0\" data-lane=\"DP_A\" ");
+  const std::size_t b = count(svg, "class=\"ac-span\" data-line=\"1\" data-lane=\"DP_B\" ");
+  const std::size_t none = count(svg, "class=\"ac-span\" data-line=\"-1\" data-lane=\"\" ");
+  EXPECT_GE(a, 4u);
+  EXPECT_GE(b, 4u);
+  EXPECT_GE(none, 1u);
+  EXPECT_EQ(count(svg, "class=\"ac-span\""), a + b + none);
+  EXPECT_EQ(count(svg, "fill=\"url(#achatch)\""), none);
+  EXPECT_EQ(count(svg, "fill=\"#1c7ed6\"><title>STATION "), a);  // DP_A's colour
+  // The legend names the lanes' colours.
+  EXPECT_NE(dom.find("<b>active channel</b>"), std::string::npos);
 }
 
 }  // namespace

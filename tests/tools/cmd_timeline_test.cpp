@@ -1,7 +1,8 @@
 // `pbvbus timeline` on a real run of examples/multimaster.textproto (4 s, so the cable cut from
 // 2 s to 3 s is in it): the HTML page holds the lane, the frames and the events as JSON that
 // parses, its markup nests properly, and the SVG of the window around the cut is well-formed
-// XML; bad input and usage exit 2 with one line on stderr and nothing on stdout.
+// XML; bad input and usage exit 2 with one line on stderr and nothing on stdout. A run of
+// examples/switched-io.textproto gives the active-channel rows of its switched stations.
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -204,6 +205,75 @@ TEST_F(CmdTimeline, SvgOfTheCut) {
   EXPECT_LT(fs::file_size(all), 1'000'000u);
   const auto [rc2, out2] = python(kCheckSvg, all);
   EXPECT_EQ(rc2, 0) << out2;
+}
+
+// The active channel of the switched stations (issue 7) in the page of a real run of
+// examples/switched-io.textproto (10 s). The run writes no record of the active channel at
+// start-up (DP_A, set by the first Set_Prm), so a row starts at the station's first Redundancy
+// record: 3 at F10 (1 s), 4 at F11 (2 s, no channel 2.3 s .. 2.6 s), 6 at F13 (3.5 s), 5 at F9
+// (6.5 s); the short circuit on DP_B (5 s) and the master stop on DP_B (8.5 s) bring everyone
+// back to DP_A.
+constexpr const char* kCheckActive = R"PY(
+import json, sys
+page = open(sys.argv[1], encoding='utf-8').read()
+start = page.index('<script type="application/json" id="pbvbus-data">')
+start = page.index('>', start) + 1
+data = json.loads(page[start:page.index('</script>', start)])
+names = [L['name'] for L in data['lanes']]
+assert names == ['DP_A', 'DP_B'], names
+rows = data['ac']
+assert [r['a'] for r in rows] == [3, 4, 5, 6], [r['a'] for r in rows]
+end = data['span'][1] - 1
+def at(s, t):  # lane of the span at time t (s)
+    for a, b, lane, line in s:
+        if a <= t * 1e9 < b: return lane
+    return 'no span'
+for r in rows:
+    s = r['s']
+    assert all(a[1] == b[0] for a, b in zip(s, s[1:])), (r['a'], s)  # no gaps
+    assert all(a[2] != b[2] for a, b in zip(s, s[1:])), (r['a'], s)  # merged
+    assert all(sp[2] == sp[3] for sp in s), (r['a'], s)              # lane i is line i here
+    assert s[-1][1] == end and s[-1][2] == 0, (r['a'], s[-1], end)   # DP_A after 8.5 s
+    assert at(s, 7.0) == 1, (r['a'], s)                               # F9: DP_A's master fails
+by = {r['a']: r['s'] for r in rows}
+assert 1.0e9 <= by[3][0][0] < 1.1e9 and by[3][0][2] == 1, by[3]
+assert 2.0e9 <= by[4][0][0] < 2.1e9 and by[4][0][2] == 1, by[4]
+assert at(by[4], 2.2) == 1 and at(by[4], 2.5) == -1 and at(by[4], 2.7) == 1, by[4]
+assert 3.5e9 <= by[6][0][0] < 3.6e9 and by[6][0][2] == 1, by[6]
+assert 6.5e9 <= by[5][0][0] < 6.6e9 and len(by[5]) == 2, by[5]
+for a in (3, 4, 6):
+    # F14: the short circuit on DP_B at 5 s
+    assert at(by[a], 4.9) == 1 and at(by[a], 5.2) == 0 and at(by[a], 6.0) == 0, (a, by[a])
+print('ok', len(rows))
+)PY";
+
+TEST_F(CmdTimeline, ActiveChannelsOfTheSwitchedIoRun) {
+  const std::string capture = out_file("switched.pcapng");
+  std::ostringstream out, err;
+  ASSERT_EQ(cmd_run({PBVBUS_SOURCE_DIR "/examples/switched-io.textproto", "--capture", capture,
+                     "--quiet"},
+                    out, err),
+            0)
+      << err.str();
+  const std::string html = out_file("switched.html");
+  const Result r = timeline({capture, "-o", html});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  const std::string page = read_file(html);
+  EXPECT_NE(page.find(",\"ac\":[{\"a\":3,\"s\":[["), std::string::npos);
+  const auto [rc, py] = python(kCheckActive, html);
+  EXPECT_EQ(rc, 0) << py;
+  EXPECT_EQ(py, "ok 4\n");
+
+  // The static picture has the four rows too.
+  const std::string svg = out_file("switched.svg");
+  ASSERT_EQ(timeline({capture, "-o", svg}).rc, 0);
+  const std::string doc = read_file(svg);
+  for (const char* st : {"3", "4", "5", "6"}) {
+    EXPECT_NE(doc.find(std::string("<g class=\"active-channel\" data-station=\"") + st + "\">"),
+              std::string::npos)
+        << st;
+    EXPECT_NE(doc.find(std::string(">station ") + st + " active</text>"), std::string::npos) << st;
+  }
 }
 
 TEST_F(CmdTimeline, BadInputExits2) {

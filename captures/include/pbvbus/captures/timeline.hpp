@@ -1,7 +1,8 @@
 #pragma once
 // The model behind `pbvbus timeline CAPTURE` (issue 6, "a picture of the bus"): a capture read
 // into lanes of frames with their times on the wire, who held the token when, the DP cycle of
-// every slave, and the events. timeline_render.hpp draws it as HTML or SVG.
+// every slave, the events, and (issue 7) the active channel of every switched station.
+// timeline_render.hpp draws it as HTML or SVG.
 //
 // Decisions:
 //  - One lane per interface with link type USER0 (147) or PROFIBUS_DL (257), in interface
@@ -43,12 +44,30 @@
 //    do not decode are counted in `bad_event_records`. Line events that inject a fault (cable cut,
 //    short circuit, noise on, power off, transceiver failure, babbling on) are faults; their
 //    opposites are repairs; everything else is a plain event.
-//  - Window [from_ns, to_ns): frames and token spans that overlap it, polls and events that
-//    start in it. Without a window: from the earliest record to 1 ns after the end of the
-//    latest frame or event (so that what happens last is inside; to_ns saturates at the int64
-//    limit, and a window ending there includes it). Token spans and cycle times are worked
-//    out on the whole capture first, so a window does not change them; the per-slave summary
-//    covers the polls in the window. Times are the capture's own (virtual time since the start
+//  - Active channel of a switched station (issue 7): from the Redundancy event records
+//    (category 4; code = redundancy::SystemEvent::Kind, a = station address, line = the line's
+//    index, Line::index()). A station gets a row if it has at least one switchover record
+//    (code 6, "station a's active channel is now line `line`", also at start-up); stations
+//    without one (one-sided slaves, the master system with a = -1) get none. Its row starts at
+//    the station's first Redundancy record of any kind, with no active channel until the first
+//    switchover; a station failure (code 2) means no active channel until the next switchover;
+//    other codes change nothing. The last span lasts to last_ns (the end of the capture).
+//    A pbvbus run writes no record for the channel a station starts on (its first Set_Prm
+//    makes line A active), so such a station's row starts with its first fault's records.
+//    Consecutive spans of the same line are one span; a span that another record at the same
+//    instant replaces (zero length, not the last) is dropped. A line index names a lane as a
+//    Line event does: the Line event records (category 1) of that line index start their text
+//    with the line's name ("DP_A: power on"), and the line's lane is the first lane named NAME
+//    or NAME@...; for a line index without a Line event, the lanes are grouped by the name
+//    before '@' in interface order (pbvbus declares each line's interfaces together, in line
+//    index order) and the Nth group's first lane is line N's. A line index with no such lane
+//    keeps its index with line_lane = -1. Worked out on the whole capture like the token spans.
+//  - Window [from_ns, to_ns): frames, token spans and active-channel spans that overlap it,
+//    polls and events that start in it. Without a window: from the earliest record to 1 ns
+//    after the end of the latest frame or event (so that what happens last is inside; to_ns
+//    saturates at the int64 limit, and a window ending there includes it). Token spans, active
+//    channels and cycle times are worked out on the whole capture first, so a window does not
+//    change them; the per-slave summary covers the polls in the window. Times are the capture's own (virtual time since the start
 //    of the run for pbvbus captures).
 //  - Errors: anything the reader rejects (not pcapng, truncated or malformed block) fails the
 //    whole build with the reader's message and offset: a partial picture of a broken file would
@@ -147,6 +166,15 @@ struct TimelineEvent {
   EventStyle style = EventStyle::Event;
 };
 
+/// A time in which a switched station's active channel was one line (or none).
+struct ActiveChannelSpan {
+  int station = 0;     ///< the station's address
+  int line = -1;       ///< line index (Line::index()) of the active channel; -1 = none
+  int line_lane = -1;  ///< index into Timeline::lanes of that line; -1 = none, or no lane
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+};
+
 struct Timeline {
   std::int64_t from_ns = 0;  ///< the window
   std::int64_t to_ns = 0;
@@ -154,6 +182,8 @@ struct Timeline {
   std::int64_t last_ns = 0;   ///< end of the latest frame, or the latest event
   std::vector<TimelineLane> lanes;
   std::vector<TimelineEvent> events;  ///< in the window, by time
+  /// In the window, by station, then by start time (one row per switched station).
+  std::vector<ActiveChannelSpan> active_channels;
   std::uint64_t records = 0;
   std::uint64_t bad_event_records = 0;
   std::uint64_t skipped_interfaces = 0;

@@ -246,6 +246,18 @@ TEST(RedundantMasterSystem, StartUpMakesLineAActiveOnEveryStation) {
   EXPECT_EQ(s.ms().active(kOneB), 1);
   EXPECT_TRUE(s.s7().empty());
   EXPECT_EQ(s.ms().switchovers(), 0u);
+  // One start-up record per switched station: line A, from no channel, when master A read the
+  // station's Red_Status showing Primary (its first diagnosis in data exchange).
+  int records = 0;
+  for (const auto& e : s.ms().events()) {
+    ASSERT_EQ(e.kind, K::Switchover);
+    EXPECT_EQ(e.cause, SystemEvent::Cause::StartUp);
+    EXPECT_EQ(e.line, 0);
+    EXPECT_EQ(e.from, -1);
+    EXPECT_LT(e.time, 20 * kMs);
+    ++records;
+  }
+  EXPECT_EQ(records, 2);
   // The program's outputs reach the modules: the backplane follows the counter.
   EXPECT_GT(s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8), 0);
   smp.expect_no_pulse(0, 0);
@@ -392,7 +404,7 @@ TEST(RedundantMasterSystem, ShortCircuitIsOneMasterSystemFailure) {
   // Both switchovers were commanded at the line loss, in the same instant.
   int sw = 0;
   for (const auto& e : s.ms().events())
-    if (e.kind == K::Switchover) {
+    if (e.kind == K::Switchover && e.cause != SystemEvent::Cause::StartUp) {
       EXPECT_EQ(e.time, ev[0].time);
       EXPECT_EQ(e.line, 1);
       ++sw;

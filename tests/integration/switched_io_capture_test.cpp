@@ -87,12 +87,15 @@ TEST(SwitchedIoCapture, TsharkShowsTheS7EventsAndThePrmCmds) {
       {"master system failure", "W#16#39C3", "-1"},
       {"master system return", "W#16#38C3", "-1"}};
   EXPECT_EQ(rows, want);
-  // Switchover records: station 3 to line B first (F10).
+  // Switchover records: one start-up record per station (line DP_A), then station 3 to line B
+  // first (F10).
   const auto sw = test::tshark_fields(path, {"pbevent.a", "pbevent.text"},
                                       "pbevent.category == 4 && pbevent.code == 6");
-  ASSERT_FALSE(sw.empty());
-  EXPECT_EQ(sw[0][0], "3");
-  EXPECT_NE(sw[0][1].find("to line DP_B"), std::string::npos) << sw[0][1];
+  ASSERT_GE(sw.size(), 5u);
+  for (std::size_t i = 0; i < 4; ++i)
+    EXPECT_NE(sw[i][1].find("to line DP_A (start-up)"), std::string::npos) << sw[i][1];
+  EXPECT_EQ(sw[4][0], "3");
+  EXPECT_NE(sw[4][1].find("to line DP_B"), std::string::npos) << sw[4][1];
   // PrmCmd blocks on the wire: start-up Set_Prms on both lines (Primary_Request on DP_A only),
   // then the pure PrmCmds of the commanded switchovers.
   const auto prm = test::tshark_fields(path, {"frame.interface_name", "pbdp.prmcmd.function"},

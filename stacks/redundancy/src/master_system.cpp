@@ -60,6 +60,7 @@ std::string_view to_string(SystemEvent::Cause c) {
     case SystemEvent::Cause::LineLost: return "line lost";
     case SystemEvent::Cause::SwitchoverTimeout: return "switchover timeout";
     case SystemEvent::Cause::StartUp: return "start-up";
+    case SystemEvent::Cause::Station: return "by the station";
   }
   return "?";
 }
@@ -184,7 +185,7 @@ void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {
     case K::StationFailure: channel_down(*s, line, e.time, reporting(line)); break;
     case K::DataExchangeEntered: channel_up(*s, line, e.time, e.diag); break;
     case K::Diagnosis:
-      if (s->switched) observe_red_status(*s, line, e.diag);
+      if (s->switched) observe_red_status(*s, line, e.diag, e.time);
       break;
     case K::Alarm: on_alarm_event(*s, line, e); break;
     case K::AlarmAcknowledged: on_alarm_ack(*s, line, e); break;
@@ -237,12 +238,17 @@ void MasterSystem::on_alarm_ack(Station& s, int line, const dp::MasterEvent& e) 
   });
 }
 
-void MasterSystem::observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag) {
+void MasterSystem::observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag,
+                                      bus::Ticks now) {
   const auto rs = find_red_status(diag);
   if (!rs || !rs->own.primary || !s.up[line]) return;
   // The station says which interface drives its outputs: that is the active channel, whether
   // we commanded it or the station switched by itself.
+  const int from = s.active;
   s.active = line;
+  if (from != line && s.target != line)
+    emit(SystemEvent::Kind::Switchover, now, line, s.address,
+         from < 0 ? SystemEvent::Cause::StartUp : SystemEvent::Cause::Station, from);
   if (s.target == line) {
     s.target = -1;
     s.deadline = bus::kNever;
@@ -280,7 +286,7 @@ void MasterSystem::channel_up(Station& s, int line, bus::Ticks now,
       emit(SystemEvent::Kind::RedundancyLoss, now, other, s.address,
            SystemEvent::Cause::ChannelMissing);
   }
-  observe_red_status(s, line, diag);
+  observe_red_status(s, line, diag, now);
   const bool has_primary = s.active >= 0 && s.up[s.active];
   if (!has_primary && s.target < 0) switch_to(s, line, now, SystemEvent::Cause::StartUp);
 }

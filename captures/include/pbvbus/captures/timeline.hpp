@@ -52,8 +52,8 @@
 //    the station's first Redundancy record of any kind, with no active channel until the first
 //    switchover; a station failure (code 2) means no active channel until the next switchover;
 //    other codes change nothing. The last span lasts to last_ns (the end of the capture).
-//    A pbvbus run writes no record for the channel a station starts on (its first Set_Prm
-//    makes line A active), so such a station's row starts with its first fault's records.
+//    A pbvbus run writes a start-up switchover record when the system first sees a station's
+//    primary (redundancy::MasterSystem), so a row starts within the first DP cycles.
 //    Consecutive spans of the same line are one span; a span that another record at the same
 //    instant replaces (zero length, not the last) is dropped. A line index names a lane as a
 //    Line event does: the Line event records (category 1) of that line index start their text

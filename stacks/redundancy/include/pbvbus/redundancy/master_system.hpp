@@ -51,6 +51,10 @@
 //   two channels), so whichever channel is active carries the newest value and a switchover
 //   can never bring an older one. Inputs (and the diagnosis the program uses) come from the
 //   active channel's master image (active_image()).
+// - Switchover records (no OB): one whenever the system commands a channel, and one whenever the
+//   station's reported primary changes without a command (its first primary at start-up,
+//   cause StartUp; an autonomous switch, cause Station), so the record stream always says
+//   which channel is active (captures, timeline).
 // - Seq_Nr: one counter per station, incremented for every PrmCmd that changes a block.
 // - Alarms (S8, "no interrupt lost, none twice"): the station raises an alarm on its PRIMARY
 //   only and raises it again on the new PRIMARY when the primary changes before the master's
@@ -138,6 +142,7 @@ struct SystemEvent {
     LineLost,           ///< a whole line lost (MasterFailure: per-station events)
     SwitchoverTimeout,  ///< F24: the station did not take the commanded role in time
     StartUp,            ///< Switchover: first choice of an active channel
+    Station,            ///< Switchover record: the station changed its primary by itself
   };
   Kind kind = Kind::RedundancyLoss;
   bus::Ticks time = 0;
@@ -241,7 +246,8 @@ class MasterSystem {
   void channel_down(Station& s, int line, bus::Ticks now, bool report,
                     SystemEvent::Cause cause = SystemEvent::Cause::ChannelFailure);
   void channel_up(Station& s, int line, bus::Ticks now, std::span<const std::uint8_t> diag);
-  void observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag);
+  void observe_red_status(Station& s, int line, std::span<const std::uint8_t> diag,
+                          bus::Ticks now);
   void on_alarm_event(Station& s, int line, const dp::MasterEvent& e);
   void on_alarm_ack(Station& s, int line, const dp::MasterEvent& e);
   struct Record {

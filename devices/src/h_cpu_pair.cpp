@@ -346,8 +346,7 @@ void HCpuPair::expire(int r, bus::Ticks now) {
       break;
     case CpuState::ErrorSearch:
       if (c.hw_fault) {
-        c.defective = true;
-        set_state(r, CpuState::Defective, now, "self-test: fault found");
+        make_defective(r, now, "self-test: fault found");
       } else {
         diag(r, now, "self-test: no fault found");
         if (c.switch_run && c.role == CpuRole::Standby && linked(r) &&
@@ -366,6 +365,10 @@ void HCpuPair::expire(int r, bus::Ticks now) {
 void HCpuPair::evaluate(bus::Ticks now) {
   for (int r = 0; r < 2; ++r) {
     Cpu& c = m_cpu[r];
+    // A standby that sees over a whole link that its partner is off is the only CPU: master.
+    if (c.role == CpuRole::Standby && c.state != CpuState::Defective && link_whole() &&
+        !powered(partner(r)))
+      set_role(r, CpuRole::Master, now, "only CPU");
     if (c.state != CpuState::Stop || !c.want_run) continue;
     if (c.role == CpuRole::Master) {
       c.want_run = false;
@@ -412,6 +415,22 @@ void HCpuPair::stop_cpu(int r, bus::Ticks now, std::string_view why) {
   c.hold_remaining = -1;
   c.want_run = false;
   set_state(r, CpuState::Stop, now, why);
+}
+
+void HCpuPair::make_defective(int r, bus::Ticks now, std::string_view why) {
+  Cpu& c = m_cpu[r];
+  c.defective = true;
+  c.deadline = bus::kNever;
+  c.after_update = Pending::None;
+  c.want_run = false;
+  set_state(r, CpuState::Defective, now, why);
+  if (c.role == CpuRole::Master) {
+    // A DEFECTIVE CPU is never master: a linked standby partner takes the role (in its state).
+    set_role(r, CpuRole::Standby, now, "defective");
+    const int p = partner(r);
+    if (linked(r) && m_cpu[p].role == CpuRole::Standby && m_cpu[p].state != CpuState::Defective)
+      set_role(p, CpuRole::Master, now, "partner CPU defective");
+  }
 }
 
 void HCpuPair::begin_link_up(int s, bus::Ticks now, Pending after) {
@@ -727,9 +746,7 @@ bool HCpuPair::one_sided_ob121(int r, bus::Ticks now) {
   if (is_1500()) {
     stop_cpu(r, now, "one-sided OB 121");
   } else if (repeated) {
-    c.defective = true;
-    c.deadline = bus::kNever;
-    set_state(r, CpuState::Defective, now, "one-sided OB 121 repeated within 7 days");
+    make_defective(r, now, "one-sided OB 121 repeated within 7 days");
   } else {
     set_state(r, CpuState::ErrorSearch, now, "one-sided OB 121");
     c.deadline = now + m_p.self_test_time;

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -538,6 +540,157 @@ TEST(HCpuPair, DiagBufferHasVirtualTimestampsAndRoles) {
   EXPECT_EQ(d.front().at, kCpu1On);
   EXPECT_TRUE(has_diag(p, 1, kRedundantAt, "UPDATE -> RUN"));
   EXPECT_EQ(d.back().role, CpuRole::Standby);
+}
+
+TEST(HCpuPair, LoneDefectiveCpuRepairedBecomesMaster) {
+  HCpuPair p;
+  bring_up(p);
+  p.inject_hardware_fault(1, sec(9));
+  p.inject_comparison_error(sec(10));
+  p.on_time(sec(100));  // 10 s + 90 s: DEFECTIVE
+  p.power_off(0, sec(110));
+  EXPECT_EQ(p.role(1), CpuRole::Standby);  // a DEFECTIVE CPU is never master
+  p.repair_cpu(1, sec(120));
+  EXPECT_EQ(p.role(1), CpuRole::Master);
+  p.switch_to_run(1, sec(121));
+  EXPECT_EQ(p.state(1), CpuState::Startup);
+}
+
+TEST(HCpuPair, OneFibreCutDuringLinkUpAbortsIt) {
+  HCpuPair p;
+  p.power_on(0, 0);
+  p.on_time(kStartup);
+  p.power_on(1, kCpu1On);
+  p.cut_fibre(1, kCpu1On + sec(1));  // during LINK-UP (5 s .. 7 s)
+  EXPECT_EQ(p.state(1), CpuState::Stop);
+  EXPECT_EQ(p.system_mode(), SystemMode::Solo);
+  EXPECT_TRUE(obs(p, 72).empty());
+  EXPECT_TRUE(p.leds(0).ifm2f);
+  EXPECT_FALSE(p.leds(0).ifm1f);
+}
+
+// Seeded random operations; after each: the invariants the rules promise.
+TEST(HCpuPair, RandomOperationsKeepInvariants) {
+  for (std::uint32_t seed : {1u, 2u, 3u, 4u}) {
+    SCOPED_TRACE(seed);
+    std::mt19937 rng(seed);
+    HCpuPairParams prm;
+    if (seed == 4) prm.profile = HProfile::S7_1500RH;
+    HCpuPair p(prm);
+    Ticks now = 0;
+    bool split_seen = false;
+    for (int step = 0; step < 10000; ++step) {
+      const int r = static_cast<int>(rng() % 2);
+      const auto op = static_cast<unsigned>(rng() % 28);  // 16..27: time passes with a RUN request
+      if (rng() % 50 == 0) {
+        now += 3 * kDay;
+      } else {
+        now += static_cast<Ticks>(rng() % 5000) * ms(1);
+      }
+      p.on_time(now);
+      switch (op) {
+        case 0:
+        case 1:
+          if (!p.link_whole()) split_seen = true;
+          p.power_on(r, now);
+          break;
+        case 2:
+          p.power_off(r, now);
+          break;
+        case 3:
+        case 4:
+          p.switch_to_run(r, now);
+          break;
+        case 5:
+          p.switch_to_stop(r, now);
+          break;
+        case 6:
+          p.cut_fibre(r, now);
+          break;
+        case 7:
+          if (p.link_whole()) split_seen = true;
+          p.cut_both_fibres(now);
+          break;
+        case 8:
+        case 9:
+          p.repair_fibre(r, now);
+          break;
+        case 10:
+          p.hold(r, now);
+          break;
+        case 11:
+          p.release_hold(r, now);
+          break;
+        case 12:
+          p.inject_comparison_error(now);
+          break;
+        case 13:
+          p.one_sided_ob121(r, now);
+          break;
+        case 14:
+          if (rng() % 4 == 0) p.inject_hardware_fault(r, now);
+          p.repair_cpu(1 - r, now);
+          break;
+        case 15:
+          p.request_master_swap(now);
+          break;
+        default:
+          p.switch_to_run(r, now);
+          break;
+      }
+      EXPECT_GT(p.next_deadline(), now);
+      for (int i = 0; i < 2; ++i) {
+        const int o = 1 - i;
+        const CpuState st = p.state(i);
+        if (st == CpuState::Off) {
+          EXPECT_EQ(p.role(i), CpuRole::None);
+        }
+        if (st == CpuState::Defective) {
+          EXPECT_NE(p.role(i), CpuRole::Master);
+        }
+        const bool syncing_standby =
+            st == CpuState::LinkUp || st == CpuState::Update ||
+            (p.role(i) == CpuRole::Standby && (st == CpuState::Run || st == CpuState::SyncUp));
+        if (syncing_standby) {
+          EXPECT_EQ(p.role(i), CpuRole::Standby);
+          EXPECT_TRUE(p.link_whole());
+          EXPECT_EQ(p.role(o), CpuRole::Master);
+          EXPECT_TRUE(p.state(o) == CpuState::Run || p.state(o) == CpuState::SyncUp);
+        }
+      }
+      if (p.master_count() == 2) {
+        EXPECT_TRUE(split_seen);
+      }
+      if (p.accesses_switched_io(0) && p.accesses_switched_io(1)) {
+        EXPECT_EQ(p.master_count(), 2);
+      }
+      if (::testing::Test::HasFailure()) return;
+    }
+    Ticks last = 0;
+    int redundant = 0, two_masters = 0, error_search = 0, defective = 0, ob72 = 0;
+    for (const HEvent& e : p.events()) {
+      EXPECT_GE(e.at, last);
+      last = e.at;
+      if (e.kind == HEvent::Kind::SystemMode && e.to_mode == SystemMode::Redundant) ++redundant;
+      if (e.kind == HEvent::Kind::Role && e.role == CpuRole::Master &&
+          e.from_role == CpuRole::Standby)
+        ++two_masters;
+      if (e.kind == HEvent::Kind::State && e.to_state == CpuState::ErrorSearch) ++error_search;
+      if (e.kind == HEvent::Kind::State && e.to_state == CpuState::Defective) ++defective;
+      if (e.kind == HEvent::Kind::Ob && e.ob == 72) ++ob72;
+    }
+    // The walk reaches the interesting states (not only the invariants' trivial cases).
+    EXPECT_GE(redundant, 10);
+    EXPECT_GE(two_masters, 5);
+    EXPECT_GE(ob72, 10);
+    if (prm.profile == HProfile::S7_400H) {
+      EXPECT_GE(error_search, 3);
+    }
+    std::printf(
+        "seed %u: Redundant %d, standby->master %d, ERROR-SEARCH %d, DEFECTIVE %d, "
+        "OB 72 %d\n",
+        seed, redundant, two_masters, error_search, defective, ob72);
+  }
 }
 
 }  // namespace

@@ -278,6 +278,7 @@ class HCpuPair {
   /// A CPU leaves RUN/link-up states (power-off or STOP): the partner's reaction.
   void partner_lost(int r, bool master_was, CpuState was, bool power, bus::Ticks now);
   void stop_cpu(int r, bus::Ticks now, std::string_view why);
+  void make_defective(int r, bus::Ticks now, std::string_view why);
 
   HCpuPairParams m_p;
   bus::Ticks m_update_time;

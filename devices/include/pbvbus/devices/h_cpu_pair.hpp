@@ -51,7 +51,9 @@
 // - ERROR-SEARCH lasts `self_test_time`; a latent fault (inject_hardware_fault) -> DEFECTIVE,
 //   else the CPU links up again (LINK-UP -> UPDATE) and at the end of the update the roles swap
 //   (001 §5.3.6): both RUN in Redundant mode, OB 72 on both (digest §10 item 1: OB 72).
-//   DEFECTIVE persists across power cycles until repair_cpu().
+//   DEFECTIVE persists across power cycles until repair_cpu(); a DEFECTIVE CPU is never master
+//   (a linked standby takes the role). A standby that sees over a whole link that its partner
+//   is off becomes master in its current state.
 // - request_master_swap() (PG/ES "switch to CPU with modified configuration"; Solo, standby in
 //   STOP): link-up and update, then the old standby is master in RUN (Solo) and the old master
 //   STOPs; OB 72 on the new master.

@@ -1,0 +1,296 @@
+#pragma once
+// The CPU pair of an S7-400H-style H-system (issue 8, deliverable 2 and the first parts of 4
+// and 5; seeds-digest.md §1, §4, §6, §7; docs/h-system.md has the states, the rules and every
+// decision): two CPUs, rack 0 and rack 1, joined by a sync link of two fibres (0 = upper,
+// 1 = lower). Per CPU: operating state, role (master/standby), mode switch, diagnostic buffer,
+// LEDs; for the pair: the system mode derived as in the digest's table, and events with their
+// virtual time, rack and role (state and role changes, system-mode changes, OB 72, OB 121).
+//
+// Sans-I/O: no threads, no clock, no bus. The owner calls on_time(now) at next_deadline() and
+// the operations at a virtual time; every operation first runs the deadlines due at `now`
+// (on_time(now)), so a deadline and an operation at the same instant see the deadline first.
+// The DP master systems, the user program and the process images are not here: the owner reads
+// is_master(), accesses_switched_io(), dp_master_running() and dp_master_operate() and the
+// events, and drives devices::RedundantMasterSystemModel from them.
+//
+// Decisions (summary; the reasons are in docs/h-system.md):
+// - Roles are decided at power-on ("started" = power_on(), independent of the mode switch).
+//   A CPU that powers on while its partner is linked and master becomes standby. A CPU alone
+//   (partner off or the sync link not whole) becomes master at once, unless it remembers being
+//   standby: then it waits `role_window` (3 s) for its partner; if the partner powers on within
+//   the window (now < own power-on + 3 s) the remembered assignment stays (rack roles as
+//   before: "simultaneous power-on"), else at power-on + 3 s it becomes master (R2: the standby
+//   started >= 3 s before the master swaps the roles; a master powering on at exactly +3 s
+//   finds the swap done). Roles are remembered across power cycles. A first-ever power-on has
+//   no memory: the first power_on() call is master; power_on_both() is the simultaneous
+//   power-on and makes rack 0 master when nothing is remembered.
+// - The mode switch: switch_to_run(r) is a STOP -> RUN request (the PG/ES restart too);
+//   switch_to_stop(r) is the switch at STOP. A CPU stopped by a fault (fibre cut, aborted
+//   link-up, refused link-up) stays in STOP until the next switch_to_run(). power_on() starts
+//   the CPU when its switch is at RUN and it was not in STOP when it lost power (digest §4).
+// - STARTUP (startup_time) runs on the master only; a standby whose switch is at RUN waits in
+//   STOP until the master is in RUN (Solo), then goes LINK-UP (link_up_time) -> UPDATE
+//   (update_time) -> RUN (Redundant). The master stays RUN throughout (Table 4-1).
+// - Leaving Redundant: master power-off or STOP -> the standby becomes master in Solo, OB 72 on
+//   it; standby power-off or STOP -> Solo, OB 72 on the master. During link-up/update: the
+//   link-up is aborted (the standby to STOP; if the master was lost, the survivor becomes
+//   master in STOP). A lone powered CPU whose linked partner powers off is master.
+// - Sync link: both fibres are needed for link-up and Redundant mode. One fibre cut while
+//   linked (F5): the standby STOPs, OB 72 on the master if it runs. cut_both_fibres() (F6):
+//   a standby in RUN becomes a second master in RUN, OB 72 on both; a standby still linking
+//   up STOPs. Two cut_fibre() calls are two events, the first one F5. Fibres cut before
+//   power-on (F7): each CPU is alone, so both may run as master. A repair does not start a
+//   link-up (a STOP -> RUN is needed) and does not end a split: a master switched to STOP
+//   while the other master runs over a whole link becomes its standby.
+// - Comparison error (F16, Redundant only): the standby goes ERROR-SEARCH (or STOP, per
+//   `comparison_reaction`), OB 72 on the master (Solo). In the first cyclic self-test period
+//   after an ERROR-SEARCH that found nothing, a new comparison error STOPs the standby (000
+//   Table 4-4). One-sided OB 121 (F17, Redundant only): OB 121 on that CPU, which goes
+//   ERROR-SEARCH (the partner becomes master if needed, OB 72 on it); a second one on the same
+//   CPU within `defective_window` (7 days, inclusive) -> DEFECTIVE at once.
+// - ERROR-SEARCH lasts `self_test_time`; a latent fault (inject_hardware_fault) -> DEFECTIVE,
+//   else the CPU links up again (LINK-UP -> UPDATE) and at the end of the update the roles swap
+//   (001 §5.3.6): both RUN in Redundant mode, OB 72 on both (digest §10 item 1: OB 72).
+//   DEFECTIVE persists across power cycles until repair_cpu(); a DEFECTIVE CPU is never master
+//   (a linked standby takes the role). A standby that sees over a whole link that its partner
+//   is off becomes master in its current state.
+// - request_master_swap() (PG/ES "switch to CPU with modified configuration"; Solo, standby in
+//   STOP): link-up and update, then the old standby is master in RUN (Solo) and the old master
+//   STOPs; OB 72 on the new master.
+// - S7-1500R/H profile: STOP -> STARTUP (primary only) -> RUN-Solo -> SYNCUP (both CPUs,
+//   link_up_time + update_time) -> RUN-Redundant; roles named primary/backup; no HOLD; a
+//   comparison error or one-sided OB 121 STOPs the CPU (no ERROR-SEARCH in the 1500 excerpt).
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/bus/time.hpp"
+
+namespace pbvbus::devices {
+
+enum class CpuState : std::uint8_t {
+  Off,  ///< powered off (CPU or PS failure)
+  Stop,
+  Startup,
+  Run,  ///< Solo or Redundant (the system mode tells which); 1500: RUN-Solo / RUN-Redundant
+  LinkUp,
+  Update,
+  Hold,
+  ErrorSearch,
+  Defective,
+  SyncUp,  ///< S7-1500R/H profile only
+};
+std::string_view to_string(CpuState s);
+
+enum class CpuRole : std::uint8_t { None, Master, Standby };
+/// "master"/"standby" (S7-400H) or "primary"/"backup" (S7-1500R/H).
+enum class HProfile : std::uint8_t { S7_400H, S7_1500RH };
+std::string_view to_string(CpuRole r, HProfile p = HProfile::S7_400H);
+
+enum class SystemMode : std::uint8_t {
+  Stop,
+  Startup,
+  Solo,
+  LinkUp,
+  Update,
+  Redundant,
+  Hold,
+  SyncUp
+};
+std::string_view to_string(SystemMode m, HProfile p = HProfile::S7_400H);
+
+enum class Redf : std::uint8_t { Off, Flash0_5Hz, Flash2Hz, On };
+std::string_view to_string(Redf r);
+
+enum class ComparisonReaction : std::uint8_t { ErrorSearch, Stop };
+
+/// Why an OB 72 ran (the seeds give no event IDs for OB 72: HEvent::code stays 0).
+enum class HReason : std::uint8_t {
+  None,
+  MasterLost,       ///< the master failed or was powered off: the standby took over
+  MasterStop,       ///< the master went to STOP in Redundant mode: the standby took over
+  StandbyLost,      ///< the standby failed or was powered off
+  StandbyStop,      ///< the standby went to STOP
+  LinkLost,         ///< one fibre (F5) or both fibres (F6) of the sync link
+  ComparisonError,  ///< F16
+  OneSidedOb121,    ///< F17
+  MasterSwap,       ///< automatic swap after ERROR-SEARCH or the operator's swap
+};
+std::string_view to_string(HReason r);
+
+struct HEvent {
+  enum class Kind : std::uint8_t { State, Role, SystemMode, Ob };
+  Kind kind = Kind::State;
+  bus::Ticks at = 0;
+  int rack = 0;
+  CpuRole role = CpuRole::None;  ///< the CPU's role after the event
+  CpuState from_state = CpuState::Off, to_state = CpuState::Off;        ///< Kind::State
+  CpuRole from_role = CpuRole::None;                                    ///< Kind::Role (to = role)
+  SystemMode from_mode = SystemMode::Stop, to_mode = SystemMode::Stop;  ///< Kind::SystemMode
+  int ob = 0;                                                           ///< Kind::Ob: 72 or 121
+  std::uint16_t code = 0;  ///< event ID where the digest gives one, else 0
+  HReason reason = HReason::None;
+};
+
+struct DiagEntry {
+  bus::Ticks at = 0;
+  CpuRole role = CpuRole::None;
+  std::uint16_t code = 0;
+  std::string text;
+};
+
+struct CpuLeds {
+  bool mstr = false;   ///< this CPU accesses the switched I/O (master, powered)
+  bool rack0 = false;  ///< powered CPU in rack 0
+  bool rack1 = false;
+  Redf redf = Redf::Off;
+  bool ifm1f = false;  ///< upper fibre fault (cut, or no partner on it)
+  bool ifm2f = false;  ///< lower fibre fault
+};
+
+struct HCpuPairParams {
+  HProfile profile = HProfile::S7_400H;
+  bus::Ticks startup_time = 1000 * bus::kTicksPerMs;  ///< STARTUP (OB 100) on the master
+  bus::Ticks link_up_time = 2000 * bus::kTicksPerMs;  ///< LINK-UP (program compare/copy)
+  /// KB of data blocks the update copies (for the default update_time).
+  std::uint32_t update_db_kb = 100;
+  /// UPDATE duration; default 75 ms + 0.7 ms per KB of update_db_kb (digest §3.1, T7).
+  std::optional<bus::Ticks> update_time;
+  bus::Ticks role_window = 3000 * bus::kTicksPerMs;       ///< R2
+  bus::Ticks self_test_time = 90 * bus::kTicksPerSecond;  ///< full self-test in ERROR-SEARCH
+  bus::Ticks cyclic_self_test_period = 90 * 60 * bus::kTicksPerSecond;
+  bus::Ticks defective_window = 7 * 24 * 3600 * bus::kTicksPerSecond;  ///< F17 repetition
+  ComparisonReaction comparison_reaction = ComparisonReaction::ErrorSearch;
+  std::array<bool, 2> switch_run{true, true};  ///< mode switch positions at construction
+  std::size_t diag_capacity = 120;             ///< entries per CPU, oldest dropped
+};
+
+/// 75 ms + 0.7 ms per KB (exact in ticks: 0.7 ms = 2 545 200 ticks).
+constexpr bus::Ticks default_update_time(std::uint32_t kb) {
+  return 75 * bus::kTicksPerMs + static_cast<bus::Ticks>(kb) * (7 * bus::kTicksPerMs / 10);
+}
+
+class HCpuPair {
+ public:
+  explicit HCpuPair(HCpuPairParams p = {});
+
+  // ---- operations (each at virtual time `now`, non-decreasing) ----
+  void power_on(int rack, bus::Ticks now);
+  /// Both racks at the same instant (the simultaneous POWER ON of the manual).
+  void power_on_both(bus::Ticks now);
+  void power_off(int rack, bus::Ticks now);  ///< CPU or PS failure, or switched off
+  void switch_to_run(int rack, bus::Ticks now);
+  void switch_to_stop(int rack, bus::Ticks now);
+  void cut_fibre(int fibre, bus::Ticks now);
+  void cut_both_fibres(bus::Ticks now);
+  void repair_fibre(int fibre, bus::Ticks now);
+  /// false if HOLD is not reachable (only the master in STARTUP or Solo RUN; not in 1500).
+  bool hold(int rack, bus::Ticks now);
+  bool release_hold(int rack, bus::Ticks now);
+  /// RAM/output-image comparison error (F16); false unless the system is Redundant.
+  bool inject_comparison_error(bus::Ticks now);
+  /// OB 121 on `rack` only (F17); false unless the system is Redundant.
+  bool one_sided_ob121(int rack, bus::Ticks now);
+  /// A latent hardware fault on `rack` that the next full self-test finds (-> DEFECTIVE).
+  void inject_hardware_fault(int rack, bus::Ticks now);
+  /// The CPU is replaced or its fault removed: clears the fault, the OB 121 history and
+  /// DEFECTIVE (the CPU goes to STOP if powered).
+  void repair_cpu(int rack, bus::Ticks now);
+  /// PG/ES "switch to CPU with modified configuration"; false unless Solo with the master in
+  /// RUN and the standby powered in STOP over a whole link.
+  bool request_master_swap(bus::Ticks now);
+
+  bus::Ticks next_deadline() const;
+  void on_time(bus::Ticks now);
+
+  // ---- queries ----
+  CpuState state(int rack) const { return m_cpu[rack].state; }
+  CpuRole role(int rack) const { return m_cpu[rack].role; }
+  bool is_master(int rack) const { return m_cpu[rack].role == CpuRole::Master; }
+  /// The master's rack, -1 if none; with two masters (F6/F7) rack 0.
+  int master() const;
+  int master_count() const;
+  /// The pair's system mode, seen by the master (rack 0's if two masters); Stop if none.
+  SystemMode system_mode() const;
+  /// The system mode as rack r sees it (Stop if off or without a master it is linked to).
+  SystemMode system_mode(int rack) const;
+  /// Rack r may access the switched I/O: a powered master (also in STOP, digest §1).
+  bool accesses_switched_io(int rack) const;
+  /// Rack r's DP master(s) run: a powered master that is not DEFECTIVE; a standby from the end
+  /// of its link-up (UPDATE, RUN), as it registers the DP slaves then (001 Fig. 6-1).
+  bool dp_master_running(int rack) const;
+  /// Rack r's DP master(s) send outputs (Operate): the CPU's program runs (RUN, SYNCUP).
+  bool dp_master_operate(int rack) const;
+  bool fibre_ok(int fibre) const { return m_fibre_ok[fibre]; }
+  bool link_whole() const { return m_fibre_ok[0] && m_fibre_ok[1]; }
+  bool switch_at_run(int rack) const { return m_cpu[rack].switch_run; }
+  CpuLeds leds(int rack) const;
+  const std::deque<DiagEntry>& diag_buffer(int rack) const { return m_cpu[rack].diag; }
+  const std::vector<HEvent>& events() const { return m_events; }
+  void on_event(std::function<void(const HEvent&)> cb) { m_cb = std::move(cb); }
+  const HCpuPairParams& params() const { return m_p; }
+  bus::Ticks update_time() const { return m_update_time; }
+
+ private:
+  enum class Pending : std::uint8_t { None, Relink, Swap };
+  struct Cpu {
+    CpuState state = CpuState::Off;
+    CpuRole role = CpuRole::None;
+    CpuRole remembered = CpuRole::None;  ///< the role before the last power-off
+    bool switch_run = true;
+    bool want_run = false;         ///< a start request not yet served (switch STOP -> RUN, power)
+    bool restart_on_power = true;  ///< not in STOP when power was lost
+    bool hw_fault = false;
+    bool defective = false;
+    bus::Ticks deadline = bus::kNever;        ///< end of the current timed state
+    bus::Ticks pending_master = bus::kNever;  ///< alone, remembered standby: master at this time
+    bus::Ticks hold_remaining = -1;  ///< STARTUP time left when HOLD was entered, -1: from RUN
+    std::optional<bus::Ticks> last_ob121;
+    Pending after_update = Pending::None;  ///< what the end of this standby's update does
+    std::deque<DiagEntry> diag;
+  };
+
+  int partner(int r) const { return 1 - r; }
+  bool powered(int r) const { return m_cpu[r].state != CpuState::Off; }
+  /// r and its partner are both powered over a whole link.
+  bool linked(int r) const { return powered(r) && powered(partner(r)) && link_whole(); }
+  bool is_1500() const { return m_p.profile == HProfile::S7_1500RH; }
+  SystemMode mode_of_master(int m) const;
+
+  void run_due(bus::Ticks now);
+  void expire(int r, bus::Ticks now);
+  void evaluate(bus::Ticks now);
+  void after_step(bus::Ticks now);
+  void set_state(int r, CpuState s, bus::Ticks now, std::string_view why = {});
+  void set_role(int r, CpuRole role, bus::Ticks now, std::string_view why = {});
+  void ob(int r, int ob_nr, HReason why, bus::Ticks now, std::uint16_t code = 0);
+  void diag(int r, bus::Ticks now, std::string text, std::uint16_t code = 0);
+  void emit(HEvent e);
+  void begin_link_up(int s, bus::Ticks now, Pending after);
+  void finish_update(int s, bus::Ticks now);
+  /// Standby s's link-up/update/SYNCUP ends early: s to STOP, the master back to Solo.
+  void abort_link_up(int s, bus::Ticks now, std::string_view why);
+  /// A CPU leaves RUN/link-up states (power-off or STOP): the partner's reaction.
+  void partner_lost(int r, bool master_was, CpuState was, bool power, bus::Ticks now);
+  void stop_cpu(int r, bus::Ticks now, std::string_view why);
+  void make_defective(int r, bus::Ticks now, std::string_view why);
+
+  HCpuPairParams m_p;
+  bus::Ticks m_update_time;
+  std::array<Cpu, 2> m_cpu;
+  std::array<bool, 2> m_fibre_ok{true, true};
+  bus::Ticks m_search_redundant_at = bus::kNever;  ///< Redundant reached after ERROR-SEARCH
+  SystemMode m_mode = SystemMode::Stop;
+  std::vector<HEvent> m_events;
+  std::function<void(const HEvent&)> m_cb;
+  bool m_in_step = false;
+};
+
+}  // namespace pbvbus::devices

@@ -419,10 +419,12 @@ void RedundantSlave::set_ack(int i) {
 }
 
 void RedundantSlave::refresh_status() {
+  // Runs after every request: each Red_State once (bench/switched_io_bench.cpp profile).
+  const std::uint8_t state[2] = {red_state(0).octet(), red_state(1).octet()};
   for (int i = 0; i < 2; ++i) {
     Iface& f = m_if[i];
-    const std::uint8_t own = red_state(i).octet();
-    const std::uint8_t partner = red_state(1 - i).octet();
+    const std::uint8_t own = state[i];
+    const std::uint8_t partner = state[1 - i];
     const std::int32_t key = (f.cmd_spec << 16) | (own << 8) | partner;
     if (key == f.status_cache) continue;
     f.status_cache = key;

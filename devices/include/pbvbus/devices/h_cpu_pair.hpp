@@ -290,7 +290,6 @@ class HCpuPair {
   SystemMode m_mode = SystemMode::Stop;
   std::vector<HEvent> m_events;
   std::function<void(const HEvent&)> m_cb;
-  bool m_in_step = false;
 };
 
 }  // namespace pbvbus::devices

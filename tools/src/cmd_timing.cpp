@@ -76,6 +76,7 @@
 #include "pbvbus/tools/json_text.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/timing_plan.hpp"
+#include "pbvbus/tools/h_plan.hpp"
 
 namespace pbvbus::tools {
 
@@ -358,6 +359,7 @@ std::string jnotes(const std::vector<std::string>& notes) {
   return s + "]";
 }
 
+/// Everything but the h_systems and the closing brace (cmd_timing adds those).
 void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& systems,
                 const std::vector<MasterTiming>& masters, std::ostream& out) {
   out << "{\"schema\": \"pbvbus.timing/1\",\n";
@@ -418,7 +420,91 @@ void print_json(const ScenarioPlan& plan, const std::vector<SystemTiming>& syste
         << jline(m.plan.line[0], m.plan, 0, m.line_name, m.mp->params.address, "    ") << ",\n";
     out << "   \"notes\": " << jnotes(m.plan.notes) << "}";
   }
-  out << (masters.empty() ? "]}\n" : "\n ]}\n");
+  out << (masters.empty() ? "]" : "\n ]");
+}
+
+
+// --- the H-system's update timing (h_system entries) -----------------------------------------
+
+struct HTiming {
+  const HSystemPlan* hp = nullptr;
+  devices::UpdatePlan plan;
+  devices::HCheckResult checks;
+  bool configured = false;  ///< any of the four H parameters given
+};
+
+std::string hms(devices::Us v) { return devices::format_ms(v); }
+
+void print_h_text(const HTiming& h, std::ostream& out) {
+  const devices::UpdatePlan& p = h.plan;
+  out << "\nH-system \"" << h.hp->name << "\": update timing (T_P15 procedure, docs/h-timing.md)\n";
+  out << "  T_WA " << hms(p.input.t_wa) << ", T_PROG " << hms(p.input.t_prog)
+      << ", DBs in work memory " << p.input.db_kb << " KB\n";
+  for (const auto& s : p.systems) {
+    out << "  [1] " << s.in.name << ": T_PTO " << hms(s.in.t_pto) << " - (2 x T_TR " << hms(s.in.t_tr)
+        << " + T_WA + T_PROG + T_DP_UM " << hms(s.in.t_dp_um) << " + T_SLAVE_UM "
+        << hms(s.in.t_slave_um) << " = " << hms(s.subtracted) << ") = " << hms(s.t_p15) << "\n";
+  }
+  if (p.t_p15_hw)
+    out << "  T_P15_HW = " << hms(*p.t_p15_hw) << " (" << p.systems.at(*p.hw_system).in.name << ")\n";
+  else
+    out << "  T_P15_HW: none (no DP master system)\n";
+  out << "  T_PH = MAX(30 ms, 3 x T_TRmax " << hms(p.t_tr_max) << ") = " << hms(p.t_ph) << "\n";
+  out << "  [2] T_P15_OD = 50 ms + T_PH = " << hms(p.t_p15_od) << "; T_P15_AWP = 75 ms + 0.7 ms x "
+      << p.input.db_kb << " KB = " << hms(p.t_p15_awp) << "\n";
+  if (p.t_p15) {
+    out << "  [3] T_P15 = MAX(T_P15_AWP, T_P15_OD) = " << hms(*p.t_p15) << "\n";
+    out << "  recommended: max communication delay 4 x T_P15 = " << hms(*p.recommended_comm_delay)
+        << ", max cycle extension 10 x T_P15 = " << hms(*p.recommended_cycle_extension) << "\n";
+    if (p.settable_t_p15) out << "  smallest settable T_P15: " << hms(*p.settable_t_p15) << "\n";
+  } else {
+    out << "  no recommendation: the procedure aborts (" << devices::to_string(p.abort) << ")\n";
+  }
+  for (const auto& m : p.messages) out << "    " << m << "\n";
+  for (const auto& n : p.notes) out << "  note: " << n << "\n";
+  if (h.configured) {
+    out << "  configured H parameters: " << (h.checks.ok() ? "ok" : "NOT OK") << "\n";
+  }
+  for (const auto& v : h.checks.violations)
+    out << "    " << (v.severity == devices::Severity::Error ? "error" : "warning") << ": "
+        << v.message << "\n";
+}
+
+std::string jus(std::optional<devices::Us> v) { return v ? std::to_string(*v) : "null"; }
+
+void print_h_json(const std::vector<HTiming>& hs, std::ostream& out) {
+  out << ",\n \"h_systems\": [";
+  for (std::size_t n = 0; n < hs.size(); ++n) {
+    const HTiming& h = hs[n];
+    const devices::UpdatePlan& p = h.plan;
+    out << (n ? "," : "") << "\n  {\"name\": " << json_quote(h.hp->name) << ", \"t_wa_us\": "
+        << p.input.t_wa << ", \"t_prog_us\": " << p.input.t_prog << ", \"db_kb\": " << p.input.db_kb
+        << ",\n   \"dp_systems\": [";
+    for (std::size_t k = 0; k < p.systems.size(); ++k) {
+      const auto& s = p.systems[k];
+      out << (k ? ", " : "") << "{\"name\": " << json_quote(s.in.name) << ", \"t_tr_us\": "
+          << s.in.t_tr << ", \"t_dp_um_us\": " << s.in.t_dp_um << ", \"t_slave_um_us\": "
+          << s.in.t_slave_um << ", \"t_pto_us\": " << s.in.t_pto << ", \"subtracted_us\": "
+          << s.subtracted << ", \"t_p15_us\": " << s.t_p15 << "}";
+    }
+    out << "],\n   \"t_p15_hw_us\": " << jus(p.t_p15_hw) << ", \"t_ph_us\": " << p.t_ph
+        << ", \"t_p15_od_us\": " << p.t_p15_od << ", \"t_p15_awp_us\": " << p.t_p15_awp
+        << ", \"t_p15_us\": " << jus(p.t_p15) << ", \"recommended_comm_delay_us\": "
+        << jus(p.recommended_comm_delay) << ", \"recommended_cycle_extension_us\": "
+        << jus(p.recommended_cycle_extension) << ", \"abort\": "
+        << json_quote(devices::to_string(p.abort)) << ",\n   \"messages\": " << jnotes(p.messages)
+        << ", \"notes\": " << jnotes(p.notes) << ",\n   \"configured\": "
+        << (h.configured ? "true" : "false") << ", \"checks_ok\": " << (h.checks.ok() ? "true" : "false")
+        << ", \"checks\": [";
+    for (std::size_t k = 0; k < h.checks.violations.size(); ++k) {
+      const auto& v = h.checks.violations[k];
+      out << (k ? ", " : "") << "{\"check\": " << json_quote(devices::to_string(v.check))
+          << ", \"severity\": " << (v.severity == devices::Severity::Error ? "\"error\"" : "\"warning\"")
+          << ", \"message\": " << json_quote(v.message) << "}";
+    }
+    out << "]}";
+  }
+  out << (hs.empty() ? "]" : "\n ]");
 }
 
 }  // namespace
@@ -486,19 +572,37 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
     err << "pbvbus timing: " << plan.file << ": " << e.what() << "\n";
     return 2;
   }
+  std::vector<HTiming> hs;
+  try {
+    for (const auto& hp : plan.h_systems) {
+      HTiming h;
+      h.hp = &hp;
+      h.plan = devices::plan_update(h_update_input(plan, hp));
+      const auto& c = hp.params;
+      h.configured = c.max_cycle_extension || c.max_comm_delay || c.t_p15 || c.t_ph;
+      if (h.configured) h.checks = devices::check_h_parameters(c, &h.plan);
+      hs.push_back(std::move(h));
+    }
+  } catch (const std::exception& e) {
+    err << "pbvbus timing: " << plan.file << ": " << e.what() << "\n";
+    return 2;
+  }
 
   if (json) {
     print_json(plan, systems, masters, out);
+    print_h_json(hs, out);
+    out << "}\n";
     return 0;
   }
   out << "Scenario \"" << plan.name << "\" (" << plan.file
       << "): planned DP rotation and switchover times\n";
-  if (systems.empty() && masters.empty()) {
+  if (systems.empty() && masters.empty() && hs.empty()) {
     out << "no DP master system in this scenario: nothing to plan\n";
     return 0;
   }
   for (const auto& s : systems) print_system_text(plan, s, out);
   for (const auto& m : masters) print_master_text(m, out);
+  for (const auto& h : hs) print_h_text(h, out);
   return 0;
 }
 

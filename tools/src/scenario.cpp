@@ -165,13 +165,15 @@ class Planner {
       }
     }
     plan_lines(plan);
-    plan_dp(plan, [this](const char* rep, int index, const char* field, int element) {
+    const DpLocator locate = [this](const char* rep, int index, const char* field, int element) {
       Where w = nested(m_root, scenario::Scenario::descriptor(), rep, index);
       if (field != nullptr)
         w = at_field(w, scenario::Scenario::descriptor()->FindFieldByName(rep)->message_type(),
                      field, element);
       return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
-    }, m_errors);
+    };
+    plan_dp(plan, locate, m_errors);
+    plan_h(plan, locate, m_errors);
     plan_stations(plan);
     plan_captures(plan);
     plan_faults(plan);
@@ -258,7 +260,9 @@ class Planner {
       m_line_index.emplace(l.name(), static_cast<int>(plan.lines.size()));
       plan.lines.push_back(std::move(pl));
     }
-    if (m_proto.line_size() == 0) error(m_root, "the scenario has no line");
+    // A timing-only file (h_system figures for `pbvbus timing`) needs no line.
+    if (m_proto.line_size() == 0 && m_proto.h_system_size() == 0)
+      error(m_root, "the scenario has no line");
   }
 
   /// Index of the line named by field `name` of the message at `w`, or -1 (error reported).

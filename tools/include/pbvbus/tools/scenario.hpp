@@ -31,6 +31,7 @@
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
+#include "pbvbus/tools/h_plan.hpp"
 #include "scenario.pb.h"
 
 namespace pbvbus::tools {
@@ -135,6 +136,7 @@ struct ScenarioPlan {
   std::vector<DpSlavePlan> dp_slaves;    ///< in file order, valid ones only
   std::vector<RedundancyPlan> redundant_systems;  ///< in file order
   std::vector<SwitchedPlan> switched;             ///< in file order, valid ones only
+  std::vector<HSystemPlan> h_systems;             ///< h_system entries (update timing)
 };
 
 struct LoadResult {

@@ -30,8 +30,13 @@ Result timing(const Args& args) {
 
 const std::string kExample = PBVBUS_SOURCE_DIR "/examples/h-update-example.textproto";
 
-std::string write_scenario(const std::string& name, const std::string& text) {
-  const std::string path = std::string(PBVBUS_SOURCE_DIR) + "/examples/" + name;
+/// Into the build tree (never the sources); relative GSD paths made absolute.
+std::string write_scenario(const std::string& name, std::string text) {
+  const std::string gsd = "gsd: \"gsd/";
+  const std::string abs = "gsd: \"" PBVBUS_SOURCE_DIR "/examples/gsd/";
+  for (auto at = text.find(gsd); at != std::string::npos; at = text.find(gsd, at + abs.size()))
+    text.replace(at, gsd.size(), abs);
+  const std::string path = std::string(PBVBUS_BINARY_DIR) + "/" + name;
   std::ofstream(path) << text;
   return path;
 }

@@ -166,8 +166,8 @@ void RedundantSystemNode::on_system_event(const redundancy::SystemEvent& e) {
   captures::EventRecord r;
   r.category = captures::EventCategory::Redundancy;
   r.code = static_cast<std::uint16_t>(e.kind);
-  const int li = e.line >= 0 ? line(e.line) : -1;
-  r.line = m_lines[0] != nullptr && e.line >= 0 && m_lines[e.line] != nullptr ? m_lines[e.line]->index() : li;
+  // The Simulation numbers its lines (Line::index()) by their plan index.
+  r.line = e.line >= 0 ? line(e.line) : -1;
   r.a = e.station == 0xFF ? -1 : e.station;
   r.b = r.line;
   r.value = e.code();

@@ -78,11 +78,7 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
     m_redundant.push_back(std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params));
   }
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
-  for (auto& node : m_redundant) {
-    node->set_lines(m_lines.at(static_cast<std::size_t>(node->line(0)))->line.get(),
-                    m_lines.at(static_cast<std::size_t>(node->line(1)))->line.get());
-    node->set_capture(m_opts.capture);
-  }
+  for (auto& node : m_redundant) node->set_capture(m_opts.capture);
   std::string why;
   auto probes = plan_capture_probes(m_plan, m_opts.probe, &why);
   if (!probes && m_opts.capture != nullptr) throw std::runtime_error(why);

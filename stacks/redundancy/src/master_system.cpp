@@ -391,7 +391,8 @@ std::uint32_t MasterSystem::read(std::uint8_t address, std::uint8_t slot, std::u
   r.index = index;
   r.length = length;
   r.cb = std::move(cb);
-  if (!start_record(r, now)) return 0;
+  m_now = std::max(m_now, now);
+  if (!start_record(r)) return 0;
   r.id = m_next_record++;
   m_records.push_back(std::move(r));
   return m_records.back().id;
@@ -407,13 +408,14 @@ std::uint32_t MasterSystem::write(std::uint8_t address, std::uint8_t slot, std::
   r.index = index;
   r.data.assign(data.begin(), data.end());
   r.cb = std::move(cb);
-  if (!start_record(r, now)) return 0;
+  m_now = std::max(m_now, now);
+  if (!start_record(r)) return 0;
   r.id = m_next_record++;
   m_records.push_back(std::move(r));
   return m_records.back().id;
 }
 
-bool MasterSystem::start_record(Record& r, bus::Ticks now) {
+bool MasterSystem::start_record(Record& r) {
   const int line = active(r.address);
   if (line < 0) return false;
   // The id is not known yet for a new job: the callback finds it by the master's job id.
@@ -426,7 +428,6 @@ bool MasterSystem::start_record(Record& r, bus::Ticks now) {
   r.line = line;
   r.waiting_since = bus::kNever;
   ++r.attempts;
-  (void)now;
   return true;
 }
 
@@ -459,7 +460,7 @@ void MasterSystem::retry_records(bus::Ticks now) {
     }
     const int line = active(r.address);
     const bool channel = line >= 0 && switching_to(r.address) < 0;
-    if (channel && start_record(r, now)) {
+    if (channel && start_record(r)) {
       ++m_record_repeats;
       ++i;
       continue;

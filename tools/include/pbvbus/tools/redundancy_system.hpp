@@ -117,7 +117,6 @@ class RedundantSystemNode {
 
   /// Line indices (ScenarioPlan::lines) of sides A and B.
   int line(int side) const;
-  void set_lines(bus::Line* a, bus::Line* b) { m_lines[0] = a; m_lines[1] = b; }
   void set_capture(captures::PcapngWriter* w) { m_capture = w; }
 
   /// A fault or repair that concerns the system (its lines or devices) was applied at `now`.
@@ -136,7 +135,6 @@ class RedundantSystemNode {
   int m_system;
   std::unique_ptr<devices::RedundantMasterSystemModel> m_model;
   std::vector<std::pair<int, std::unique_ptr<devices::SwitchedStationModel>>> m_stations;
-  bus::Line* m_lines[2] = {nullptr, nullptr};
   captures::PcapngWriter* m_capture = nullptr;
   redundancy::SwitchoverPlan m_timing;
   scenario::DpMaster::Outputs m_program = scenario::DpMaster::COUNT;

@@ -261,7 +261,7 @@ class MasterSystem {
     int line = -1;                      ///< where it runs now (-1: waiting for a channel)
     bus::Ticks waiting_since = bus::kNever;
   };
-  bool start_record(Record& r, bus::Ticks now);
+  bool start_record(Record& r);
   void record_done(std::uint32_t id, const dp::AcyclicResult& res);
   void retry_records(bus::Ticks now);
   void switch_to(Station& s, int line, bus::Ticks now, SystemEvent::Cause cause);

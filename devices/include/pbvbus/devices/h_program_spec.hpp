@@ -1,0 +1,67 @@
+#pragma once
+// What a scenario says about the user program of an H-system (issue 8, deliverable 1): a cyclic
+// OB 1 over the process image with a scan time, built from a few kinds of networks a scenario
+// can combine. The scenario loader fills this struct; devices/h_program.hpp builds and runs it.
+//
+// Addresses are byte offsets in the CPU's process images: `input` in the process-image input
+// table (PII, "IB n"), `output` in the process-image output table (PIQ, "QB n"). Which DP
+// slave's module lies at which address is the owner's map (the H-system model assigns them);
+// the program only sees the images. Multi-octet values are big-endian (S7 byte order).
+//
+// Decisions:
+// - A program is a list of networks executed in order each scan: copies, then counters, then
+//   discrepancy monitors (fixed order, so a copy's target can be overwritten by a counter on
+//   purpose and the result is the same on both CPUs).
+// - Every piece of program state (counter values, pulse phase, discrepancy timers) lives in
+//   the CPU's memory area, never in the program object, so that the update can copy a CPU's
+//   whole state to its partner and the comparison covers it (digest §5: RAM and output image
+//   are compared).
+#include <cstdint>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+
+namespace pbvbus::devices {
+
+/// PII[from_input .. +length) → PIQ[to_output .. +length).
+struct CopyNetwork {
+  std::uint32_t from_input = 0;
+  std::uint32_t to_output = 0;
+  std::uint32_t length = 1;
+};
+
+/// A counter in PIQ[output .. +width) (width 1, 2 or 4, big-endian, wraps), incremented by
+/// `step` every `period`; optionally a pulse: bit `pulse_bit` of PIQ byte `pulse_output` is 1
+/// for `pulse_high` at the start of every period, else 0 (pulse_high = 0: no pulse).
+struct CounterNetwork {
+  std::uint32_t output = 0;
+  std::uint32_t width = 1;
+  bus::Ticks period = 100 * bus::kTicksPerMs;
+  std::uint32_t step = 1;
+  std::uint32_t pulse_output = 0;
+  std::uint8_t pulse_bit = 0;
+  bus::Ticks pulse_high = 0;
+};
+
+/// Redundant inputs (two modules reading the same sensor, 001 §7.4): the bits `mask` of
+/// PII[input_a .. +length) and PII[input_b .. +length) must agree; while they differ the last
+/// agreed value is used, and a difference lasting longer than `discrepancy_time` raises the
+/// discrepancy error (error 7960) once per pair until they agree again. The used value goes to
+/// PIQ[to_output .. +length).
+struct DiscrepancyNetwork {
+  std::uint32_t input_a = 0;
+  std::uint32_t input_b = 0;
+  std::uint32_t length = 1;
+  std::uint8_t mask = 0xFF;
+  std::uint32_t to_output = 0;
+  bus::Ticks discrepancy_time = 10 * bus::kTicksPerMs;
+};
+
+struct ProgramSpec {
+  bus::Ticks scan_time = 10 * bus::kTicksPerMs;  ///< OB 1 cycle (start to start)
+  std::vector<CopyNetwork> copies;
+  std::vector<CounterNetwork> counters;
+  std::vector<DiscrepancyNetwork> monitors;
+};
+
+}  // namespace pbvbus::devices

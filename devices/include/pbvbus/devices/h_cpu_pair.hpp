@@ -30,7 +30,38 @@
 //   the CPU when its switch is at RUN and it was not in STOP when it lost power (digest §4).
 // - STARTUP (startup_time) runs on the master only; a standby whose switch is at RUN waits in
 //   STOP until the master is in RUN (Solo), then goes LINK-UP (link_up_time) -> UPDATE
-//   (update_time) -> RUN (Redundant). The master stays RUN throughout (Table 4-1).
+//   (W, below) -> RUN (Redundant). The master stays RUN throughout (Table 4-1).
+// - The update in phases (400H; digest §3.1 timeline, §4 "Update steps"): t1 = the standby
+//   enters UPDATE (end of LINK-UP): data-record jobs refused (record_job_result: 80C3/8085),
+//   messages/communication and OB 1/classes <= 15 delayed, DP interrupts held
+//   (interrupts_held). t3 = t1: the delay stages take no time in this model. [t3, t5) is the
+//   no-I/O window (io_frozen: no OB, no I/O update on either CPU) of length
+//   W = MAX(T_P15_AWP(update_db_kb) = 75 ms + 0.7 ms/KB (or update_time), 50 ms + T_PH), the
+//   50 ms + T_PH term only with a configured T_PH > 0. t4 = t5 - T_PH: output hold
+//   (outputs_held_by_both; empty with T_PH = 0); t4 is a deadline of its own. t5 = Redundant
+//   mode or the swap. The pair only reports the phases; holding/delivering interrupts, pausing
+//   the program and driving outputs is the owner's. dp_master_operate() is not changed by the
+//   window (a Clear would drive safe values; the owner asks io_frozen()).
+// - Update timeout (F19/R6): the first monitored (set, not 0) limit among T_P15, max
+//   communication delay, max cycle extension that is < W aborts the update at t3 + limit (each
+//   covers W from t1 = t2 = t3 here; a valid set makes T_P15 the first). Abort: standby STOP
+//   (re-reads its SDBs), Solo with the same master, OB 72 UpdateTimeout on the master, buffer
+//   entries on both, any pending swap dropped; the standby retries by itself exactly 60 s later
+//   (a plain link-up), at most kUpdateMaxTries tries per series; switch_to_run(), power-on, the
+//   re-link after ERROR-SEARCH and request_master_swap() start a new series. Not modelled: the
+//   cycle monitoring time that bounds an update with no H parameters.
+// - F20/R9: the standby powered off or switched to STOP in LINK-UP gets a reset request
+//   (W#16#6523 if within the first load_memory_copy_time of LINK-UP, default half of it); it
+//   stays in STOP (switch_to_run refused, no start at power-on) until memory_reset(), which
+//   does not start it. Aborts caused by the partner or the link set no reset request.
+// - R8: connect(r) counts S7 connections; refused on a CPU off/ERROR-SEARCH/DEFECTIVE and on
+//   both CPUs while a CPU is in LINK-UP or UPDATE; link-up breaks the standby's, keeps the
+//   master's; power-off drops a CPU's.
+// - F22 load_change(): Allowed -> buffer entry; a structural FB-interface or global-DB change
+//   in Redundant -> both CPUs STOP (no OB 72), in Solo -> loaded; refused unless Solo or
+//   Redundant (no block load during link-up/update). F23: with set_standby_parameter_change
+//   (true) request_master_swap() is refused at the request: standby stays in STOP, W#16#5966
+//   in both buffers.
 // - Leaving Redundant: master power-off or STOP -> the standby becomes master in Solo, OB 72 on
 //   it; standby power-off or STOP -> Solo, OB 72 on the master. During link-up/update: the
 //   link-up is aborted (the standby to STOP; if the master was lost, the survivor becomes
@@ -58,7 +89,8 @@
 //   STOP): link-up and update, then the old standby is master in RUN (Solo) and the old master
 //   STOPs; OB 72 on the new master.
 // - S7-1500R/H profile: STOP -> STARTUP (primary only) -> RUN-Solo -> SYNCUP (both CPUs,
-//   link_up_time + update_time) -> RUN-Redundant; roles named primary/backup; no HOLD; a
+//   link_up_time + W, no phases, no timeout, no reset request, io_frozen() etc. false) ->
+//   RUN-Redundant; roles named primary/backup; no HOLD; a
 //   comparison error or one-sided OB 121 STOPs the CPU (no ERROR-SEARCH in the 1500 excerpt).
 
 #include <array>

@@ -227,9 +227,10 @@ void HCpuPair::begin_update(int s, bus::Ticks now) {
     }
   }
   m_cpu[s].deadline = std::min(win.t5, m_update_abort_at);
-  const std::string text = "UPDATE: data-record jobs refused, OB 1 and classes <= 15 delayed; "
-                           "no OB and no I/O update until Redundant mode (" +
-                           format_ms(ticks_to_us_ceil(w)) + ")";
+  const std::string text =
+      "UPDATE: data-record jobs refused, OB 1 and classes <= 15 delayed; "
+      "no OB and no I/O update until Redundant mode (" +
+      format_ms(ticks_to_us_ceil(w)) + ")";
   diag(s, now, text);
   diag(m, now, text);
 }
@@ -264,8 +265,8 @@ void HCpuPair::update_timeout(int s, bus::Ticks now) {
     c.retry_at = now + kUpdateRetryDelayTicks;
     diag(s, now, "link-up retry in 60 s (try " + std::to_string(m_tries + 1) + ")");
   } else {
-    const std::string t = "update failed " + std::to_string(m_tries) +
-                          " times: link-up must be restarted manually";
+    const std::string t =
+        "update failed " + std::to_string(m_tries) + " times: link-up must be restarted manually";
     diag(s, now, t);
     diag(m, now, t);
   }
@@ -287,8 +288,8 @@ void HCpuPair::retry_due(int r, bus::Ticks now) {
 void HCpuPair::set_reset_request(int r, bus::Ticks now) {
   Cpu& c = m_cpu[r];
   c.reset_request = true;
-  const bool copying = c.link_up_start != bus::kNever &&
-                       now - c.link_up_start < load_memory_copy_time();
+  const bool copying =
+      c.link_up_start != bus::kNever && now - c.link_up_start < load_memory_copy_time();
   if (copying)
     diag(r, now, "reset request: link-up interrupted during the load-memory copy", 0x6523);
   else
@@ -654,8 +655,9 @@ void HCpuPair::begin_link_up(int s, bus::Ticks now, Pending after) {
               : after == Pending::Swap ? "master swap requested"
                                        : "link-up request");
     diag(m, now, "link-up with the standby CPU (rack " + std::to_string(s) + ")");
-    diag(s, now, "LINK-UP: copying the load memory (" +
-                     format_ms(ticks_to_us_ceil(load_memory_copy_time())) + ")");
+    diag(s, now,
+         "LINK-UP: copying the load memory (" +
+             format_ms(ticks_to_us_ceil(load_memory_copy_time())) + ")");
     c.deadline = now + m_p.link_up_time;
   }
 }
@@ -1057,8 +1059,10 @@ HChangeResult HCpuPair::load_change(HChange kind, bus::Ticks now) {
   const SystemMode mode = system_mode();
   const int m = master();
   if (m < 0 || (mode != SystemMode::Solo && mode != SystemMode::Redundant)) {
-    if (m >= 0) diag(m, now, "load refused: " + std::string(to_string(kind)) + " (" +
-                                 std::string(to_string(mode, m_p.profile)) + ")");
+    if (m >= 0)
+      diag(m, now,
+           "load refused: " + std::string(to_string(kind)) + " (" +
+               std::string(to_string(mode, m_p.profile)) + ")");
     return HChangeResult::Refused;
   }
   const int s = partner(m);

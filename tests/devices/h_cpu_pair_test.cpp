@@ -666,8 +666,7 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
       EXPECT_GT(p.next_deadline(), now);
       // The update model: the no-I/O window only while a CPU is in UPDATE; the output hold
       // lies inside it; data-record jobs are refused exactly while interrupts are held.
-      const bool in_update =
-          p.state(0) == CpuState::Update || p.state(1) == CpuState::Update;
+      const bool in_update = p.state(0) == CpuState::Update || p.state(1) == CpuState::Update;
       if (p.io_frozen()) {
         EXPECT_TRUE(in_update);
       }
@@ -707,8 +706,7 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
       if (::testing::Test::HasFailure()) return;
     }
     Ticks last = 0;
-    int redundant = 0, two_masters = 0, error_search = 0, defective = 0, ob72 = 0,
-        timeouts = 0;
+    int redundant = 0, two_masters = 0, error_search = 0, defective = 0, ob72 = 0, timeouts = 0;
     for (const HEvent& e : p.events()) {
       EXPECT_GE(e.at, last);
       last = e.at;

@@ -53,8 +53,7 @@ void start(HCpuPair& p) {
   ASSERT_EQ(p.state(1), CpuState::LinkUp);
 }
 
-bool has_diag(const HCpuPair& p, int r, Ticks at, const std::string& text,
-              std::uint16_t code = 0) {
+bool has_diag(const HCpuPair& p, int r, Ticks at, const std::string& text, std::uint16_t code = 0) {
   return std::any_of(p.diag_buffer(r).begin(), p.diag_buffer(r).end(), [&](const DiagEntry& d) {
     return d.at == at && d.code == code && d.text.find(text) != std::string::npos;
   });
@@ -115,7 +114,7 @@ TEST(HUpdatePhases, NoHParametersWindowIs145msAndNoOutputHold) {
 }
 
 TEST(HUpdatePhases, ManualExampleWindow194msWithOutputHold90ms) {
-  HCpuPair p(manual_params(194));  // configured T_P15 194 ms: the update fits exactly
+  HCpuPair p(manual_params(194));        // configured T_P15 194 ms: the update fits exactly
   EXPECT_EQ(p.update_time(), tms(194));  // MAX(75 + 0.7 x 170 = 194, 50 + 90 = 140)
   start(p);
   const Ticks t5 = kT3 + tms(194);  // 7.194 s

@@ -222,16 +222,16 @@ constexpr bus::Ticks default_update_time(std::uint32_t kb) {
 
 /// A program change loaded into the H system (F22).
 enum class HChange : std::uint8_t {
-  Allowed,               ///< a change allowed in any mode: nothing happens but a buffer entry
-  StructuralFbInterface, ///< a structural change of an FB interface
-  GlobalDb,              ///< a change of a global DB's structure
+  Allowed,                ///< a change allowed in any mode: nothing happens but a buffer entry
+  StructuralFbInterface,  ///< a structural change of an FB interface
+  GlobalDb,               ///< a change of a global DB's structure
 };
 std::string_view to_string(HChange c);
 
 enum class HChangeResult : std::uint8_t {
-  Loaded,        ///< loaded (Solo, or an allowed change)
-  BothStopped,   ///< F22: not allowed in Redundant mode: both CPUs went to STOP
-  Refused,       ///< not loadable now: no master in RUN, or during link-up/update (digest §4)
+  Loaded,       ///< loaded (Solo, or an allowed change)
+  BothStopped,  ///< F22: not allowed in Redundant mode: both CPUs went to STOP
+  Refused,      ///< not loadable now: no master in RUN, or during link-up/update (digest §4)
 };
 std::string_view to_string(HChangeResult r);
 
@@ -239,7 +239,7 @@ std::string_view to_string(HChangeResult r);
 /// window (T_P15), t4 start of the output hold (T_PH), t5 Redundant mode / swap, or the abort.
 struct UpdateWindow {
   bus::Ticks t1 = 0, t3 = 0, t4 = 0, t5 = 0;
-  bool aborted = false;  ///< ended before the planned t5 (timeout, CPU or link lost): t5 = then
+  bool aborted = false;    ///< ended before the planned t5 (timeout, CPU or link lost): t5 = then
   bool timed_out = false;  ///< aborted by the update monitoring (F19)
 };
 
@@ -396,7 +396,6 @@ class HCpuPair {
   void output_hold_begins(bus::Ticks now);
   void retry_due(int r, bus::Ticks now);
   void set_reset_request(int r, bus::Ticks now);
-  bool update_running() const { return m_update_running; }
 
   HCpuPairParams m_p;
   bus::Ticks m_now = 0;  ///< the latest time seen (queries without a time use it)

@@ -102,6 +102,32 @@ std::string_view to_string(HReason r) {
       return "one-sided OB 121";
     case HReason::MasterSwap:
       return "master/standby swap";
+    case HReason::UpdateTimeout:
+      return "update timeout";
+  }
+  return "?";
+}
+
+std::string_view to_string(HChange c) {
+  switch (c) {
+    case HChange::Allowed:
+      return "allowed change";
+    case HChange::StructuralFbInterface:
+      return "structural FB-interface change";
+    case HChange::GlobalDb:
+      return "global-DB change";
+  }
+  return "?";
+}
+
+std::string_view to_string(HChangeResult r) {
+  switch (r) {
+    case HChangeResult::Loaded:
+      return "loaded";
+    case HChangeResult::BothStopped:
+      return "both CPUs STOP";
+    case HChangeResult::Refused:
+      return "refused";
   }
   return "?";
 }
@@ -118,12 +144,156 @@ void check_rack(int r) {
 }
 }  // namespace
 
-HCpuPair::HCpuPair(HCpuPairParams p)
-    : m_p(p), m_update_time(p.update_time ? *p.update_time : default_update_time(p.update_db_kb)) {
-  if (m_p.startup_time < 0 || m_p.link_up_time < 0 || m_update_time < 0 || m_p.role_window <= 0 ||
-      m_p.self_test_time < 0)
+HCpuPair::HCpuPair(HCpuPairParams p) : m_p(std::move(p)) {
+  if (m_p.startup_time < 0 || m_p.link_up_time < 0 || (m_p.update_time && *m_p.update_time < 0) ||
+      m_p.role_window <= 0 || m_p.self_test_time < 0)
     throw std::invalid_argument("HCpuPair: negative duration");
+  if (m_p.load_memory_copy_time &&
+      (*m_p.load_memory_copy_time < 0 || *m_p.load_memory_copy_time > m_p.link_up_time))
+    throw std::invalid_argument("HCpuPair: load_memory_copy_time must lie in 0..link_up_time");
+  // The model must not run on a set the checker rejects (the scenario loader checks first).
+  for (const HViolation& v : check_h_parameters(m_p.h_parameters).violations)
+    if (v.severity == Severity::Error) throw std::invalid_argument(v.message);
   for (int r = 0; r < 2; ++r) m_cpu[r].switch_run = m_p.switch_run[r];
+}
+
+// ---------------------------------------------------------------- update model
+
+namespace {
+/// A configured H parameter that is monitored (set and not 0), in ticks.
+std::optional<bus::Ticks> monitored(const std::optional<Us>& v) {
+  if (!v || *v <= 0) return std::nullopt;
+  return to_ticks(*v);
+}
+}  // namespace
+
+bus::Ticks HCpuPair::update_time() const {
+  const bus::Ticks copy =
+      m_p.update_time ? *m_p.update_time : to_ticks(t_p15_awp(m_p.update_db_kb));
+  const std::optional<bus::Ticks> tph = monitored(m_p.h_parameters.t_ph);
+  // Without T_PH the output copy lies inside the copy time (T_P15_OD = 50 ms < the 75 ms base
+  // of T_P15_AWP), so an explicit update_time stays exact.
+  return tph ? std::max(copy, to_ticks(kOutputCopyTime) + *tph) : copy;
+}
+
+bool HCpuPair::io_frozen() const {
+  return m_update_running && m_window && m_window->t3 <= m_now && m_now < m_window->t5;
+}
+
+bool HCpuPair::outputs_held_by_both() const {
+  return m_update_running && m_window && m_window->t4 <= m_now && m_now < m_window->t5;
+}
+
+bool HCpuPair::interrupts_held() const {
+  return m_update_running && m_window && m_window->t1 <= m_now && m_now < m_window->t5;
+}
+
+std::uint16_t HCpuPair::record_job_result(int sfc, bus::Ticks now) {
+  run_due(now);
+  if (!interrupts_held()) return 0;  // [t1, t5): the update restrictions
+  if (sfc == 51) return 0x8085;
+  if (sfc == 13 || (sfc >= 55 && sfc <= 59)) return 0x80C3;
+  return 0;
+}
+
+void HCpuPair::begin_update(int s, bus::Ticks now) {
+  const int m = partner(s);
+  set_state(s, CpuState::Update, now, "link-up done");
+  const bus::Ticks w = update_time();
+  const bus::Ticks tph = monitored(m_p.h_parameters.t_ph).value_or(0);
+  // t1 = t3: the delay stages (data records, messages, classes <= 15) take no time here.
+  UpdateWindow win;
+  win.t1 = now;
+  win.t3 = now;
+  win.t5 = now + w;
+  win.t4 = win.t5 - tph;
+  m_window = win;
+  m_update_running = true;
+  m_phase_at = tph > 0 ? win.t4 : bus::kNever;
+  // F19: the first monitoring limit shorter than the part of the update it covers (each
+  // covers W from t1 = t2 = t3 here). With a valid set T_P15 < comm delay < cycle extension,
+  // so T_P15 is reached first; the others matter only when T_P15 is 0 (not monitored).
+  m_update_abort_at = bus::kNever;
+  m_update_limit.clear();
+  const std::pair<const std::optional<Us>*, const char*> limits[] = {
+      {&m_p.h_parameters.t_p15, "T_P15"},
+      {&m_p.h_parameters.max_comm_delay, "max communication delay"},
+      {&m_p.h_parameters.max_cycle_extension, "max scan-cycle extension"}};
+  for (const auto& [v, name] : limits) {
+    const std::optional<bus::Ticks> l = monitored(*v);
+    if (l && *l < w && now + *l < m_update_abort_at) {
+      m_update_abort_at = now + *l;
+      m_update_limit = name;
+    }
+  }
+  m_cpu[s].deadline = std::min(win.t5, m_update_abort_at);
+  const std::string text =
+      "UPDATE: data-record jobs refused, OB 1 and classes <= 15 delayed; "
+      "no OB and no I/O update until Redundant mode (" +
+      format_ms(ticks_to_us_ceil(w)) + ")";
+  diag(s, now, text);
+  diag(m, now, text);
+}
+
+void HCpuPair::output_hold_begins(bus::Ticks now) {
+  for (int r = 0; r < 2; ++r)
+    if (powered(r))
+      diag(r, now, "UPDATE: outputs copied to the standby; both CPUs drive the outputs (T_PH)");
+}
+
+void HCpuPair::close_window(bus::Ticks now, bool aborted, bool timed_out) {
+  if (!m_update_running) return;
+  m_update_running = false;
+  m_phase_at = bus::kNever;
+  m_update_abort_at = bus::kNever;
+  m_window->t5 = now;
+  m_window->t4 = std::min(m_window->t4, now);
+  m_window->aborted = aborted;
+  m_window->timed_out = timed_out;
+}
+
+void HCpuPair::update_timeout(int s, bus::Ticks now) {
+  const int m = partner(s);
+  Cpu& c = m_cpu[s];
+  const std::string why = "update timeout: " + m_update_limit + " exceeded";
+  close_window(now, true, true);
+  stop_cpu(s, now, why);
+  diag(s, now, "SDBs re-read after the update timeout");
+  diag(m, now, "update aborted (" + why + "): Solo mode with the same master");
+  ob(m, 72, HReason::UpdateTimeout, now);
+  if (m_tries < kUpdateMaxTries) {
+    c.retry_at = now + kUpdateRetryDelayTicks;
+    diag(s, now, "link-up retry in 60 s (try " + std::to_string(m_tries + 1) + ")");
+  } else {
+    const std::string t =
+        "update failed " + std::to_string(m_tries) + " times: link-up must be restarted manually";
+    diag(s, now, t);
+    diag(m, now, t);
+  }
+}
+
+void HCpuPair::retry_due(int r, bus::Ticks now) {
+  Cpu& c = m_cpu[r];
+  c.retry_at = bus::kNever;
+  if (powered(r) && c.state == CpuState::Stop && c.role == CpuRole::Standby && c.switch_run &&
+      !c.reset_request) {
+    c.retrying = true;
+    c.want_run = true;
+    diag(r, now, "link-up retry after the update timeout");
+  } else {
+    diag(r, now, "link-up retry dropped: the standby is not ready");
+  }
+}
+
+void HCpuPair::set_reset_request(int r, bus::Ticks now) {
+  Cpu& c = m_cpu[r];
+  c.reset_request = true;
+  const bool copying =
+      c.link_up_start != bus::kNever && now - c.link_up_start < load_memory_copy_time();
+  if (copying)
+    diag(r, now, "reset request: link-up interrupted during the load-memory copy", 0x6523);
+  else
+    diag(r, now, "reset request: link-up interrupted");
 }
 
 // ---------------------------------------------------------------- queries
@@ -233,8 +403,8 @@ CpuLeds HCpuPair::leds(int r) const {
 }
 
 bus::Ticks HCpuPair::next_deadline() const {
-  bus::Ticks t = bus::kNever;
-  for (const Cpu& c : m_cpu) t = std::min({t, c.deadline, c.pending_master});
+  bus::Ticks t = m_phase_at;
+  for (const Cpu& c : m_cpu) t = std::min({t, c.deadline, c.pending_master, c.retry_at});
   return t;
 }
 
@@ -254,6 +424,8 @@ void HCpuPair::diag(int r, bus::Ticks now, std::string text, std::uint16_t code)
 void HCpuPair::set_state(int r, CpuState s, bus::Ticks now, std::string_view why) {
   Cpu& c = m_cpu[r];
   if (c.state == s) return;
+  // The standby leaves UPDATE: the update window ends (Redundant/swap, or aborted).
+  if (c.state == CpuState::Update) close_window(now, s != CpuState::Run, false);
   HEvent e;
   e.kind = HEvent::Kind::State;
   e.at = now;
@@ -311,16 +483,28 @@ void HCpuPair::run_due(bus::Ticks now) {
     int r = -1;
     bus::Ticks t = bus::kNever;
     for (int i = 0; i < 2; ++i) {
-      const bus::Ticks d = std::min(m_cpu[i].deadline, m_cpu[i].pending_master);
+      const Cpu& c = m_cpu[i];
+      const bus::Ticks d = std::min({c.deadline, c.pending_master, c.retry_at});
       if (d < t) {
         t = d;
         r = i;
       }
     }
-    if (r < 0 || t > now) return;
+    // t4 (output hold) only when no CPU deadline comes first or at the same time: an abort
+    // at t4 wins, the outputs were not copied.
+    if (m_phase_at < t && m_phase_at <= now) {
+      m_now = std::max(m_now, m_phase_at);
+      const bus::Ticks at = m_phase_at;
+      m_phase_at = bus::kNever;
+      output_hold_begins(at);
+      continue;
+    }
+    if (r < 0 || t > now) break;
+    m_now = std::max(m_now, t);
     expire(r, t);
     after_step(t);
   }
+  m_now = std::max(m_now, now);
 }
 
 void HCpuPair::expire(int r, bus::Ticks now) {
@@ -330,6 +514,10 @@ void HCpuPair::expire(int r, bus::Ticks now) {
     set_role(r, CpuRole::Master, now, "partner not started within the role window");
     return;
   }
+  if (c.retry_at <= now && c.retry_at <= c.deadline) {
+    retry_due(r, now);
+    return;
+  }
   c.deadline = bus::kNever;
   const int p = partner(r);
   switch (c.state) {
@@ -337,10 +525,14 @@ void HCpuPair::expire(int r, bus::Ticks now) {
       set_state(r, CpuState::Run, now, "startup done");
       break;
     case CpuState::LinkUp:
-      set_state(r, CpuState::Update, now, "link-up done");
-      c.deadline = now + m_update_time;
+      begin_update(r, now);
       break;
     case CpuState::Update:
+      if (m_update_abort_at <= now)
+        update_timeout(r, now);
+      else
+        finish_update(r, now);
+      break;
     case CpuState::SyncUp:
       finish_update(r, now);
       break;
@@ -370,6 +562,10 @@ void HCpuPair::evaluate(bus::Ticks now) {
         !powered(partner(r)))
       set_role(r, CpuRole::Master, now, "only CPU");
     if (c.state != CpuState::Stop || !c.want_run) continue;
+    if (c.reset_request) {  // F20: no start until MRES
+      c.want_run = false;
+      continue;
+    }
     if (c.role == CpuRole::Master) {
       c.want_run = false;
       set_state(r, CpuState::Startup, now, "start request");
@@ -438,16 +634,30 @@ void HCpuPair::begin_link_up(int s, bus::Ticks now, Pending after) {
   const int m = partner(s);
   c.want_run = false;
   c.after_update = after;
+  // F19: an automatic retry continues the series, any other start begins a new one.
+  if (!c.retrying) m_tries = 0;
+  c.retrying = false;
+  ++m_tries;
+  c.retry_at = bus::kNever;
   if (is_1500()) {
     set_state(s, CpuState::SyncUp, now, "backup to RUN");
     set_state(m, CpuState::SyncUp, now, "backup to RUN");
-    c.deadline = now + m_p.link_up_time + m_update_time;
+    c.deadline = now + m_p.link_up_time + update_time();
   } else {
+    c.link_up_start = now;
+    // R8: the standby's connections are all broken at link-up; the master keeps its own.
+    if (c.connections > 0)
+      diag(s, now,
+           "link-up: " + std::to_string(c.connections) + " connection(s) of this CPU broken");
+    c.connections = 0;
     set_state(s, CpuState::LinkUp, now,
               after == Pending::Relink ? "re-link after error search"
               : after == Pending::Swap ? "master swap requested"
                                        : "link-up request");
     diag(m, now, "link-up with the standby CPU (rack " + std::to_string(s) + ")");
+    diag(s, now,
+         "LINK-UP: copying the load memory (" +
+             format_ms(ticks_to_us_ceil(load_memory_copy_time())) + ")");
     c.deadline = now + m_p.link_up_time;
   }
 }
@@ -527,7 +737,9 @@ void HCpuPair::power_on(int r, bus::Ticks now) {
   c.pending_master = bus::kNever;
   c.after_update = Pending::None;
   c.hold_remaining = -1;
-  c.want_run = c.switch_run && c.restart_on_power;
+  c.want_run = c.switch_run && c.restart_on_power && !c.reset_request;
+  c.retry_at = bus::kNever;
+  c.retrying = false;
   if (c.defective) {
     set_state(r, CpuState::Defective, now, "power on");
     set_role(r, CpuRole::Standby, now, "defective");
@@ -535,6 +747,7 @@ void HCpuPair::power_on(int r, bus::Ticks now) {
     return;
   }
   set_state(r, CpuState::Stop, now, "power on");
+  if (c.reset_request) diag(r, now, "reset request pending: no start before a memory reset");
   const bool lk = powered(p) && link_whole();
   if (lk && q.role == CpuRole::Master) {
     set_role(r, CpuRole::Standby, now, "partner is master");
@@ -576,7 +789,12 @@ void HCpuPair::power_off(int r, bus::Ticks now) {
   c.after_update = Pending::None;
   c.hold_remaining = -1;
   c.want_run = false;
+  c.retry_at = bus::kNever;
+  c.retrying = false;
+  c.connections = 0;
   diag(r, now, "power off");
+  if (!is_1500() && was == CpuState::LinkUp && c.role == CpuRole::Standby)
+    set_reset_request(r, now);  // F20/R9
   set_state(r, CpuState::Off, now);
   set_role(r, CpuRole::None, now);
   if (lk) partner_lost(r, was_master, was, true, now);
@@ -588,7 +806,14 @@ void HCpuPair::switch_to_run(int r, bus::Ticks now) {
   run_due(now);
   Cpu& c = m_cpu[r];
   c.switch_run = true;
-  if (c.state == CpuState::Stop) c.want_run = true;
+  c.retry_at = bus::kNever;  // a manual start begins a new series of tries (F19)
+  c.retrying = false;
+  if (c.state == CpuState::Stop) {
+    if (c.reset_request)
+      diag(r, now, "STOP -> RUN refused: reset request (memory reset needed)");
+    else
+      c.want_run = true;
+  }
   after_step(now);
 }
 
@@ -598,11 +823,15 @@ void HCpuPair::switch_to_stop(int r, bus::Ticks now) {
   Cpu& c = m_cpu[r];
   c.switch_run = false;
   c.want_run = false;
+  c.retry_at = bus::kNever;
+  c.retrying = false;
   if (running(c.state)) {
     const CpuState was = c.state;
     const bool was_master = c.role == CpuRole::Master;
     const bool lk = linked(r);
     stop_cpu(r, now, "mode switch STOP");
+    if (!is_1500() && was == CpuState::LinkUp && c.role == CpuRole::Standby)
+      set_reset_request(r, now);  // F20/R9
     if (lk) partner_lost(r, was_master, was, false, now);
     if (lk && was_master && m_cpu[partner(r)].role == CpuRole::Master)
       set_role(r, CpuRole::Standby, now, "partner is master");
@@ -783,9 +1012,73 @@ bool HCpuPair::request_master_swap(bus::Ticks now) {
   if (!linked(m) || m_cpu[s].role != CpuRole::Standby || m_cpu[s].state != CpuState::Stop)
     return false;
   diag(m, now, "PG/ES: switch to CPU with modified configuration");
+  if (m_param_change) {  // F23: no swap, the standby stays in STOP
+    const std::string t = "master swap refused: a parameter that may not change was changed";
+    diag(m, now, t, 0x5966);
+    diag(s, now, t, 0x5966);
+    after_step(now);
+    return false;
+  }
   begin_link_up(s, now, Pending::Swap);
   after_step(now);
   return true;
+}
+
+void HCpuPair::set_changed_db_kb(std::uint32_t kb, bus::Ticks now) {
+  run_due(now);
+  m_p.update_db_kb = kb;
+  m_p.update_time.reset();
+}
+
+bool HCpuPair::memory_reset(int r, bus::Ticks now) {
+  check_rack(r);
+  run_due(now);
+  Cpu& c = m_cpu[r];
+  if (c.state != CpuState::Stop) return false;
+  c.reset_request = false;
+  diag(r, now, "memory reset (MRES)");
+  after_step(now);
+  return true;
+}
+
+bool HCpuPair::connect(int r, bus::Ticks now) {
+  check_rack(r);
+  run_due(now);
+  Cpu& c = m_cpu[r];
+  if (!powered(r) || c.state == CpuState::ErrorSearch || c.state == CpuState::Defective)
+    return false;
+  // R8: no new connections on either CPU from the start of link-up to the end of the update.
+  for (const Cpu& x : m_cpu)
+    if (x.state == CpuState::LinkUp || x.state == CpuState::Update) return false;
+  ++c.connections;
+  return true;
+}
+
+HChangeResult HCpuPair::load_change(HChange kind, bus::Ticks now) {
+  run_due(now);
+  const SystemMode mode = system_mode();
+  const int m = master();
+  if (m < 0 || (mode != SystemMode::Solo && mode != SystemMode::Redundant)) {
+    if (m >= 0)
+      diag(m, now,
+           "load refused: " + std::string(to_string(kind)) + " (" +
+               std::string(to_string(mode, m_p.profile)) + ")");
+    return HChangeResult::Refused;
+  }
+  const int s = partner(m);
+  const bool redundant = mode == SystemMode::Redundant;
+  if (kind == HChange::Allowed || !redundant) {
+    const std::string t = "program change loaded: " + std::string(to_string(kind));
+    diag(m, now, t);
+    if (redundant) diag(s, now, t);
+    return HChangeResult::Loaded;
+  }
+  // F22: the change may not be made in Redundant mode: both CPUs STOP (no OB 72: nobody runs).
+  const std::string why = std::string(to_string(kind)) + " loaded in Redundant mode";
+  stop_cpu(s, now, why);
+  stop_cpu(m, now, why);
+  after_step(now);
+  return HChangeResult::BothStopped;
 }
 
 }  // namespace pbvbus::devices

@@ -29,6 +29,9 @@ constexpr Ticks kLinkUp = sec(2);
 constexpr Ticks kUpdate = ms(75) + 100 * (ms(7) / 10);  // 145 ms
 static_assert(kUpdate == ms(145));
 constexpr Ticks kSelfTest = sec(90);
+constexpr Us ms_us(std::int64_t v) {
+  return v * kUsPerMs;
+}
 constexpr Ticks kDay = sec(24 * 3600);
 
 // Power-on CPU0 at 0 and CPU1 at 5 s; Redundant at 5 s + 2 s + 145 ms = 7.145 s.
@@ -524,8 +527,13 @@ TEST(HCpuPair, StandbyLostDuringLinkUpAndMasterLostDuringUpdate) {
   EXPECT_EQ(p.system_mode(), SystemMode::Solo);
   EXPECT_TRUE(has_diag(p, 0, kCpu1On + sec(1), "link-up aborted: standby CPU lost"));
   EXPECT_TRUE(obs(p, 72).empty());
+  // F20: power lost during LINK-UP leaves a reset request: no start before the memory reset.
   p.power_on(1, sec(10));
+  EXPECT_EQ(p.state(1), CpuState::Stop);
+  EXPECT_TRUE(p.memory_reset(1, sec(10)));
+  p.switch_to_run(1, sec(10));
   p.on_time(sec(10) + kLinkUp);  // UPDATE
+  EXPECT_EQ(p.state(1), CpuState::Update);
   p.power_off(0, sec(12) + ms(50));
   EXPECT_EQ(p.state(1), CpuState::Stop);
   EXPECT_EQ(p.master(), 1);
@@ -576,6 +584,9 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
     std::mt19937 rng(seed);
     HCpuPairParams prm;
     if (seed == 4) prm.profile = HProfile::S7_1500RH;
+    // Seed 3 with the manual's H parameters (T_PH 90 ms, T_P15 194 ms): DB changes above
+    // 170 KB make the update time out (F19).
+    if (seed == 3) prm.h_parameters = HParameters{ms_us(1940), ms_us(776), ms_us(194), ms_us(90)};
     HCpuPair p(prm);
     Ticks now = 0;
     bool split_seen = false;
@@ -632,13 +643,38 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
           p.repair_cpu(1 - r, now);
           break;
         case 15:
+          if (rng() % 8 == 0) p.set_standby_parameter_change(rng() % 2 == 0);
           p.request_master_swap(now);
+          break;
+        case 16:
+          p.memory_reset(r, now);
+          p.switch_to_run(r, now);
+          break;
+        case 17:
+          p.connect(r, now);
+          break;
+        case 18:
+          if (rng() % 4 == 0) p.load_change(static_cast<HChange>(rng() % 3), now);
+          break;
+        case 19:
+          p.set_changed_db_kb(static_cast<std::uint32_t>(rng() % 300), now);
           break;
         default:
           p.switch_to_run(r, now);
           break;
       }
       EXPECT_GT(p.next_deadline(), now);
+      // The update model: the no-I/O window only while a CPU is in UPDATE; the output hold
+      // lies inside it; data-record jobs are refused exactly while interrupts are held.
+      const bool in_update = p.state(0) == CpuState::Update || p.state(1) == CpuState::Update;
+      if (p.io_frozen()) {
+        EXPECT_TRUE(in_update);
+      }
+      if (p.outputs_held_by_both()) {
+        EXPECT_TRUE(p.io_frozen());
+      }
+      EXPECT_EQ(p.record_job_result(51, now), p.interrupts_held() ? 0x8085 : 0);
+      EXPECT_LE(p.update_tries(), kUpdateMaxTries);
       for (int i = 0; i < 2; ++i) {
         const int o = 1 - i;
         const CpuState st = p.state(i);
@@ -647,6 +683,9 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
         }
         if (st == CpuState::Defective) {
           EXPECT_NE(p.role(i), CpuRole::Master);
+        }
+        if (p.reset_request(i)) {  // F20: no start before the memory reset
+          EXPECT_TRUE(st == CpuState::Off || st == CpuState::Stop || st == CpuState::Defective);
         }
         const bool syncing_standby =
             st == CpuState::LinkUp || st == CpuState::Update ||
@@ -667,7 +706,7 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
       if (::testing::Test::HasFailure()) return;
     }
     Ticks last = 0;
-    int redundant = 0, two_masters = 0, error_search = 0, defective = 0, ob72 = 0;
+    int redundant = 0, two_masters = 0, error_search = 0, defective = 0, ob72 = 0, timeouts = 0;
     for (const HEvent& e : p.events()) {
       EXPECT_GE(e.at, last);
       last = e.at;
@@ -678,6 +717,7 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
       if (e.kind == HEvent::Kind::State && e.to_state == CpuState::ErrorSearch) ++error_search;
       if (e.kind == HEvent::Kind::State && e.to_state == CpuState::Defective) ++defective;
       if (e.kind == HEvent::Kind::Ob && e.ob == 72) ++ob72;
+      if (e.kind == HEvent::Kind::Ob && e.reason == HReason::UpdateTimeout) ++timeouts;
     }
     // The walk reaches the interesting states (not only the invariants' trivial cases).
     EXPECT_GE(redundant, 10);
@@ -686,10 +726,13 @@ TEST(HCpuPair, RandomOperationsKeepInvariants) {
     if (prm.profile == HProfile::S7_400H) {
       EXPECT_GE(error_search, 3);
     }
+    if (seed == 3) {
+      EXPECT_GE(timeouts, 3);
+    }
     std::printf(
         "seed %u: Redundant %d, standby->master %d, ERROR-SEARCH %d, DEFECTIVE %d, "
-        "OB 72 %d\n",
-        seed, redundant, two_masters, error_search, defective, ob72);
+        "OB 72 %d, update timeouts %d\n",
+        seed, redundant, two_masters, error_search, defective, ob72, timeouts);
   }
 }
 

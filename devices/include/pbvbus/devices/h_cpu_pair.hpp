@@ -30,7 +30,38 @@
 //   the CPU when its switch is at RUN and it was not in STOP when it lost power (digest §4).
 // - STARTUP (startup_time) runs on the master only; a standby whose switch is at RUN waits in
 //   STOP until the master is in RUN (Solo), then goes LINK-UP (link_up_time) -> UPDATE
-//   (update_time) -> RUN (Redundant). The master stays RUN throughout (Table 4-1).
+//   (W, below) -> RUN (Redundant). The master stays RUN throughout (Table 4-1).
+// - The update in phases (400H; digest §3.1 timeline, §4 "Update steps"): t1 = the standby
+//   enters UPDATE (end of LINK-UP): data-record jobs refused (record_job_result: 80C3/8085),
+//   messages/communication and OB 1/classes <= 15 delayed, DP interrupts held
+//   (interrupts_held). t3 = t1: the delay stages take no time in this model. [t3, t5) is the
+//   no-I/O window (io_frozen: no OB, no I/O update on either CPU) of length
+//   W = MAX(T_P15_AWP(update_db_kb) = 75 ms + 0.7 ms/KB (or update_time), 50 ms + T_PH), the
+//   50 ms + T_PH term only with a configured T_PH > 0. t4 = t5 - T_PH: output hold
+//   (outputs_held_by_both; empty with T_PH = 0); t4 is a deadline of its own. t5 = Redundant
+//   mode or the swap. The pair only reports the phases; holding/delivering interrupts, pausing
+//   the program and driving outputs is the owner's. dp_master_operate() is not changed by the
+//   window (a Clear would drive safe values; the owner asks io_frozen()).
+// - Update timeout (F19/R6): the first monitored (set, not 0) limit among T_P15, max
+//   communication delay, max cycle extension that is < W aborts the update at t3 + limit (each
+//   covers W from t1 = t2 = t3 here; a valid set makes T_P15 the first). Abort: standby STOP
+//   (re-reads its SDBs), Solo with the same master, OB 72 UpdateTimeout on the master, buffer
+//   entries on both, any pending swap dropped; the standby retries by itself exactly 60 s later
+//   (a plain link-up), at most kUpdateMaxTries tries per series; switch_to_run(), power-on, the
+//   re-link after ERROR-SEARCH and request_master_swap() start a new series. Not modelled: the
+//   cycle monitoring time that bounds an update with no H parameters.
+// - F20/R9: the standby powered off or switched to STOP in LINK-UP gets a reset request
+//   (W#16#6523 if within the first load_memory_copy_time of LINK-UP, default half of it); it
+//   stays in STOP (switch_to_run refused, no start at power-on) until memory_reset(), which
+//   does not start it. Aborts caused by the partner or the link set no reset request.
+// - R8: connect(r) counts S7 connections; refused on a CPU off/ERROR-SEARCH/DEFECTIVE and on
+//   both CPUs while a CPU is in LINK-UP or UPDATE; link-up breaks the standby's, keeps the
+//   master's; power-off drops a CPU's.
+// - F22 load_change(): Allowed -> buffer entry; a structural FB-interface or global-DB change
+//   in Redundant -> both CPUs STOP (no OB 72), in Solo -> loaded; refused unless Solo or
+//   Redundant (no block load during link-up/update). F23: with set_standby_parameter_change
+//   (true) request_master_swap() is refused at the request: standby stays in STOP, W#16#5966
+//   in both buffers.
 // - Leaving Redundant: master power-off or STOP -> the standby becomes master in Solo, OB 72 on
 //   it; standby power-off or STOP -> Solo, OB 72 on the master. During link-up/update: the
 //   link-up is aborted (the standby to STOP; if the master was lost, the survivor becomes
@@ -58,7 +89,8 @@
 //   STOP): link-up and update, then the old standby is master in RUN (Solo) and the old master
 //   STOPs; OB 72 on the new master.
 // - S7-1500R/H profile: STOP -> STARTUP (primary only) -> RUN-Solo -> SYNCUP (both CPUs,
-//   link_up_time + update_time) -> RUN-Redundant; roles named primary/backup; no HOLD; a
+//   link_up_time + W, no phases, no timeout, no reset request, io_frozen() etc. false) ->
+//   RUN-Redundant; roles named primary/backup; no HOLD; a
 //   comparison error or one-sided OB 121 STOPs the CPU (no ERROR-SEARCH in the 1500 excerpt).
 
 #include <array>
@@ -72,6 +104,7 @@
 
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
+#include "pbvbus/devices/h_update_timing.hpp"
 
 namespace pbvbus::devices {
 
@@ -122,6 +155,7 @@ enum class HReason : std::uint8_t {
   ComparisonError,  ///< F16
   OneSidedOb121,    ///< F17
   MasterSwap,       ///< automatic swap after ERROR-SEARCH or the operator's swap
+  UpdateTimeout,    ///< F19/R6: the update exceeded a configured monitoring time
 };
 std::string_view to_string(HReason r);
 
@@ -160,9 +194,18 @@ struct HCpuPairParams {
   bus::Ticks startup_time = 1000 * bus::kTicksPerMs;  ///< STARTUP (OB 100) on the master
   bus::Ticks link_up_time = 2000 * bus::kTicksPerMs;  ///< LINK-UP (program compare/copy)
   /// KB of data blocks the update copies (for the default update_time).
+  /// KB of changed data blocks the next update copies (T_P15_AWP's KB; set_changed_db_kb()
+  /// changes it at run time).
   std::uint32_t update_db_kb = 100;
-  /// UPDATE duration; default 75 ms + 0.7 ms per KB of update_db_kb (digest §3.1, T7).
+  /// Overrides the copy time T_P15_AWP(update_db_kb) = 75 ms + 0.7 ms per KB (digest §3.1, T7)
+  /// in the no-I/O window W; cleared by set_changed_db_kb().
   std::optional<bus::Ticks> update_time;
+  /// The four configured H parameters (µs; all unset = none configured). Checked with
+  /// check_h_parameters() in the constructor: an Error throws std::invalid_argument.
+  HParameters h_parameters;
+  /// The load-memory copy at the start of LINK-UP (F20/R9: W#16#6523). Default: half of
+  /// link_up_time (T8: the default 2 s are 1 MB x 1 s of copy + 1 s base). 0..link_up_time.
+  std::optional<bus::Ticks> load_memory_copy_time;
   bus::Ticks role_window = 3000 * bus::kTicksPerMs;       ///< R2
   bus::Ticks self_test_time = 90 * bus::kTicksPerSecond;  ///< full self-test in ERROR-SEARCH
   bus::Ticks cyclic_self_test_period = 90 * 60 * bus::kTicksPerSecond;
@@ -176,6 +219,32 @@ struct HCpuPairParams {
 constexpr bus::Ticks default_update_time(std::uint32_t kb) {
   return 75 * bus::kTicksPerMs + static_cast<bus::Ticks>(kb) * (7 * bus::kTicksPerMs / 10);
 }
+
+/// A program change loaded into the H system (F22).
+enum class HChange : std::uint8_t {
+  Allowed,                ///< a change allowed in any mode: nothing happens but a buffer entry
+  StructuralFbInterface,  ///< a structural change of an FB interface
+  GlobalDb,               ///< a change of a global DB's structure
+};
+std::string_view to_string(HChange c);
+
+enum class HChangeResult : std::uint8_t {
+  Loaded,       ///< loaded (Solo, or an allowed change)
+  BothStopped,  ///< F22: not allowed in Redundant mode: both CPUs went to STOP
+  Refused,      ///< not loadable now: no master in RUN, or during link-up/update (digest §4)
+};
+std::string_view to_string(HChangeResult r);
+
+/// The times of one update (400H): t1 start of UPDATE (= t3 here), t3 start of the no-I/O
+/// window (T_P15), t4 start of the output hold (T_PH), t5 Redundant mode / swap, or the abort.
+struct UpdateWindow {
+  bus::Ticks t1 = 0, t3 = 0, t4 = 0, t5 = 0;
+  bool aborted = false;    ///< ended before the planned t5 (timeout, CPU or link lost): t5 = then
+  bool timed_out = false;  ///< aborted by the update monitoring (F19)
+};
+
+/// F19/R6: the standby retries the link-up this long after an update timeout (>= 1 min).
+inline constexpr bus::Ticks kUpdateRetryDelayTicks = to_ticks(kUpdateRetryDelay);
 
 class HCpuPair {
  public:
@@ -206,6 +275,23 @@ class HCpuPair {
   /// PG/ES "switch to CPU with modified configuration"; false unless Solo with the master in
   /// RUN and the standby powered in STOP over a whole link.
   bool request_master_swap(bus::Ticks now);
+  /// The next update copies `kb` KB of changed DBs (the program changed DBs since the last
+  /// update): W grows by 0.7 ms per KB; a running update keeps its plan. Clears update_time.
+  void set_changed_db_kb(std::uint32_t kb, bus::Ticks now);
+  /// MRES on `rack` (powered, STOP/DEFECTIVE excluded): clears a reset request (F20/R9). The CPU
+  /// stays in STOP; a switch_to_run() starts it. false if not possible.
+  bool memory_reset(int rack, bus::Ticks now);
+  /// R8: open an S7 connection to `rack`; false on a CPU that is off, in ERROR-SEARCH or
+  /// DEFECTIVE, and on both CPUs from the start of a link-up to the end of the update (400H).
+  bool connect(int rack, bus::Ticks now);
+  /// F22: load a program change (into the master; in Redundant mode into both).
+  HChangeResult load_change(HChange kind, bus::Ticks now);
+  /// F23: the standby's configuration has a changed parameter that may not change; a
+  /// request_master_swap() is then refused (standby stays in STOP, W#16#5966 on both).
+  void set_standby_parameter_change(bool may_not_change) { m_param_change = may_not_change; }
+  /// R7: the result of a data-record SFC started at `now`: W#16#80C3 for SFC 13, 55..59 and
+  /// W#16#8085 for SFC 51 while an update runs ([t1, t5)), else 0.
+  std::uint16_t record_job_result(int sfc, bus::Ticks now);
 
   bus::Ticks next_deadline() const;
   void on_time(bus::Ticks now);
@@ -236,7 +322,21 @@ class HCpuPair {
   const std::vector<HEvent>& events() const { return m_events; }
   void on_event(std::function<void(const HEvent&)> cb) { m_cb = std::move(cb); }
   const HCpuPairParams& params() const { return m_p; }
-  bus::Ticks update_time() const { return m_update_time; }
+  /// W of the next update: MAX(T_P15_AWP(KB) or update_time, 50 ms + T_PH).
+  bus::Ticks update_time() const;
+  /// Inside [t3, t5) of a running update (400H): no program scan, no I/O update on either CPU.
+  bool io_frozen() const;
+  /// Inside [t4, t5) of a running update (400H): both CPUs drive the outputs (T_PH).
+  bool outputs_held_by_both() const;
+  /// From t1 to t5 of a running update: DP interrupts are stored, delivered after (by the owner).
+  bool interrupts_held() const;
+  /// The running update, or the last completed/aborted one.
+  std::optional<UpdateWindow> update_window() const { return m_window; }
+  /// Link-up/update tries in the current series (F19: at most kUpdateMaxTries); a new start
+  /// request (switch_to_run, power-on, re-link, master swap) starts a new series.
+  int update_tries() const { return m_tries; }
+  int connections(int rack) const { return m_cpu[rack].connections; }
+  bool reset_request(int rack) const { return m_cpu[rack].reset_request; }
 
  private:
   enum class Pending : std::uint8_t { None, Relink, Swap };
@@ -254,6 +354,11 @@ class HCpuPair {
     bus::Ticks hold_remaining = -1;  ///< STARTUP time left when HOLD was entered, -1: from RUN
     std::optional<bus::Ticks> last_ob121;
     Pending after_update = Pending::None;  ///< what the end of this standby's update does
+    bool reset_request = false;            ///< F20/R9: STOP until memory_reset()
+    bool retrying = false;                 ///< the pending start is an F19 retry
+    bus::Ticks link_up_start = bus::kNever;
+    bus::Ticks retry_at = bus::kNever;  ///< F19: the standby's own link-up retry
+    int connections = 0;                ///< R8: open S7 connections
     std::deque<DiagEntry> diag;
   };
 
@@ -282,8 +387,25 @@ class HCpuPair {
   void stop_cpu(int r, bus::Ticks now, std::string_view why);
   void make_defective(int r, bus::Ticks now, std::string_view why);
 
+  void begin_update(int s, bus::Ticks now);
+  void update_timeout(int s, bus::Ticks now);
+  void close_window(bus::Ticks now, bool aborted, bool timed_out);
+  bus::Ticks load_memory_copy_time() const {
+    return m_p.load_memory_copy_time.value_or(m_p.link_up_time / 2);
+  }
+  void output_hold_begins(bus::Ticks now);
+  void retry_due(int r, bus::Ticks now);
+  void set_reset_request(int r, bus::Ticks now);
+
   HCpuPairParams m_p;
-  bus::Ticks m_update_time;
+  bus::Ticks m_now = 0;  ///< the latest time seen (queries without a time use it)
+  std::optional<UpdateWindow> m_window;
+  bool m_update_running = false;
+  bus::Ticks m_update_abort_at = bus::kNever;  ///< F19: t3 + the first monitoring limit < W
+  std::string m_update_limit;                  ///< which limit it is, for the buffer
+  bus::Ticks m_phase_at = bus::kNever;         ///< t4 while it lies ahead
+  int m_tries = 0;
+  bool m_param_change = false;
   std::array<Cpu, 2> m_cpu;
   std::array<bool, 2> m_fibre_ok{true, true};
   bus::Ticks m_search_redundant_at = bus::kNever;  ///< Redundant reached after ERROR-SEARCH

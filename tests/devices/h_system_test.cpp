@@ -454,7 +454,11 @@ TEST(HSystem, AutomaticSwapAfterErrorSearchKeepsChannels) {
   EXPECT_EQ(s.h->side_mode(0, 1), Mode::Stop);
   // Self-test 4 -> 5 s, LINK-UP 5 -> 7 s, UPDATE 7 -> 7.145 s, swap.
   const bus::Ticks up = te + 3000 * kMs, swap = up + 145 * kMs;
+  s.run_until(te + 1500 * kMs);
+  EXPECT_TRUE(s.one[1]->application().outputs_safe());  // B's master stopped: 11 dropped
+  EXPECT_EQ(s.one_outputs(0), s.counter);
   s.run_until(swap + 1000 * kMs);
+  EXPECT_EQ(s.one_outputs(1), s.counter);  // back with B's master
   EXPECT_EQ(s.h->pair().master(), 1);
   EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Redundant);
   const auto io = s.s7();
@@ -542,6 +546,58 @@ TEST(HSystem, DiagBufferMergesCpuAndIoEntries) {
     EXPECT_EQ(d.size(), cpu.size() + 1) << r;
     EXPECT_EQ(cpu.back().at, tf) << r;  // the pair logged the cut at the same instant
   }
+}
+
+// The program's inputs come through the I/O map (the one-sided slave 10's module at PII 4..5);
+// the I/O gate skips whole scans: the hook does not run and the outputs stay as they were.
+// Solo from 1.012 s, scans at 1.012 + k x 10 ms; the gate is shut for [2.000 s, 2.100 s):
+// the scans at 2.002, 2.012, ..., 2.092 s (10) are skipped. Until 2.5 s: k = 0..148 = 149
+// scan times, 149 - 10 = 139 scans run.
+TEST(HSystem, InputsThroughTheMapAndTheIoGate) {
+  HCpuPairParams p;
+  p.switch_run = {true, false};
+  HSys s(p);
+  const Bytes in{0x12, 0x34};
+  ASSERT_TRUE(s.one[0]->application().write_inputs(0, in));
+  s.h->set_io_gate([](bus::Ticks now) { return now < 2000 * kMs || now >= 2100 * kMs; });
+  s.at(kT0);
+  s.h->power_on_both();
+  s.run_until(1995 * kMs);
+  EXPECT_EQ(s.h->pii()[4], 0x12);
+  EXPECT_EQ(s.h->pii()[5], 0x34);
+  EXPECT_EQ(s.h->pii()[6], 0x00);  // 11 on B: no active channel (B never ran), last value 0
+  s.run_until(2000 * kMs);
+  const std::uint16_t frozen = s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8);
+  EXPECT_NE(frozen, 0);
+  s.run_until(2095 * kMs);
+  EXPECT_EQ(s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8), frozen);
+  s.run_until(2500 * kMs);
+  EXPECT_EQ(s.h->scans(), 139u);
+  EXPECT_EQ(s.counter, 139);
+}
+
+// A CPU never powered is no lost line: the master alone runs Solo, its partner's side stays
+// dark and idle, no I/O event at all; the master's power-off then loses line A only (one 39C3,
+// no OB: no CPU runs a program, and no CPU is powered to log it).
+TEST(HSystem, NeverPoweredPartnerIsNoLineLoss) {
+  HSys s;
+  s.at(kT0);
+  s.h->power_on(0);
+  s.run_until(3000 * kMs);
+  EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Solo);
+  EXPECT_EQ(s.h->side_mode(0, 1), Mode::Unpowered);
+  EXPECT_FALSE(s.sys->attachment_powered(1));
+  EXPECT_TRUE(s.ms().line_idle(1));
+  EXPECT_TRUE(s.s7().empty());
+  for (std::uint8_t a : {kFast, kSlow}) EXPECT_EQ(s.ms().active(a), 0) << int(a);
+  s.h->power_off(0);
+  const auto io = s.s7();
+  ASSERT_EQ(io.size(), 1u);
+  EXPECT_EQ(io[0].code(), 0x39C3);
+  EXPECT_EQ(io[0].line, 0);
+  EXPECT_EQ(io[0].time, 3000 * kMs);
+  EXPECT_TRUE(s.h->events().empty());
+  EXPECT_EQ(s.h->diag_buffer(0).size(), s.h->pair().diag_buffer(0).size());
 }
 
 }  // namespace

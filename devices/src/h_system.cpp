@@ -260,6 +260,11 @@ void insert_sorted(std::vector<HSystemEvent>& v, HSystemEvent e) {
 }
 }  // namespace
 
+void HSystemModel::add_event(HSystemEvent e) {
+  if (m_handler) m_handler(e);
+  insert_sorted(m_events, std::move(e));
+}
+
 void HSystemModel::on_pair_event(const HEvent& e) {
   if (e.kind != HEvent::Kind::Ob) return;
   HSystemEvent h;
@@ -270,7 +275,7 @@ void HSystemModel::on_pair_event(const HEvent& e) {
   h.code = e.code;
   h.text = "OB " + std::to_string(e.ob) + " " + std::string(to_string(e.reason));
   h.source = HSystemEvent::Source::Cpu;
-  insert_sorted(m_events, std::move(h));
+  add_event(std::move(h));
 }
 
 void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) {
@@ -300,7 +305,7 @@ void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) 
   h.system = static_cast<int>(s);
   h.line = e.line;
   h.station = e.station;
-  insert_sorted(m_events, std::move(h));
+  add_event(std::move(h));
 }
 
 std::vector<DiagEntry> HSystemModel::diag_buffer(int r) const {

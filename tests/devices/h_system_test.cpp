@@ -260,8 +260,13 @@ TEST(HSystem, F1MasterPowerOffOneMasterSystemFailureNoPulse) {
   Sampler smp(s);
   s.bring_up();
   const bus::Ticks tf = 4000 * kMs;
+  std::vector<int> handled;
+  s.h->set_event_handler([&](const HSystemEvent& e) { handled.push_back(e.ob); });
   s.at(tf);
   s.h->power_off(0);
+  EXPECT_EQ(handled, (std::vector<int>{72, 86}));
+  EXPECT_EQ(s.h->model(0), s.sys.get());
+  EXPECT_EQ(s.h->model(1), nullptr);
   EXPECT_EQ(s.h->pair().master(), 1);
   EXPECT_EQ(s.h->side_mode(0, 0), Mode::Unpowered);
   EXPECT_FALSE(s.sys->attachment_powered(0));

@@ -123,7 +123,10 @@ class HSystemModel final : public bus::EventTarget {
   // ---- queries ----
   const HCpuPair& pair() const { return m_pair; }
   std::span<RedundantMasterSystemModel* const> master_systems() const { return m_systems; }
-  RedundantMasterSystemModel& model(std::size_t system) { return *m_systems.at(system); }
+  /// Master system `system`, nullptr if there is none.
+  RedundantMasterSystemModel* model(std::size_t system) {
+    return system < m_systems.size() ? m_systems[system] : nullptr;
+  }
   const HIoMap& io_map() const { return m_map; }
   /// OB 1 scans run so far.
   std::uint64_t scans() const { return m_scans; }
@@ -132,6 +135,10 @@ class HSystemModel final : public bus::EventTarget {
   /// What side `rack` of master system `system` was last set to.
   SideMode side_mode(std::size_t system, int rack) const;
   const std::vector<HSystemEvent>& events() const { return m_events; }
+  /// Called with every event as it is added to events() (for a runtime's report or capture).
+  /// The model owns the MasterSystems' on_event callbacks: read them through this or
+  /// MasterSystem::events().
+  void set_event_handler(std::function<void(const HSystemEvent&)> h) { m_handler = std::move(h); }
   std::vector<DiagEntry> diag_buffer(int rack) const;
   HSystemLeds leds(int rack) const;
 
@@ -152,6 +159,7 @@ class HSystemModel final : public bus::EventTarget {
   void scan(bus::Ticks now);
   void on_pair_event(const HEvent& e);
   void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
+  void add_event(HSystemEvent e);
   bool valid_rack(int r) const { return r == 0 || r == 1; }
 
   bus::Scheduler& m_sched;
@@ -168,6 +176,7 @@ class HSystemModel final : public bus::EventTarget {
   std::uint64_t m_gen = 0;  ///< generation of the armed pair deadline
   bus::Ticks m_armed_at = bus::kNever;
   std::vector<HSystemEvent> m_events;
+  std::function<void(const HSystemEvent&)> m_handler;
   std::array<std::vector<DiagEntry>, 2> m_io_diag;
 };
 

@@ -572,7 +572,7 @@ TEST(HSystem, InputsThroughTheMapAndTheIoGate) {
   EXPECT_EQ(s.h->pii()[5], 0x34);
   EXPECT_EQ(s.h->pii()[6], 0x00);  // 11 on B: no active channel (B never ran), last value 0
   s.run_until(2000 * kMs);
-  const std::uint16_t frozen = s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8);
+  const int frozen = s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8);
   EXPECT_NE(frozen, 0);
   s.run_until(2095 * kMs);
   EXPECT_EQ(s.station(kFast).outputs()[1] | (s.station(kFast).outputs()[0] << 8), frozen);

@@ -605,5 +605,29 @@ TEST(HSystem, NeverPoweredPartnerIsNoLineLoss) {
   EXPECT_EQ(s.h->diag_buffer(0).size(), s.h->pair().diag_buffer(0).size());
 }
 
+// Two master systems: the second system's modules follow the first's in both images (PII/PIQ
+// 8..9 for its slave at 3); a null system is dropped.
+TEST(HSystem, IoMapSecondSystemFollowsTheFirst) {
+  HSys s;
+  const GsdFile plain = load("PBVB0A01.gsd");
+  auto sp = master_slave_params(plain, plain_modules(), 3);
+  ASSERT_TRUE(sp.ok());
+  RedundantMasterSystemOptions o;
+  o.bus_params = s.bp;
+  RedundantMasterSystemModel second(o, {*sp.value}, {}, {});
+  const std::vector<RedundantMasterSystemModel*> both{s.sys.get(), &second};
+  const HIoMap map(both);
+  ASSERT_EQ(map.entries().size(), 7u);
+  EXPECT_EQ(map.entries()[6], (HIoEntry{1, 3, 0, 8, 2, 8, 2}));
+  EXPECT_EQ(map.pii_size(), 10u);
+  EXPECT_EQ(map.piq_size(), 10u);
+  bus::Scheduler other;
+  HSystemModel h(other, {}, {nullptr, &second});
+  EXPECT_EQ(h.master_systems().size(), 1u);
+  EXPECT_EQ(h.io_map().entries(), (std::vector<HIoEntry>{{0, 3, 0, 0, 2, 0, 2}}));
+  EXPECT_EQ(h.leds(0).busf.size(), 1u);
+  EXPECT_EQ(h.leds(2).busf.size(), 0u);  // bad rack: empty, no crash
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

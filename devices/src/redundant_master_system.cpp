@@ -82,6 +82,7 @@ bus::AttachmentId RedundantMasterSystemModel::attach(int line, bus::Line& l, std
   if (line != 0 && line != 1) throw std::invalid_argument("redundant master system: line 0 or 1");
   m_line[line] = &l;
   m_att[line] = l.attach(m_node[line]->station(), std::move(label));
+  if (!m_cpu_on[line]) l.set_power(m_att[line], false);  // attachments start unpowered anyway
   return m_att[line];
 }
 
@@ -124,7 +125,22 @@ void RedundantMasterSystemModel::repair_master(int line) {
   if (!m_failed[line]) return;
   m_failed[line] = false;
   m_system->line_back(line, now(line));
-  if (m_line[line] != nullptr) m_line[line]->set_power(m_att[line], true);
+  apply_power(line);
+}
+
+void RedundantMasterSystemModel::set_cpu_power(int line, bool on) {
+  if (line != 0 && line != 1) return;
+  m_cpu_on[line] = on;
+  apply_power(line);
+}
+
+void RedundantMasterSystemModel::apply_power(int line) {
+  if (m_line[line] == nullptr) return;
+  m_line[line]->set_power(m_att[line], m_cpu_on[line] && !m_failed[line]);
+}
+
+bool RedundantMasterSystemModel::attachment_powered(int line) const {
+  return (line == 0 || line == 1) && m_line[line] != nullptr && m_line[line]->powered(m_att[line]);
 }
 
 }  // namespace pbvbus::devices

@@ -13,6 +13,7 @@ std::string_view to_string(LineLoss c) {
     case LineLoss::ShortCircuit: return "short circuit";
     case LineLoss::MasterStop: return "master stop";
     case LineLoss::MasterFailure: return "master failure";
+    case LineLoss::CpuFailure: return "CPU failure";
   }
   return "?";
 }
@@ -152,7 +153,29 @@ std::array<std::uint8_t, kPrmCmdLen> MasterSystem::block(const Station& s,
 
 bool MasterSystem::reporting(int line) const {
   // A 39C3 line loss reports once for the whole line; a master failure reports per station.
+  if (m_line[line].idle) return false;  // never started: nothing to report for it
   return !m_line[line].lost || m_line[line].cause == LineLoss::MasterFailure;
+}
+
+std::optional<LineLoss> MasterSystem::line_loss(int line) const {
+  if ((line != 0 && line != 1) || !m_line[line].lost) return std::nullopt;
+  return m_line[line].cause;
+}
+
+bool MasterSystem::mark_line_idle(int line) {
+  if (line != 0 && line != 1) return false;
+  Line& l = m_line[line];
+  if (l.ran || l.lost) return false;
+  l.idle = true;
+  return true;
+}
+
+bool MasterSystem::start_line(int line, bus::Ticks now) {
+  if (line != 0 && line != 1) return false;
+  if (!m_line[line].idle) return false;
+  m_line[line].idle = false;
+  m_now = std::max(m_now, now);
+  return true;
 }
 
 void MasterSystem::emit(SystemEvent::Kind k, bus::Ticks t, int line, std::uint8_t station,
@@ -261,6 +284,7 @@ void MasterSystem::channel_up(Station& s, int line, bus::Ticks now,
   const int other = 1 - line;
   s.up[line] = true;
   s.down[line] = false;
+  m_line[line].ran = true;
   if (!s.switched) {
     if (s.failed) {
       s.failed = false;
@@ -353,7 +377,7 @@ void MasterSystem::switch_to(Station& s, int line, bus::Ticks now, SystemEvent::
 }
 
 void MasterSystem::line_lost(int line, LineLoss cause, bus::Ticks now) {
-  if ((line != 0 && line != 1) || m_line[line].lost) return;
+  if ((line != 0 && line != 1) || m_line[line].lost || m_line[line].idle) return;
   m_line[line].lost = true;
   m_line[line].cause = cause;
   const bool per_station = cause == LineLoss::MasterFailure;
@@ -367,7 +391,7 @@ void MasterSystem::line_lost(int line, LineLoss cause, bus::Ticks now) {
 }
 
 void MasterSystem::line_back(int line, bus::Ticks now) {
-  if ((line != 0 && line != 1) || !m_line[line].lost) return;
+  if ((line != 0 && line != 1) || !m_line[line].lost || m_line[line].idle) return;
   m_line[line].lost = false;
   if (m_line[line].cause != LineLoss::MasterFailure)
     emit(SystemEvent::Kind::MasterSystemReturn, now, line, 0xFF, SystemEvent::Cause::LineLost);

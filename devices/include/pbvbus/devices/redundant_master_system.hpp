@@ -82,6 +82,18 @@ class RedundantMasterSystemModel {
   void repair_master(int line);
   bool master_failed(int line) const { return m_failed[line]; }
 
+  // --- the owning CPU (devices::HSystemModel) ---
+  /// The CPU that owns line l's master is powered or not. The master's attachment is powered
+  /// only while its CPU is powered and the master module has not failed (fail_master), so a
+  /// repair_master() of an unpowered CPU's master keeps it dark and a CPU power-on does not
+  /// revive a failed module. Only the power: the owner tells the MasterSystem (line_lost with
+  /// LineLoss::CpuFailure) and sets the master's mode itself. Before attach() the state is
+  /// remembered and applied by attach().
+  void set_cpu_power(int line, bool on);
+  bool cpu_powered(int line) const { return m_cpu_on[line]; }
+  /// The line's master attachment is powered (attached, CPU on, module not failed).
+  bool attachment_powered(int line) const;
+
  private:
   class Node;
   void check_medium(int line, bus::Ticks now);
@@ -94,6 +106,8 @@ class RedundantMasterSystemModel {
   bus::AttachmentId m_att[2] = {};
   bool m_short[2] = {false, false};
   bool m_failed[2] = {false, false};
+  bool m_cpu_on[2] = {true, true};
+  void apply_power(int line);
   CycleHook m_hook;
   std::function<void(int, const dp::MasterEvent&)> m_master_events;
 };

@@ -47,6 +47,16 @@
 //       the line had failed: 73A3 for switched stations, 39C4 for one-sided slaves; their
 //       returns as usual (72A3, 38C4).
 //   While a line is lost, the masters' own StationFailure reports from it are bookkeeping only.
+//     CpuFailure (H-system, the CPU owning the line's master is off): as ShortCircuit.
+// - A line that has not started (mark_line_idle(): the standby CPU's DP master before its first
+//   link-up, or a CPU never powered) is NOT lost: no 39C3/38C3 for it, line_lost()/line_back()
+//   and the master's ModeChange are ignored, and the StationFailure reports of its master are
+//   bookkeeping only (a station whose other channel comes up meanwhile gets no 73A3: the I/O
+//   was never redundant). start_line() ends it silently: the line's channels come up as its
+//   master reaches data exchange with them, without 72A3/38C4 (the owed returns are silent);
+//   from then on the line reports like any other, and when it stops it is lost as above.
+//   mark_line_idle() is refused (false) for a line that has run (a channel was up on it) or is
+//   lost: a line that ran and stops is a lost line.
 // - Outputs: write_outputs() writes the same octets into BOTH masters' images (one program,
 //   two channels), so whichever channel is active carries the newest value and a switchover
 //   can never bring an older one. Inputs (and the diagnosis the program uses) come from the
@@ -121,6 +131,10 @@ enum class LineLoss : std::uint8_t {
   ShortCircuit,   ///< the master's transceiver reads back garbage (F14)
   MasterStop,     ///< the line's master went to Stop/Offline (F14: CP RUN → STOP)
   MasterFailure,  ///< the master module itself failed (F9)
+  /// The CPU that owns the line's master failed or lost power (H-system F1: "a CPU failure is
+  /// a master-system failure for its side's DP lines"): like ShortCircuit/MasterStop, one
+  /// W#16#39C3 and no per-station events; W#16#38C3 when the CPU's DP master runs again.
+  CpuFailure,
 };
 std::string_view to_string(LineLoss c);
 
@@ -174,6 +188,13 @@ class MasterSystem {
   void line_lost(int line, LineLoss cause, bus::Ticks now);
   void line_back(int line, bus::Ticks now);
   bool line_is_lost(int line) const { return m_line[line].lost; }
+  /// Why the line is lost, or nothing if it is not (bad line: nothing).
+  std::optional<LineLoss> line_loss(int line) const;
+  /// Declares a line not started (see above); false if it ran already, is lost or is not 0/1.
+  bool mark_line_idle(int line);
+  /// The idle line starts (its master is about to run): silent; false if it was not idle.
+  bool start_line(int line, bus::Ticks now);
+  bool line_idle(int line) const { return (line == 0 || line == 1) && m_line[line].idle; }
   bus::Ticks next_deadline() const;
   void on_time(bus::Ticks now);
 
@@ -277,6 +298,8 @@ class MasterSystem {
   struct Line {
     bool lost = false;
     LineLoss cause = LineLoss::ShortCircuit;
+    bool idle = false;  ///< not started (mark_line_idle), no events for it
+    bool ran = false;   ///< a channel was up on it once
   } m_line[2];
   std::vector<SystemEvent> m_events;
   std::function<void(const SystemEvent&)> m_cb;

@@ -1,0 +1,183 @@
+#pragma once
+// The H-system model (issue 8; docs/h-system.md "The H-system model (CPU pair + DP master
+// systems)"; seeds-digest.md §1, §2, §6, §7 F1, F5–F7, F9–F14, §11): an HCpuPair (owned) driving
+// N redundant DP master systems (RedundantMasterSystemModel, not owned; rack r <-> line r of
+// each) on a bus::Scheduler, with the user program (OB 1) on the process images.
+//
+// Decisions (the reasons are in the doc):
+// - Reconciliation after every operation, every pair deadline and at construction: per rack r
+//   and per master system the side-r DP master follows its CPU:
+//     CPU off -> the master's attachment is unpowered (set_cpu_power) and, if the line ran,
+//       MasterSystem::line_lost(r, LineLoss::CpuFailure): one W#16#39C3 for that system, no
+//       per-station event; W#16#38C3 when that CPU's DP master runs again;
+//     powered, !dp_master_running(r) (STOP/LINK-UP as standby, ERROR-SEARCH, DEFECTIVE ...) ->
+//       master Stop and, if the line ran, line_lost(r, MasterStop): one 39C3; back -> 38C3;
+//     running -> Operate while the master CPU's program runs (dp_master_operate(master())),
+//       else Clear (a master CPU in STOP/STARTUP still accesses the switched I/O, digest §1,
+//       with the outputs disabled). With two masters (F6/F7) each side follows its own CPU
+//       (dp_master_operate(r)). A standby in UPDATE therefore already sends the master's
+//       outputs: one program, write_outputs writes both images.
+//   A side whose master never ran is idle (MasterSystem::mark_line_idle): no 39C3, no 73A3 for
+//   its channels; when it starts its channels come up without any event. Order: when a side
+//   goes away the MasterSystem is told first (it switches every station on that line to the
+//   other one at once), then the master is stopped / unpowered (as stop_master() does).
+// - The program: set_program(hook, scan_time). OB 1 starts every scan_time (start to start)
+//   while some CPU operates as master (dp_master_operate of a master rack); each scan: the PII
+//   from the active images through io_map(), the hook, the PIQ through write_outputs (both
+//   lines alike). No hook: no scans, outputs untouched. The first scan runs at the instant the
+//   master CPU starts operating (as a scheduler event after the operation). set_io_gate(g):
+//   when g(now) is false the scan is skipped entirely (not counted), the next one is still
+//   scheduled. With two masters one program runs (the same user program on both CPUs; their
+//   divergence is not modelled).
+// - Events: events() merges, in time order, the pair's OB events (72, 121; source Cpu) and
+//   every S7 event of the master systems (OB 70/86; source Io). An I/O OB runs on every CPU that
+//   runs a program (dp_master_operate): rack -1 when both do (Redundant), the one rack in Solo;
+//   when no CPU runs a program no OB runs: the event is only a diagnostic-buffer entry (not in
+//   events()). Every powered CPU logs each I/O event in its diagnostic buffer (digest §7 F3:
+//   "both CPUs log"); diag_buffer(r) merges the pair's entries and these by time, the pair's
+//   first at equal times (the CPU's change comes first, the I/O reaction follows it), the newest
+//   diag_capacity entries.
+// - LEDs: leds(r) = the pair's CpuLeds plus BUSxF per master system (dark when the CPU is off):
+//   On when side r's line is lost by a short circuit or its master module failed (bus or
+//   interface fault); Flashing when a station of that line failed (one-sided slave 39C4) or a
+//   switched station lost its channel on that line (73A3 owed back) while the line runs; Off
+//   otherwise, also when the line is lost only because its CPU/master stopped.
+// - The lines must be started (bus::Line::start powers every attachment) before the model is
+//   constructed: the construction unpowers the masters of the CPUs that are off.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/bus/time.hpp"
+#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/devices/h_io_map.hpp"
+#include "pbvbus/devices/redundant_master_system.hpp"
+
+namespace pbvbus::devices {
+
+struct HSystemEvent {
+  enum class Source : std::uint8_t { Cpu, Io };
+  bus::Ticks time = 0;
+  int rack = -1;                  ///< the CPU the OB runs on; -1 = both
+  CpuRole role = CpuRole::None;   ///< the role of that CPU (both: Master)
+  int ob = 0;                     ///< 70, 72, 86, 121
+  std::uint16_t code = 0;         ///< W#16#73A3 ... for I/O events; 0 for OB 72/121
+  std::string text;
+  Source source = Source::Cpu;
+  int system = -1;                ///< master system index (Io), -1 for CPU events
+  int line = -1;                  ///< Io: the line concerned
+  std::uint8_t station = 0xFF;    ///< Io: the station, 0xFF for the whole master system
+};
+
+enum class BusLed : std::uint8_t { Off, On, Flashing };
+std::string_view to_string(BusLed l);
+
+struct HSystemLeds {
+  CpuLeds cpu;
+  std::vector<BusLed> busf;  ///< one per master system (BUS1F, BUS2F, ...)
+};
+
+class HSystemModel final : public bus::EventTarget {
+ public:
+  using Program = std::function<void(std::span<const std::uint8_t> pii,
+                                     std::span<std::uint8_t> piq, bus::Ticks now)>;
+  using IoGate = std::function<bool(bus::Ticks now)>;
+  enum class SideMode : std::uint8_t { Unpowered, Stop, Clear, Operate };
+
+  /// Null entries in `systems` are dropped. The lines must already be started.
+  HSystemModel(bus::Scheduler& sched, HCpuPairParams params,
+               std::vector<RedundantMasterSystemModel*> systems);
+  HSystemModel(const HSystemModel&) = delete;
+  HSystemModel& operator=(const HSystemModel&) = delete;
+
+  // ---- the program ----
+  /// scan_time <= 0 is replaced by 1 ms. An empty hook stops the scans.
+  void set_program(Program hook, bus::Ticks scan_time);
+  void set_io_gate(IoGate gate) { m_gate = std::move(gate); }
+
+  // ---- operations (at scheduler.now(), then reconciliation) ----
+  void power_on(int rack);
+  void power_on_both();
+  void power_off(int rack);
+  void switch_to_run(int rack);
+  void switch_to_stop(int rack);
+  void cut_fibre(int fibre);
+  void cut_both_fibres();
+  void repair_fibre(int fibre);
+  bool hold(int rack);
+  bool release_hold(int rack);
+  bool inject_comparison_error();
+  bool one_sided_ob121(int rack);
+  void inject_hardware_fault(int rack);
+  void repair_cpu(int rack);
+  bool request_master_swap();
+  /// Brings every side in line with its CPU now (the operations do it themselves).
+  void reconcile();
+
+  // ---- queries ----
+  const HCpuPair& pair() const { return m_pair; }
+  std::span<RedundantMasterSystemModel* const> master_systems() const { return m_systems; }
+  /// Master system `system`, nullptr if there is none.
+  RedundantMasterSystemModel* model(std::size_t system) {
+    return system < m_systems.size() ? m_systems[system] : nullptr;
+  }
+  const HIoMap& io_map() const { return m_map; }
+  /// OB 1 scans run so far.
+  std::uint64_t scans() const { return m_scans; }
+  std::span<const std::uint8_t> pii() const { return m_pii; }
+  std::span<const std::uint8_t> piq() const { return m_piq; }
+  /// What side `rack` of master system `system` was last set to.
+  SideMode side_mode(std::size_t system, int rack) const;
+  const std::vector<HSystemEvent>& events() const { return m_events; }
+  /// Called with every event as it is added to events() (for a runtime's report or capture).
+  /// The model owns the MasterSystems' on_event callbacks: read them through this or
+  /// MasterSystem::events().
+  void set_event_handler(std::function<void(const HSystemEvent&)> h) { m_handler = std::move(h); }
+  std::vector<DiagEntry> diag_buffer(int rack) const;
+  HSystemLeds leds(int rack) const;
+
+  void on_event(bus::Ticks now, std::uint64_t tag) override;
+
+ private:
+  struct Side {
+    SideMode mode = SideMode::Operate;  ///< unknown at construction: forced by the first pass
+    bool known = false;
+    bool ran = false;
+  };
+  void after_op();
+  void arm_deadline();
+  void arm_scan(bus::Ticks at);
+  bool program_runs() const;
+  SideMode target(int rack) const;
+  void apply(std::size_t system, int rack, SideMode to);
+  void scan(bus::Ticks now);
+  void on_pair_event(const HEvent& e);
+  void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
+  void add_event(HSystemEvent e);
+  bool valid_rack(int r) const { return r == 0 || r == 1; }
+
+  bus::Scheduler& m_sched;
+  HCpuPair m_pair;
+  std::vector<RedundantMasterSystemModel*> m_systems;
+  std::vector<std::array<Side, 2>> m_side;
+  HIoMap m_map;
+  std::vector<std::uint8_t> m_pii, m_piq;
+  Program m_program;
+  IoGate m_gate;
+  bus::Ticks m_scan_time = bus::kTicksPerMs;
+  bool m_scan_armed = false;
+  std::uint64_t m_scans = 0;
+  std::uint64_t m_gen = 0;  ///< generation of the armed pair deadline
+  bus::Ticks m_armed_at = bus::kNever;
+  std::vector<HSystemEvent> m_events;
+  std::function<void(const HSystemEvent&)> m_handler;
+  std::array<std::vector<DiagEntry>, 2> m_io_diag;
+};
+
+}  // namespace pbvbus::devices

@@ -65,6 +65,7 @@ std::vector<std::string> validate(const ProgramSpec& spec, std::size_t pii_bytes
     const std::string who = "copy " + std::to_string(i);
     if (n.length == 0) {
       c.out.push_back(who + ": length 0 (at least 1 octet)");
+      copy_out.push_back(Range{0, 0});  // keeps the indices of the later messages right
       continue;
     }
     c.inside_pii(who, "from_input", n.from_input, n.length);
@@ -137,6 +138,7 @@ std::vector<std::string> validate(const ProgramSpec& spec, std::size_t pii_bytes
     const std::string who = "monitor " + std::to_string(i);
     if (n.length == 0) {
       c.out.push_back(who + ": length 0 (at least 1 octet)");
+      mon_out.push_back(Range{0, 0});
       continue;
     }
     if (n.mask == 0)

@@ -396,5 +396,33 @@ TEST(HProgram, ValidationOfCountersAgainstEachOtherAndHugeAddresses) {
   EXPECT_TRUE(validate(ok, 4, 8).empty());
 }
 
+TEST(HProgram, ValidationOfLengthsSignsAndMonitorOutputs) {
+  ProgramSpec s;
+  s.copies.push_back({0, 0, 0});
+  CounterNetwork c;
+  c.output = 2;
+  c.pulse_output = 3;
+  c.pulse_high = -5;
+  s.counters.push_back(c);
+  DiscrepancyNetwork m0;
+  m0.length = 0;
+  DiscrepancyNetwork m1;  // IB 0 vs IB 1 → QB 0
+  m1.input_b = 1;
+  m1.discrepancy_time = -1;
+  DiscrepancyNetwork m2 = m1;  // IB 2 vs IB 3 → QB 0 again
+  m2.input_a = 2;
+  m2.input_b = 3;
+  m2.discrepancy_time = 0;
+  s.monitors = {m0, m1, m2};
+  EXPECT_EQ(validate(s, 4, 4), (std::vector<std::string>{
+                                   "copy 0: length 0 (at least 1 octet)",
+                                   "counter 0: pulse_high -5 ticks must be ≥ 0",
+                                   "monitor 0: length 0 (at least 1 octet)",
+                                   "monitor 1: discrepancy_time -1 ticks must be ≥ 0",
+                                   "monitor 2: to_output QB 0 (1 octet) overlaps the output of "
+                                   "monitor 1",
+                               }));
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

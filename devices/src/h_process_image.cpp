@@ -64,16 +64,15 @@ std::optional<ImageDifference> first_difference(const ProcessImage& a, const Pro
     auto x = a.area(area);
     auto y = b.area(area);
     const std::size_t common = std::min(x.size(), y.size());
-    auto [px, py] = std::mismatch(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(common),
-                                  y.begin());
-    std::size_t off = static_cast<std::size_t>(px - x.begin());
+    const auto px =
+        std::mismatch(x.begin(), x.begin() + static_cast<std::ptrdiff_t>(common), y.begin()).first;
+    const auto off = static_cast<std::size_t>(px - x.begin());
     if (off == common && x.size() == y.size()) continue;
     ImageDifference d;
     d.area = area;
     d.offset = static_cast<std::uint32_t>(off);
     d.value[0] = off < x.size() ? x[off] : 0;
     d.value[1] = off < y.size() ? y[off] : 0;
-    (void)py;
     return d;
   }
   return std::nullopt;

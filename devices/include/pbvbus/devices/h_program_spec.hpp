@@ -48,6 +48,10 @@ struct CounterNetwork {
 /// agreed value is used, and a difference lasting longer than `discrepancy_time` raises the
 /// discrepancy error (error 7960) once per pair until they agree again. The used value goes to
 /// PIQ[to_output .. +length).
+/// Boundary (decided in h_program.hpp): the program sees the inputs only at its scans, so the
+/// difference is timed from the first scan that saw it, and 7960 is raised at the first scan at
+/// which it has lasted >= discrepancy_time (then it has lasted at least that long); the episode
+/// ends, with a "gone" event if 7960 was raised, at the first scan that sees all mask bits agree.
 struct DiscrepancyNetwork {
   std::uint32_t input_a = 0;
   std::uint32_t input_b = 0;

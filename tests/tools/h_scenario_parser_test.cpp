@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pbvbus/tools/commands.hpp"
 #include "pbvbus/tools/scenario.hpp"
 
 namespace pbvbus::tools {
@@ -316,6 +317,19 @@ TEST(HScenarioParser, TheExampleLoads) {
   int h_faults = 0;
   for (const auto& f : r.plan->faults) h_faults += is_h_fault(f.kind) ? 1 : 0;
   EXPECT_EQ(h_faults, 3);  // fibre_cut, cpu_stop, cpu_failure
+}
+
+// `pbvbus timing` still plans the example: the h_system is also timing input.
+TEST(HScenarioParser, PbvbusTimingPlansTheExample) {
+  std::ostringstream out, err;
+  const int rc = cmd_timing({PBVBUS_SOURCE_DIR "/examples/h-system.textproto"}, out, err);
+  ASSERT_EQ(rc, 0) << err.str();
+  // T_P15_AWP(100 KB) = 75 + 0.7 x 100 = 145 ms > T_P15_OD = 50 + 30 = 80 ms -> T_P15 145 ms;
+  // T_PH = MAX(30 ms, 3 x T_TR 2.38 ms) = 30 ms; the configured {1450, 580, 145, 30} passes.
+  EXPECT_NE(out.str().find("T_P15_AWP = 75 ms + 0.7 ms x 100 KB = 145 ms"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("[3] T_P15 = MAX(T_P15_AWP, T_P15_OD) = 145 ms"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("configured H parameters: ok"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("H-DP 1"), std::string::npos) << out.str();
 }
 
 }  // namespace

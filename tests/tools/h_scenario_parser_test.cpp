@@ -112,7 +112,10 @@ TEST(HScenarioParser, AnEmptyCpuPartTakesThePairsDefaults) {
 }
 
 TEST(HScenarioParser, HFaultsArePlannedInTimeOrder) {
-  const std::string text = kPair + R"(
+  // The 400H profile: HOLD and the operator swap exist there.
+  std::string pair = kPair;
+  pair.replace(pair.find("S7_1500RH"), 9, "S7_400H");
+  const std::string text = pair + R"(
 fault { at: "10s" repair_at: "12s" cpu_failure { rack: 0 } }
 fault { at: "1s" repair_at: "2s" fibre_cut { h_system: "H-CPU" fibre: 1 } }
 fault { at: "20s" update_load { kb: 500 } }
@@ -234,6 +237,13 @@ TEST(HScenarioParser, FaultsNeedASimulatedPairAndANameWhenThereAreSeveral) {
   ASSERT_TRUE(r.ok()) << r.errors[0].str();
   EXPECT_EQ(r.plan->faults[0].h_system, 1);
   EXPECT_EQ(r.plan->faults[0].description, "CPU 1 (rack 1) fails (h_system \"B\")");
+  // The 1500 profile has neither HOLD nor the operator swap (docs/h-system.md rules 5, 13).
+  EXPECT_EQ(errors_of("h_system { name: \"R\" cpu { profile: S7_1500RH } }\n"
+                      "fault { at: \"1s\" repair_at: \"2s\" cpu_hold { rack: 0 } }\n"
+                      "fault { at: \"1s\" master_swap { } }\n"),
+            (std::vector<std::string>{"h.textproto:2:34: cpu_hold: the S7-1500R/H profile has no HOLD",
+                                      "h.textproto:3:18: master_swap: the S7-1500R/H profile has no "
+                                      "operator master swap"}));
   // Two simulated pairs of one name.
   EXPECT_EQ(errors_of("h_system { name: \"A\" cpu { } }\nh_system { name: \"A\" cpu { } }\n"),
             (std::vector<std::string>{

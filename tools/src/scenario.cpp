@@ -743,6 +743,15 @@ class Planner {
       }
     }
     pf.h_system = found;
+    // The pair refuses these in the 1500 profile (docs/h-system.md rules 5 and 13): a scenario
+    // that asks for them is wrong, not a run that shows a refusal.
+    const auto& rt = *plan.h_systems[static_cast<std::size_t>(found)].runtime;
+    if (rt.pair.profile == devices::HProfile::S7_1500RH &&
+        (pf.kind == K::CpuHold || pf.kind == K::HMasterSwap)) {
+      error(kw, kind + ": the S7-1500R/H profile has no " +
+                    (pf.kind == K::CpuHold ? std::string("HOLD") : std::string("operator master swap")));
+      return false;
+    }
     if (needs_rack) {
       if (!rack) {
         error(kw, kind + " needs a rack: rack: 0 or rack: 1");

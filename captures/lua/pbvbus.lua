@@ -146,6 +146,24 @@ local line_event_codes = {
 }
 -- Redundancy events (tools/include/pbvbus/tools/redundancy_system.hpp): code =
 -- redundancy::SystemEvent::Kind, value = the S7 event id (0 for a switchover record).
+-- H-system CPU pair events (captures/include/pbvbus/captures/cpu_event.hpp): code = kind,
+-- a = rack, b = role after the event, value = event ID (bits 0..15) | OB << 16 | reason << 24 |
+-- to << 32 | from << 40 (state, role or system mode by kind).
+local cpu_event_kinds = { [0] = "state change", [1] = "role change", [2] = "system mode change", [3] = "OB" }
+local cpu_roles = { [0] = "none", [1] = "master", [2] = "standby" }
+local cpu_states = {
+  [0] = "OFF", [1] = "STOP", [2] = "STARTUP", [3] = "RUN", [4] = "LINK-UP", [5] = "UPDATE",
+  [6] = "HOLD", [7] = "ERROR-SEARCH", [8] = "DEFECTIVE", [9] = "SYNCUP",
+}
+local cpu_modes = {
+  [0] = "Stop", [1] = "Startup", [2] = "Solo", [3] = "Link-up", [4] = "Update", [5] = "Redundant",
+  [6] = "Hold", [7] = "SYNCUP",
+}
+local cpu_reasons = {
+  [0] = "none", [1] = "master CPU lost", [2] = "master CPU in STOP", [3] = "standby CPU lost",
+  [4] = "standby CPU in STOP", [5] = "redundant link lost", [6] = "comparison error",
+  [7] = "one-sided OB 121", [8] = "master/standby swap",
+}
 local redundancy_event_codes = {
   [0] = "redundancy loss", [1] = "redundancy restored", [2] = "station failure",
   [3] = "station return", [4] = "master system failure", [5] = "master system return",
@@ -420,6 +438,15 @@ local EV = {
   value = ProtoField.uint64("pbevent.value", "Value", base.HEX),
   text = ProtoField.string("pbevent.text", "Text", base.UNICODE),
   s7 = ProtoField.string("pbevent.s7", "S7 event id"),
+  cpu_kind = ProtoField.uint16("pbevent.cpu.kind", "CPU event", base.DEC, cpu_event_kinds),
+  cpu_rack = ProtoField.int32("pbevent.cpu.rack", "Rack", base.DEC),
+  cpu_role = ProtoField.int32("pbevent.cpu.role", "Role", base.DEC, cpu_roles),
+  cpu_ob = ProtoField.uint8("pbevent.cpu.ob", "OB number", base.DEC),
+  cpu_ob_name = ProtoField.string("pbevent.cpu.ob_name", "OB"),
+  cpu_reason = ProtoField.uint8("pbevent.cpu.reason", "Reason", base.DEC, cpu_reasons),
+  cpu_event_id = ProtoField.uint16("pbevent.cpu.event_id", "Event ID", base.HEX),
+  cpu_from = ProtoField.string("pbevent.cpu.from", "From"),
+  cpu_to = ProtoField.string("pbevent.cpu.to", "To"),
 }
 ev.fields = {}
 for _, f in pairs(EV) do table.insert(ev.fields, f) end
@@ -1289,14 +1316,39 @@ function ev.dissector(tvb, pinfo, tree)
   local cname
   if cat == 1 then cname = line_event_codes[code] end
   if cat == 4 then cname = redundancy_event_codes[code] end
+  if cat == 5 then cname = cpu_event_kinds[code] end
   if cname then t:add(EV.code_name, tvb(2, 2), cname) end
   t:add_le(EV.line, tvb(4, 4))
   t:add_le(EV.a, tvb(8, 4))
   t:add_le(EV.b, tvb(12, 4))
   t:add_le(EV.value, tvb(16, 8))
-  -- Redundancy and CPU events carry the S7 event id (W#16#73A3 ...) in the value.
-  if (cat == 4 or cat == 5) and tvb(16, 4):le_uint() ~= 0 then
+  -- Redundancy and CPU events carry the S7 event id (W#16#73A3 ...) in the value (CPU: its low
+  -- 16 bits; the rest is the OB, reason and from/to, cpu_event.hpp).
+  if cat == 4 and tvb(16, 4):le_uint() ~= 0 then
     t:add(EV.s7, tvb(16, 2), string.format("W#16#%04X", tvb(16, 4):le_uint()))
+  end
+  if cat == 5 then
+    if tvb(16, 2):le_uint() ~= 0 then
+      t:add(EV.s7, tvb(16, 2), string.format("W#16#%04X", tvb(16, 2):le_uint()))
+    end
+    local c = t:add(ev, tvb(2, 22), "CPU event")
+    c:set_text("CPU event: " .. (cpu_event_kinds[code] or ("kind " .. code)))
+    c:add_le(EV.cpu_kind, tvb(2, 2))
+    c:add_le(EV.cpu_rack, tvb(8, 4))
+    c:add_le(EV.cpu_role, tvb(12, 4))
+    c:add_le(EV.cpu_event_id, tvb(16, 2))
+    local names = nil
+    if code == 0 then names = cpu_states elseif code == 1 then names = cpu_roles elseif code == 2 then names = cpu_modes end
+    if code == 3 then
+      local ob = tvb(18, 1):uint()
+      c:add(EV.cpu_ob, tvb(18, 1))
+      c:add(EV.cpu_ob_name, tvb(18, 1), "OB " .. ob)
+      c:add(EV.cpu_reason, tvb(19, 1))
+    elseif names then
+      local to, from = tvb(20, 1):uint(), tvb(21, 1):uint()
+      c:add(EV.cpu_from, tvb(21, 1), names[from] or tostring(from))
+      c:add(EV.cpu_to, tvb(20, 1), names[to] or tostring(to))
+    end
   end
   local text = ""
   if n > 24 then

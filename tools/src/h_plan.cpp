@@ -1,6 +1,9 @@
 // A scenario's h_system entries (h_plan.hpp).
 #include "pbvbus/tools/h_plan.hpp"
 
+#include <exception>
+#include <map>
+
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/timing_plan.hpp"
 
@@ -10,17 +13,40 @@ namespace {
 
 class HPlanner {
  public:
-  HPlanner(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors)
-      : m_plan(plan), m_locate(locate), m_errors(errors) {}
+  HPlanner(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
+           std::vector<Diagnostic>& errors)
+      : m_plan(plan), m_locate(locate), m_hlocate(hlocate), m_errors(errors) {}
 
   void run() {
     for (int i = 0; i < m_plan.proto.h_system_size(); ++i) plan_one(i);
+    check_shared_systems();
   }
 
  private:
   void error(int i, const char* field, std::string msg) {
     auto [l, c] = m_locate("h_system", i, field, -1);
     m_errors.push_back({m_plan.file, l, c, std::move(msg)});
+  }
+  void error_at(int i, const std::vector<HPathStep>& path, std::string msg) {
+    auto [l, c] = m_hlocate(i, path);
+    m_errors.push_back({m_plan.file, l, c, std::move(msg)});
+  }
+
+  /// A duration field inside the entry (nested path); nullopt with an error if it is bad or
+  /// not above 0 when `positive`.
+  std::optional<bus::Ticks> ticks(int i, const std::vector<HPathStep>& path, const std::string& text,
+                                  bool positive) {
+    auto t = bus::parse_duration(text);
+    const std::string name = path.back().field;
+    if (!t) {
+      error_at(i, path, "bad duration \"" + text + "\" for " + name + " (e.g. \"100ms\")");
+      return std::nullopt;
+    }
+    if (positive && *t <= 0) {
+      error_at(i, path, name + " must be longer than 0");
+      return std::nullopt;
+    }
+    return t;
   }
 
   /// A duration in whole µs (ns precision is not needed for ms-scale H parameters).
@@ -92,18 +118,181 @@ class HPlanner {
       if (!p.min_io_hold_time().empty())
         hp.params.t_ph = us(i, "h_parameters", p.min_io_hold_time());
     }
+    if (h.has_cpu()) {
+      plan_runtime(i, hp);
+    } else if (h.has_program()) {
+      error(i, "program", "h_system \"" + hp.name + "\": a program needs a cpu part (the simulated pair)");
+    }
     m_plan.h_systems.push_back(std::move(hp));
+  }
+
+  void plan_runtime(int i, HSystemPlan& hp) {
+    const auto& h = m_plan.proto.h_system(i);
+    const auto& c = h.cpu();
+    HRuntimePlan rt;
+    auto& p = rt.pair;
+    p.profile = c.profile() == scenario::HCpuPair::S7_1500RH ? devices::HProfile::S7_1500RH
+                                                             : devices::HProfile::S7_400H;
+    const scenario::HCpu* cpus[2] = {&c.cpu0(), &c.cpu1()};
+    for (int r = 0; r < 2; ++r) {
+      const char* field = r == 0 ? "cpu0" : "cpu1";
+      p.switch_run[static_cast<std::size_t>(r)] = cpus[r]->switch_() == scenario::HCpu::RUN;
+      if (!cpus[r]->has_power_on()) continue;  // default: 0 s
+      const std::string& text = cpus[r]->power_on();
+      if (text == "off") {
+        rt.power_on[static_cast<std::size_t>(r)].reset();
+      } else if (auto t = ticks(i, {{"cpu"}, {field}, {"power_on"}}, text, false)) {
+        if (m_plan.duration && *t > *m_plan.duration)
+          error_at(i, {{"cpu"}, {field}, {"power_on"}},
+                   "power_on " + text + " is after the end of the run (" + m_plan.proto.duration() + ")");
+        rt.power_on[static_cast<std::size_t>(r)] = *t;
+      }
+    }
+    rt.fibres_connected_at_power_on =
+        !c.has_fibres_connected_at_power_on() || c.fibres_connected_at_power_on();
+    if (!c.startup_time().empty())
+      if (auto t = ticks(i, {{"cpu"}, {"startup_time"}}, c.startup_time(), true)) p.startup_time = *t;
+    if (!c.link_up_time().empty())
+      if (auto t = ticks(i, {{"cpu"}, {"link_up_time"}}, c.link_up_time(), true)) p.link_up_time = *t;
+    if (!c.self_test_time().empty())
+      if (auto t = ticks(i, {{"cpu"}, {"self_test_time"}}, c.self_test_time(), true))
+        p.self_test_time = *t;
+    if (c.has_update_db_kb())
+      p.update_db_kb = c.update_db_kb();
+    else if (h.work_memory_db_kb() != 0)
+      p.update_db_kb = h.work_memory_db_kb();
+    p.comparison_reaction = c.comparison_reaction() == scenario::HCpuPair::STOP
+                                ? devices::ComparisonReaction::Stop
+                                : devices::ComparisonReaction::ErrorSearch;
+
+    // The driven systems: dp_system entries naming a redundant_master_system, each once.
+    for (std::size_t k = 0; k < hp.dp_systems.size(); ++k) {
+      const int s = hp.dp_systems[k].system;
+      if (s < 0) continue;
+      bool dup = false;
+      for (int x : rt.systems) dup |= x == s;
+      if (dup) {
+        error_at(i, {{"dp_system", static_cast<int>(k)}, {"system"}},
+                 "h_system \"" + hp.name + "\": redundant_master_system \"" +
+                     m_plan.redundant_systems[static_cast<std::size_t>(s)].name +
+                     "\" is named twice (a pair drives a system once)");
+        continue;
+      }
+      rt.systems.push_back(s);
+    }
+    if (h.has_program()) plan_program(i, h.program(), rt.program);
+
+    // A simulated pair must not run on a bad set of H parameters.
+    try {
+      const devices::UpdatePlan up = devices::plan_update(h_update_input(m_plan, hp));
+      const devices::HCheckResult r = devices::check_h_parameters(hp.params, &up);
+      for (const auto& v : r.violations)
+        if (v.severity == devices::Severity::Error)
+          error(i, "h_parameters", "h_system \"" + hp.name + "\" (simulated): H parameters: " +
+                                       std::string(devices::to_string(v.check)) + ": " + v.message);
+    } catch (const std::exception& e) {
+      error(i, "dp_system", "h_system \"" + hp.name + "\": cannot plan the update: " + e.what());
+    }
+    hp.runtime = std::move(rt);
+  }
+
+  void plan_program(int i, const scenario::HProgram& pr, devices::ProgramSpec& spec) {
+    if (!pr.scan_time().empty())
+      if (auto t = ticks(i, {{"program"}, {"scan_time"}}, pr.scan_time(), true)) spec.scan_time = *t;
+    for (int k = 0; k < pr.copy_size(); ++k) {
+      const auto& n = pr.copy(k);
+      devices::CopyNetwork c;
+      c.from_input = n.from_input();
+      c.to_output = n.to_output();
+      if (n.has_length()) {
+        if (n.length() == 0)
+          error_at(i, {{"program"}, {"copy", k}, {"length"}}, "copy network: length must be at least 1");
+        c.length = n.length();
+      }
+      spec.copies.push_back(c);
+    }
+    for (int k = 0; k < pr.counter_size(); ++k) {
+      const auto& n = pr.counter(k);
+      devices::CounterNetwork c;
+      c.output = n.output();
+      if (n.has_width()) {
+        if (n.width() != 1 && n.width() != 2 && n.width() != 4)
+          error_at(i, {{"program"}, {"counter", k}, {"width"}},
+                   "counter network: width " + std::to_string(n.width()) + " is not 1, 2 or 4 octets");
+        c.width = n.width();
+      }
+      if (!n.period().empty())
+        if (auto t = ticks(i, {{"program"}, {"counter", k}, {"period"}}, n.period(), true)) c.period = *t;
+      if (n.has_step()) c.step = n.step();
+      c.pulse_output = n.pulse_output();
+      if (n.pulse_bit() > 7)
+        error_at(i, {{"program"}, {"counter", k}, {"pulse_bit"}},
+                 "counter network: pulse_bit " + std::to_string(n.pulse_bit()) + " is not 0..7");
+      c.pulse_bit = static_cast<std::uint8_t>(n.pulse_bit() & 7U);
+      if (!n.pulse_high().empty())
+        if (auto t = ticks(i, {{"program"}, {"counter", k}, {"pulse_high"}}, n.pulse_high(), false)) {
+          c.pulse_high = *t;
+          if (c.pulse_high >= c.period)
+            error_at(i, {{"program"}, {"counter", k}, {"pulse_high"}},
+                     "counter network: pulse_high " + n.pulse_high() + " is not shorter than the period");
+        }
+      spec.counters.push_back(c);
+    }
+    for (int k = 0; k < pr.monitor_size(); ++k) {
+      const auto& n = pr.monitor(k);
+      devices::DiscrepancyNetwork d;
+      d.input_a = n.input_a();
+      d.input_b = n.input_b();
+      if (n.has_length()) {
+        if (n.length() == 0)
+          error_at(i, {{"program"}, {"monitor", k}, {"length"}}, "monitor network: length must be at least 1");
+        d.length = n.length();
+      }
+      if (n.has_mask()) {
+        if (n.mask() > 0xFF)
+          error_at(i, {{"program"}, {"monitor", k}, {"mask"}},
+                   "monitor network: mask " + std::to_string(n.mask()) + " is more than one octet");
+        d.mask = static_cast<std::uint8_t>(n.mask() & 0xFFU);
+      }
+      d.to_output = n.to_output();
+      if (!n.discrepancy_time().empty())
+        if (auto t = ticks(i, {{"program"}, {"monitor", k}, {"discrepancy_time"}}, n.discrepancy_time(), true))
+          d.discrepancy_time = *t;
+      spec.monitors.push_back(d);
+    }
+  }
+
+  /// A redundant_master_system is driven by at most one simulated pair; simulated pairs have
+  /// distinct names (faults name them).
+  void check_shared_systems() {
+    std::map<int, std::size_t> owner;  // system -> h_systems index
+    std::map<std::string, std::size_t> names;
+    for (std::size_t k = 0; k < m_plan.h_systems.size(); ++k) {
+      const auto& hp = m_plan.h_systems[k];
+      if (!hp.runtime) continue;
+      if (!names.emplace(hp.name, k).second)
+        error(hp.source, "name", "h_system \"" + hp.name + "\" is defined twice (faults name it)");
+      for (int s : hp.runtime->systems) {
+        auto [it, fresh] = owner.emplace(s, k);
+        if (!fresh)
+          error(hp.source, "dp_system",
+                "redundant_master_system \"" + m_plan.redundant_systems[static_cast<std::size_t>(s)].name +
+                    "\" is already driven by h_system \"" + m_plan.h_systems[it->second].name + "\"");
+      }
+    }
   }
 
   ScenarioPlan& m_plan;
   const DpLocator& m_locate;
+  const HLocator& m_hlocate;
   std::vector<Diagnostic>& m_errors;
 };
 
 }  // namespace
 
-void plan_h(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors) {
-  HPlanner(plan, locate, errors).run();
+void plan_h(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
+            std::vector<Diagnostic>& errors) {
+  HPlanner(plan, locate, hlocate, errors).run();
 }
 
 devices::UpdatePlanInput h_update_input(const ScenarioPlan& plan, const HSystemPlan& h) {

@@ -173,7 +173,21 @@ class Planner {
       return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
     };
     plan_dp(plan, locate, m_errors);
-    plan_h(plan, locate, m_errors);
+    const HLocator hlocate = [this](int index, const std::vector<HPathStep>& path) {
+      Where w = nested(m_root, scenario::Scenario::descriptor(), "h_system", index);
+      const pb::Descriptor* d = scenario::HSystem::descriptor();
+      for (std::size_t k = 0; k < path.size() && d != nullptr; ++k) {
+        if (k + 1 == path.size()) {
+          w = at_field(w, d, path[k].field, path[k].index);
+        } else {
+          const pb::Descriptor* next = field_of(d, path[k].field)->message_type();
+          w = nested(w, d, path[k].field, path[k].index);
+          d = next;
+        }
+      }
+      return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
+    };
+    plan_h(plan, locate, hlocate, m_errors);
     plan_stations(plan);
     plan_captures(plan);
     plan_faults(plan);
@@ -630,6 +644,160 @@ class Planner {
     return true;
   }
 
+  /// The H-system faults (docs/h-scenarios.md): the h_system by name (optional with one
+  /// simulated pair), which must have a `cpu` part; rack/fibre 0 or 1 where needed; repair_at
+  /// only where a repair exists. The Simulation does not apply them yet (the H-system runtime
+  /// will).
+  bool plan_h_fault(const ScenarioPlan& plan, const scenario::Fault& f, const Where& w, PlanFault& pf) {
+    using K = PlanFault::Kind;
+    using FK = scenario::Fault::KindCase;
+    const auto* fd = scenario::Fault::descriptor();
+    struct Info {
+      K kind;
+      const char* field;
+      bool repair;
+    };
+    Info info{K::CpuFailure, "cpu_failure", true};
+    std::string h_name;
+    std::optional<std::uint32_t> rack, fibre;
+    bool needs_rack = false;
+    switch (f.kind_case()) {
+      case FK::kCpuFailure: info = {K::CpuFailure, "cpu_failure", true}; break;
+      case FK::kCpuStop: info = {K::CpuStop, "cpu_stop", true}; break;
+      case FK::kFibreCut: info = {K::FibreCut, "fibre_cut", true}; break;
+      case FK::kFibresCut: info = {K::FibresCut, "fibres_cut", true}; break;
+      case FK::kComparisonError: info = {K::ComparisonError, "comparison_error", false}; break;
+      case FK::kOneSidedOb121: info = {K::OneSidedOb121, "one_sided_ob121", false}; break;
+      case FK::kHardwareFault: info = {K::HardwareFault, "hardware_fault", true}; break;
+      case FK::kCpuHold: info = {K::CpuHold, "cpu_hold", true}; break;
+      case FK::kMasterSwap: info = {K::HMasterSwap, "master_swap", false}; break;
+      case FK::kUpdateLoad: info = {K::UpdateLoad, "update_load", false}; break;
+      case FK::kProgramChange: info = {K::ProgramChange, "program_change", false}; break;
+      case FK::kParameterChange: info = {K::ParameterChange, "parameter_change", false}; break;
+      case FK::kMemoryReset: info = {K::MemoryReset, "memory_reset", false}; break;
+      default: return false;
+    }
+    pf.kind = info.kind;
+    pf.line = -1;
+    const scenario::HCpuFault* cpu = nullptr;
+    switch (f.kind_case()) {
+      case FK::kCpuFailure: cpu = &f.cpu_failure(); break;
+      case FK::kCpuStop: cpu = &f.cpu_stop(); break;
+      case FK::kOneSidedOb121: cpu = &f.one_sided_ob121(); break;
+      case FK::kHardwareFault: cpu = &f.hardware_fault(); break;
+      case FK::kCpuHold: cpu = &f.cpu_hold(); break;
+      case FK::kMemoryReset: cpu = &f.memory_reset(); break;
+      case FK::kFibreCut:
+        h_name = f.fibre_cut().h_system();
+        if (f.fibre_cut().has_fibre()) fibre = f.fibre_cut().fibre();
+        break;
+      case FK::kFibresCut: h_name = f.fibres_cut().h_system(); break;
+      case FK::kComparisonError: h_name = f.comparison_error().h_system(); break;
+      case FK::kMasterSwap: h_name = f.master_swap().h_system(); break;
+      case FK::kParameterChange: h_name = f.parameter_change().h_system(); break;
+      case FK::kUpdateLoad: h_name = f.update_load().h_system(); break;
+      case FK::kProgramChange: h_name = f.program_change().h_system(); break;
+      default: break;
+    }
+    if (cpu != nullptr) {
+      h_name = cpu->h_system();
+      needs_rack = true;
+      if (cpu->has_rack()) rack = cpu->rack();
+    }
+    const Where kw = nested(w, fd, info.field);
+    const pb::Descriptor* kd = fd->FindFieldByName(info.field)->message_type();
+    const std::string kind(info.field);
+    bool good = true;
+    if (!info.repair && !f.repair_at().empty()) {
+      error(at_field(w, fd, "repair_at"), kind + " has no repair: remove repair_at");
+      good = false;
+    }
+    // The h_system: by name, or the only simulated one.
+    int found = -1;
+    if (h_name.empty()) {
+      int simulated = 0;
+      for (std::size_t k = 0; k < plan.h_systems.size(); ++k)
+        if (plan.h_systems[k].runtime) {
+          found = static_cast<int>(k);
+          ++simulated;
+        }
+      if (simulated == 0) {
+        error(kw, kind + ": the scenario has no h_system with a cpu part");
+        return false;
+      }
+      if (simulated > 1) {
+        error(kw, kind + ": several h_systems are simulated: name one (h_system: \"...\")");
+        return false;
+      }
+    } else {
+      for (std::size_t k = 0; k < plan.h_systems.size(); ++k)
+        if (plan.h_systems[k].name == h_name && found < 0) found = static_cast<int>(k);
+      if (found < 0) {
+        error(at_field(kw, kd, "h_system"), kind + ": no h_system " + quoted(h_name));
+        return false;
+      }
+      if (!plan.h_systems[static_cast<std::size_t>(found)].runtime) {
+        error(at_field(kw, kd, "h_system"), kind + ": h_system " + quoted(h_name) +
+                                                " has no cpu part (it is timing input only)");
+        return false;
+      }
+    }
+    pf.h_system = found;
+    // The pair refuses these in the 1500 profile (docs/h-system.md rules 5 and 13): a scenario
+    // that asks for them is wrong, not a run that shows a refusal.
+    const auto& rt = *plan.h_systems[static_cast<std::size_t>(found)].runtime;
+    if (rt.pair.profile == devices::HProfile::S7_1500RH &&
+        (pf.kind == K::CpuHold || pf.kind == K::HMasterSwap)) {
+      error(kw, kind + ": the S7-1500R/H profile has no " +
+                    (pf.kind == K::CpuHold ? std::string("HOLD") : std::string("operator master swap")));
+      return false;
+    }
+    if (needs_rack) {
+      if (!rack) {
+        error(kw, kind + " needs a rack: rack: 0 or rack: 1");
+        return false;
+      }
+      if (*rack > 1) {
+        error(at_field(kw, kd, "rack"), kind + ": rack " + std::to_string(*rack) + " is not 0 or 1");
+        return false;
+      }
+      pf.rack = static_cast<int>(*rack);
+    }
+    if (pf.kind == K::FibreCut) {
+      if (!fibre) {
+        error(kw, "fibre_cut needs a fibre: fibre: 0 (upper) or fibre: 1 (lower)");
+        return false;
+      }
+      if (*fibre > 1) {
+        error(at_field(kw, kd, "fibre"), "fibre_cut: fibre " + std::to_string(*fibre) + " is not 0 or 1");
+        return false;
+      }
+      pf.fibre = static_cast<int>(*fibre);
+    }
+    if (pf.kind == K::UpdateLoad) {
+      if (f.update_load().kb() == 0) {
+        error(kw, "update_load needs kb > 0 (the KB of DBs the next update copies)");
+        return false;
+      }
+      pf.kb = f.update_load().kb();
+    }
+    if (pf.kind == K::ProgramChange) {
+      switch (f.program_change().kind()) {
+        case scenario::HProgramChange::STRUCTURAL_FB_INTERFACE:
+          pf.change = HProgramChangeKind::StructuralFbInterface;
+          break;
+        case scenario::HProgramChange::GLOBAL_DB: pf.change = HProgramChangeKind::GlobalDb; break;
+        default: pf.change = HProgramChangeKind::Allowed; break;
+      }
+    }
+    pf.description = h_fault_description(pf);
+    int simulated = 0;
+    for (const auto& hp : plan.h_systems) simulated += hp.runtime ? 1 : 0;
+    if (simulated > 1)
+      pf.description += " (h_system " + quoted(plan.h_systems[static_cast<std::size_t>(found)].name) + ")";
+    return good;
+  }
+
   void plan_faults(ScenarioPlan& plan) {
     const auto* sd = scenario::Scenario::descriptor();
     const auto* fd = scenario::Fault::descriptor();
@@ -683,6 +851,21 @@ class Planner {
         case FK::kStationPowerLoss: pf.kind = K::StationPowerLoss; line_name = f.station_power_loss().line(); kind_field = "station_power_loss"; break;
         case FK::kMasterFailure: pf.kind = K::MasterFailure; line_name = f.master_failure().line(); kind_field = "master_failure"; break;
         case FK::kMasterStop: pf.kind = K::MasterStop; line_name = f.master_stop().line(); kind_field = "master_stop"; break;
+        case FK::kCpuFailure:
+        case FK::kCpuStop:
+        case FK::kFibreCut:
+        case FK::kFibresCut:
+        case FK::kComparisonError:
+        case FK::kOneSidedOb121:
+        case FK::kHardwareFault:
+        case FK::kCpuHold:
+        case FK::kMasterSwap:
+        case FK::kUpdateLoad:
+        case FK::kProgramChange:
+        case FK::kParameterChange:
+        case FK::kMemoryReset:
+          if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
+          continue;
         case FK::KIND_NOT_SET:
           // The message predates the DP slave faults; tests and users match it as it is.
           error(w, "fault needs a kind: cable_cut, short_circuit, noise, power_loss, "
@@ -791,6 +974,7 @@ class Planner {
                            " of dp_master " + std::to_string(mf.address()) + " on line " + ln;
           break;
         }
+        default: continue;  // the H faults are planned by plan_h_fault above
       }
       if (ok) plan.faults.push_back(std::move(pf));
     }
@@ -807,6 +991,57 @@ class Planner {
 };
 
 }  // namespace
+
+std::string_view to_string(HProgramChangeKind k) {
+  switch (k) {
+    case HProgramChangeKind::Allowed: return "allowed in Redundant mode";
+    case HProgramChangeKind::StructuralFbInterface: return "structural change of an FB interface";
+    case HProgramChangeKind::GlobalDb: return "structural change of a global DB";
+  }
+  return "?";
+}
+
+std::string h_fault_description(const PlanFault& f) {
+  using K = PlanFault::Kind;
+  const std::string cpu = "CPU " + std::to_string(f.rack) + " (rack " + std::to_string(f.rack) + ")";
+  switch (f.kind) {
+    case K::CpuFailure: return cpu + " fails";
+    case K::CpuStop: return cpu + ": mode switch to STOP";
+    case K::FibreCut:
+      return "sync-link fibre " + std::to_string(f.fibre) + (f.fibre == 0 ? " (upper)" : " (lower)") + " cut";
+    case K::FibresCut: return "both sync-link fibres cut at once";
+    case K::ComparisonError: return "comparison error between the CPUs";
+    case K::OneSidedOb121: return "one-sided OB 121 on " + cpu;
+    case K::HardwareFault: return "latent hardware fault in " + cpu;
+    case K::CpuHold: return cpu + " to HOLD";
+    case K::HMasterSwap: return "operator master swap (switch to CPU with modified configuration)";
+    case K::UpdateLoad: return "DBs changed: the next update copies " + std::to_string(f.kb) + " KB";
+    case K::ProgramChange: return "program change in RUN (" + std::string(to_string(f.change)) + ")";
+    case K::ParameterChange: return "a parameter that may not change is changed, then a master swap";
+    case K::MemoryReset: return "memory reset of " + cpu + " after its reset request";
+    default: return {};
+  }
+}
+
+bool is_h_fault(PlanFault::Kind k) {
+  using K = PlanFault::Kind;
+  switch (k) {
+    case K::CpuFailure:
+    case K::CpuStop:
+    case K::FibreCut:
+    case K::FibresCut:
+    case K::ComparisonError:
+    case K::OneSidedOb121:
+    case K::HardwareFault:
+    case K::CpuHold:
+    case K::HMasterSwap:
+    case K::UpdateLoad:
+    case K::ProgramChange:
+    case K::ParameterChange:
+    case K::MemoryReset: return true;
+    default: return false;
+  }
+}
 
 LoadResult parse_scenario(std::string_view text, std::string_view file) {
   LoadResult r;

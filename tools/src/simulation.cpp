@@ -315,6 +315,8 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
+  // H-system faults: applied by the H-system runtime (next step).
+  if (is_h_fault(f.kind)) return;
   LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
   bus::Line& l = *ls.line;
   using K = PlanFault::Kind;
@@ -350,6 +352,7 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
       ls.stats.faults.push_back({m_sched.now(), std::move(text)});
       break;
     }
+    default: break;  // H-system faults: applied by the H-system runtime (next step)
   }
 }
 

@@ -38,7 +38,11 @@ enum class EventCategory : std::uint8_t {
   Station = 2,     ///< DP slave / station state (failure, return); a = station address
   Master = 3,      ///< DP master state (Stop/Clear/Operate, master failure)
   Redundancy = 4,  ///< switchover, redundancy loss/return; value = S7 event id if any
-  Cpu = 5,         ///< H-system CPU state and OB events; value = S7 event id (W#16#....)
+  /// H-system CPU pair events (cpu_event.hpp has the encoding): code = kind (0 state, 1 role,
+  /// 2 system mode, 3 OB), line = -1, a = rack, b = role after the event (0 none, 1 master,
+  /// 2 standby), value = S7 event id (bits 0..15, W#16#....) | OB << 16 | reason << 24 |
+  /// to << 32 | from << 40; text "CPU 0: STOP -> STARTUP".
+  Cpu = 5,
   Note = 6,        ///< free text from a scenario or tool
 };
 std::string_view to_string(EventCategory c);

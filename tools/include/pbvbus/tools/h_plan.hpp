@@ -5,10 +5,31 @@
 // redundant_master_system take T_TR, T_DP_UM and T_SLAVE_UM from redundancy::plan_switchover:
 // the larger line's T_TR, the larger direction's T_DP_UM, the slowest station's T_SLAVE_UM;
 // a figure given in the entry wins).
+//
+// An h_system with a `cpu` part is also a simulated CPU pair (docs/h-scenarios.md):
+// HSystemPlan::runtime holds the devices::HCpuPairParams, the power-on time of each rack, the
+// user program (devices::ProgramSpec) and the redundant master systems the pair drives.
+// Decisions:
+// - The systems a pair drives are its dp_system entries that name a redundant_master_system;
+//   such a system may appear in at most one h_system that has a `cpu` part and only once in
+//   it (timing-only entries may still share one: they only study it).
+// - A simulated pair's configured H parameters must pass devices::check_h_parameters against
+//   the planned update (errors refuse the file, warnings pass): a pair must not run on a bad
+//   set. Timing-only entries keep being reported by `pbvbus timing` as before.
+// - update_db_kb defaults to work_memory_db_kb (the update copies the DBs in work memory), or
+//   to HCpuPairParams' 100 KB when that is 0.
+// - power_on "off" = not powered during the run; unset = "0s". Equal times for both racks are
+//   the simultaneous POWER ON (HCpuPair::power_on_both).
+// - Program networks are checked as devices::ProgramSpec requires: width 1/2/4, period > 0,
+//   length > 0, discrepancy_time > 0, pulse_high < period, pulse_bit 0..7, scan_time > 0.
+#include <array>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_update_timing.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
 
@@ -21,6 +42,17 @@ struct HDpSystemPlan {
   devices::Us t_pto = 0;
 };
 
+/// What the Simulation needs to run an h_system's CPU pair.
+struct HRuntimePlan {
+  devices::HCpuPairParams pair;
+  /// Power-on time per rack; nullopt = not powered during the run ("off").
+  std::array<std::optional<bus::Ticks>, 2> power_on{bus::Ticks{0}, bus::Ticks{0}};
+  /// Both fibres plugged at power-on (false: both cut before the first power-on, F7).
+  bool fibres_connected_at_power_on = true;
+  devices::ProgramSpec program;
+  std::vector<int> systems;  ///< indices into ScenarioPlan::redundant_systems (driven systems)
+};
+
 struct HSystemPlan {
   int source = 0;  ///< index into Scenario.h_system
   std::string name;
@@ -29,11 +61,23 @@ struct HSystemPlan {
   devices::Us t_prog = 0;
   std::int64_t db_kb = 0;
   devices::HParameters params;  ///< what the scenario configures (all unset = none)
+  std::optional<HRuntimePlan> runtime;  ///< set when the entry has a `cpu` part
 };
+
+/// One step of a path from an h_system entry to a field in it: {"cpu"}, {"program"},
+/// {"counter", 2}, then the field {"width"}. index -1 = a singular field.
+struct HPathStep {
+  const char* field;
+  int index = -1;
+};
+/// 1-based line and column of the field at the end of `path` inside h_system[index] (the
+/// nearest known position when the field is not in the text).
+using HLocator = std::function<std::pair<int, int>(int index, const std::vector<HPathStep>& path)>;
 
 struct ScenarioPlan;
 /// Plans the h_system entries (after plan_dp: they refer to redundant_master_systems).
-void plan_h(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors);
+void plan_h(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
+            std::vector<Diagnostic>& errors);
 /// The procedure's input for h_systems[k] (may throw like redundancy::plan_switchover).
 devices::UpdatePlanInput h_update_input(const ScenarioPlan& plan, const HSystemPlan& h);
 

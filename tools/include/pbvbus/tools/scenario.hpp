@@ -21,6 +21,12 @@
 //    simply not reached and the report says so.
 //  - `capture { line: "A" at: 14 }` must name a station on that line by its FDL address; two
 //    entries for the same point (or two without `at` for one line) are an error.
+//  - H-system faults (cpu_failure ... memory_reset; docs/h-scenarios.md) name an h_system with
+//    a `cpu` part (the name may be left out when there is only one), a rack or fibre 0/1 where
+//    the kind needs one; repair_at only where a repair exists (power returns, RUN again,
+//    spliced, replaced, released); HOLD and the operator swap not on an S7-1500R/H pair. They
+//    are planned with line = -1 and are not applied by the Simulation until the H-system
+//    runtime exists.
 
 #include <cstdint>
 #include <optional>
@@ -82,6 +88,14 @@ struct PlanLine {
   int position_of(std::uint8_t addr) const;
 };
 
+/// program_change (F22): what kind of change is loaded in RUN.
+enum class HProgramChangeKind : std::uint8_t {
+  Allowed,                ///< may be made in Redundant mode
+  StructuralFbInterface,  ///< an FB interface changed: may not be made in Redundant mode
+  GlobalDb,               ///< a global DB's structure changed: may not be made in Redundant mode
+};
+std::string_view to_string(HProgramChangeKind k);
+
 struct PlanFault {
   enum class Kind : std::uint8_t {
     CableCut,
@@ -100,6 +114,22 @@ struct PlanFault {
     StationPowerLoss,  ///< `switched`
     MasterFailure,     ///< `dp_master` (and `side`/`system` if it is part of a system)
     MasterStop,
+    // H-system CPU pair faults (an h_system with a `cpu` part; docs/h-scenarios.md): `h_system`,
+    // and `rack` / `fibre` / `kb` / `change` where the kind needs them; `line` is -1. Not applied
+    // by the Simulation yet (the H-system runtime will apply them).
+    CpuFailure,       ///< F1, `rack`; repair: power returns
+    CpuStop,          ///< mode switch to STOP, `rack`; repair: STOP -> RUN
+    FibreCut,         ///< F5, `fibre`; repair: spliced
+    FibresCut,        ///< F6, both fibres at once; repair: both
+    ComparisonError,  ///< F16
+    OneSidedOb121,    ///< F17, `rack`
+    HardwareFault,    ///< latent, found by the next self-test, `rack`; repair: CPU replaced
+    CpuHold,          ///< `rack`; repair: release (F21 if a link-up is requested meanwhile)
+    HMasterSwap,      ///< operator "switch to CPU with modified configuration"
+    UpdateLoad,       ///< F19: the next update copies `kb` KB
+    ProgramChange,    ///< F22, `change`
+    ParameterChange,  ///< F23: a parameter that may not change, then a master swap (W#16#5966)
+    MemoryReset,      ///< F20: memory reset of `rack` after its reset request
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -122,7 +152,17 @@ struct PlanFault {
   int side = -1;       ///< 0 = line A, 1 = line B of the redundant system
   int dp_master = -1;  ///< index into ScenarioPlan::dp_masters
   int system = -1;     ///< index into ScenarioPlan::redundant_systems, or -1
+  int h_system = -1;   ///< H faults: index into ScenarioPlan::h_systems (one with a runtime)
+  int rack = -1;       ///< H faults: 0 or 1 where the kind names a CPU
+  int fibre = -1;      ///< fibre_cut: 0 = upper, 1 = lower
+  std::uint32_t kb = 0;  ///< update_load: KB the next update copies
+  HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
 };
+
+/// An H-system fault kind (CpuFailure .. MemoryReset)?
+bool is_h_fault(PlanFault::Kind k);
+/// "CPU 0 (rack 0) fails", "sync-link fibre 1 (lower) cut", ... (without the h_system name).
+std::string h_fault_description(const PlanFault& f);
 
 struct ScenarioPlan {
   scenario::Scenario proto;  ///< the parsed file, for the station details
@@ -136,7 +176,7 @@ struct ScenarioPlan {
   std::vector<DpSlavePlan> dp_slaves;    ///< in file order, valid ones only
   std::vector<RedundancyPlan> redundant_systems;  ///< in file order
   std::vector<SwitchedPlan> switched;             ///< in file order, valid ones only
-  std::vector<HSystemPlan> h_systems;             ///< h_system entries (update timing)
+  std::vector<HSystemPlan> h_systems;  ///< h_system entries (update timing; runtime if simulated)
 };
 
 struct LoadResult {

@@ -1,0 +1,118 @@
+#pragma once
+// The H-system part of a run's report (issue 8, deliverable 5; docs/h-scenarios.md): per
+// simulated CPU pair the final state, role and LEDs of each CPU and its diagnostic buffer, a
+// timeline per CPU, the I/O events (OB 70/85/86... filled by the H-system runtime) and the
+// measured update windows beside the planned T_P15 / T_PH; as text for a commissioning
+// engineer and as JSON; and the capture's event records for the pair's events.
+//
+// Decisions:
+// - A timeline row is one event of devices::HCpuPair: a state or role change or an OB of that
+//   CPU, or a change of the pair's system mode (in both CPUs' tables). Each row shows what holds
+//   after the event: the CPU's state and role, the pair's system mode (HCpuPair::system_mode(),
+//   the master's view), REDF and MSTR derived from them as HCpuPair::leds() does (REDF from the
+//   pair's mode for a powered CPU: 0.5 Hz Link-up/SYNCUP, 2 Hz Update, off Redundant, on
+//   otherwise; dark when off; MSTR = powered master). The final LEDs are the pair's own.
+// - Times: text in s with ms ("12.345"); JSON in ns (exact, bus::ticks_to_ns) and ms (three
+//   decimals, i.e. µs resolution, as a JSON number).
+// - An update window: t1 = the standby enters UPDATE (SYNCUP in the 1500 profile; the cycle
+//   extension starts), t5 = it reaches RUN (Redundant or the swap) or the update ends without
+//   it (aborted). t3 (T_P15 starts) and t4 (T_PH starts) are filled by the H-system runtime
+//   once the update has phases; until then they are absent and the windows are "not measured".
+//   Verdict: the measured window t5 - t3 (t5 - t4) is "within" when it is not longer than the
+//   planned T_P15 (T_PH), else "EXCEEDED" (the update's monitoring would abort it).
+// - JSON: the report part is `"h_systems_run":[...]` (one object per pair), keys in a fixed
+//   order, enum values as the names to_string() gives in the 400H profile (stable keys), the
+//   profile's own names in the text.
+// - Capture records (EventCategory::Cpu, captures/cpu_event.hpp): code = HEvent::Kind, a = rack,
+//   b = role after the event, value = S7 event ID | OB << 16 | reason << 24 | to << 32 |
+//   from << 40; text as in the timeline ("CPU 0: STOP -> STARTUP").
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+#include "pbvbus/captures/event_record.hpp"
+#include "pbvbus/devices/h_cpu_pair.hpp"
+
+namespace pbvbus::tools {
+
+struct HTimelineRow {
+  bus::Ticks at = 0;
+  devices::HEvent::Kind kind = devices::HEvent::Kind::State;
+  std::string change;  ///< h_event_text(): "CPU 0: STOP -> STARTUP", "system mode Solo -> Link-up"
+  // What holds after the event:
+  devices::CpuState state = devices::CpuState::Off;
+  devices::CpuRole role = devices::CpuRole::None;
+  devices::SystemMode mode = devices::SystemMode::Stop;
+  devices::Redf redf = devices::Redf::Off;
+  bool mstr = false;
+  int ob = 0;              ///< Kind::Ob: 72, 121
+  std::uint16_t code = 0;  ///< S7 event ID, 0 = none given
+  devices::HReason reason = devices::HReason::None;
+};
+
+struct HCpuReport {
+  int rack = 0;
+  devices::CpuState state = devices::CpuState::Off;
+  devices::CpuRole role = devices::CpuRole::None;
+  devices::SystemMode mode = devices::SystemMode::Stop;  ///< as this CPU sees it
+  devices::CpuLeds leds;
+  std::vector<devices::DiagEntry> diag;
+  std::vector<HTimelineRow> timeline;
+};
+
+/// An I/O event of the pair (OB 70, OB 85, OB 86 ... with its event ID); the runtime fills them.
+struct HIoEvent {
+  bus::Ticks at = 0;
+  std::vector<int> racks;  ///< the CPUs on which the OB ran
+  int ob = 0;
+  std::uint16_t code = 0;
+  std::string text;
+};
+
+struct HUpdateWindow {
+  int rack = 0;  ///< the CPU being updated
+  bus::Ticks t1 = 0;
+  std::optional<bus::Ticks> t3, t4;
+  bus::Ticks t5 = 0;
+  bool completed = true;  ///< false: the update ended without RUN (aborted)
+};
+
+struct HSystemReport {
+  std::string name;
+  devices::HProfile profile = devices::HProfile::S7_400H;
+  devices::SystemMode mode = devices::SystemMode::Stop;  ///< the pair's final system mode
+  std::array<HCpuReport, 2> cpus;
+  std::vector<HIoEvent> io_events;
+  std::vector<HUpdateWindow> updates;
+  /// The planned T_P15 and T_PH (h_update_timing), set by the owner that has the plan.
+  std::optional<bus::Ticks> planned_t_p15, planned_t_ph;
+};
+
+/// Everything the pair knows: final states, LEDs, buffers, the timeline from its events and
+/// the update windows (t1, t5).
+HSystemReport make_h_report(std::string name, const devices::HCpuPair& pair);
+
+/// "within" / "EXCEEDED" for a measured window against its planned bound.
+std::string_view window_verdict(bus::Ticks measured, bus::Ticks planned);
+
+/// The text part: per pair the CPUs, a timeline table per CPU, the I/O events, the updates.
+void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os);
+/// `,"h_systems_run":[...]` (nothing when `systems` is empty), to append inside a JSON object.
+void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os);
+
+/// "12.345" (s with ms, rounded down).
+std::string format_s_ms(bus::Ticks t);
+/// The one-line text of an event as the timeline and the capture show it: "CPU 0: STOP ->
+/// STARTUP", "CPU 1: role none -> standby", "system mode Solo -> Link-up", "CPU 1: OB 72
+/// (master CPU lost)" (the why of a state change is in the diagnostic buffer, not the event).
+std::string h_event_text(const devices::HEvent& e, devices::HProfile p);
+/// The capture record of one pair event (EventCategory::Cpu; encoding in captures/cpu_event.hpp).
+/// `system` prefixes the text when not empty ("H-CPU: CPU 0: ...").
+captures::EventRecord h_event_record(const devices::HEvent& e, devices::HProfile p,
+                                     std::string_view system = {});
+
+}  // namespace pbvbus::tools

@@ -138,6 +138,9 @@ bool HSystemModel::request_master_swap() {
 HSystemModel::SideMode HSystemModel::target(int r) const {
   if (m_pair.state(r) == CpuState::Off) return SideMode::Unpowered;
   if (!m_pair.dp_master_running(r)) return SideMode::Stop;
+  // The standby in UPDATE: Clear until t4 (its outputs are not driven yet; every station is
+  // active on the master's line), Operate from t4 (the output copy: both drive during T_PH).
+  if (m_pair.state(r) == CpuState::Update && !m_pair.outputs_held_by_both()) return SideMode::Clear;
   // One program: the master CPU's. With two masters (F6/F7) each CPU runs its own.
   const int m = m_pair.master_count() >= 2 ? r : m_pair.master();
   return m >= 0 && m_pair.dp_master_operate(m) ? SideMode::Operate : SideMode::Clear;
@@ -154,7 +157,9 @@ void HSystemModel::reconcile() {
     const SideMode to = target(r);
     for (std::size_t s = 0; s < m_systems.size(); ++s) apply(s, r, to);
   }
-  if (m_program && !m_scan_armed && program_runs()) arm_scan(m_sched.now());
+  track_update(m_sched.now());
+  if (has_program() && !m_scan_armed && program_runs() && !m_pair.io_frozen())
+    arm_scan(m_sched.now());
 }
 
 void HSystemModel::apply(std::size_t s, int r, SideMode to) {
@@ -223,16 +228,32 @@ void HSystemModel::arm_scan(bus::Ticks at) {
 
 void HSystemModel::set_program(Program hook, bus::Ticks scan_time) {
   m_program = std::move(hook);
+  m_exec.reset();  // one program: the hook (or none) replaces a spec
   m_scan_time = scan_time > 0 ? scan_time : bus::kTicksPerMs;
-  if (m_program && !m_scan_armed && program_runs()) arm_scan(m_sched.now());
+  if (has_program() && !m_scan_armed && program_runs()) arm_scan(m_sched.now());
 }
 
 void HSystemModel::on_event(bus::Ticks now, std::uint64_t tag) {
   if (tag == kTagScan) {
-    m_scan_armed = false;
-    if (!m_program || !program_runs()) return;  // restarted by reconcile() when it runs again
+    m_scan_armed = true;  // this event is the armed scan: a reconcile below must not arm another
+    // A pair deadline at the same instant comes first (as in the pair: deadlines before
+    // operations), so a scan at t3 sees the freeze and a scan at t5 sees it lifted.
+    if (m_pair.next_deadline() <= now) {
+      m_armed_at = bus::kNever;
+      ++m_gen;  // the scheduled deadline event is stale now
+      m_pair.on_time(now);
+      reconcile();
+      arm_deadline();
+    }
+    // Not running, or inside the update's no-I/O window [t3, t5): no OB 1 and no I/O update
+    // at all; reconcile() starts the next scan at once when it runs again / at t5 or the abort
+    // (a late OB 1 starts at once and the cycle continues from there).
+    if (!has_program() || !program_runs() || m_pair.io_frozen()) {
+      m_scan_armed = false;
+      return;
+    }
     scan(now);
-    arm_scan(now + m_scan_time);
+    m_sched.schedule(now + m_scan_time, *this, kTagScan);
     return;
   }
   if ((tag >> 1) != m_gen) return;  // stale deadline
@@ -244,6 +265,14 @@ void HSystemModel::on_event(bus::Ticks now, std::uint64_t tag) {
 
 void HSystemModel::scan(bus::Ticks now) {
   if (m_gate && !m_gate(now)) return;
+  if (!m_measures.empty() && m_measures.back().done &&
+      m_measures.back().first_scan_after == bus::kNever)
+    m_measures.back().first_scan_after = now;
+  m_last_scan = now;
+  if (m_exec) {
+    scan_execution(now);
+    return;
+  }
   ++m_scans;
   m_map.read_inputs(m_systems, m_pii);
   m_program(m_pii, m_piq, now);
@@ -274,7 +303,10 @@ void HSystemModel::on_pair_event(const HEvent& e) {
   h.ob = e.ob;
   h.code = e.code;
   h.text = "OB " + std::to_string(e.ob) + " " + std::string(to_string(e.reason));
+  if (e.ob == 72 && e.reason == HReason::ComparisonError && !m_ob72_note.empty())
+    h.text += ", " + m_ob72_note;
   h.source = HSystemEvent::Source::Cpu;
+  h.original_time = h.time;
   add_event(std::move(h));
 }
 
@@ -305,6 +337,7 @@ void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) 
   h.system = static_cast<int>(s);
   h.line = e.line;
   h.station = e.station;
+  h.original_time = h.time;
   add_event(std::move(h));
 }
 

@@ -48,6 +48,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -57,12 +58,17 @@
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/h_cpu_pair.hpp"
 #include "pbvbus/devices/h_io_map.hpp"
+#include "pbvbus/devices/h_program_spec.hpp"
+#include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/devices/h_update_measure.hpp"
 #include "pbvbus/devices/redundant_master_system.hpp"
 
 namespace pbvbus::devices {
 
 struct HSystemEvent {
-  enum class Source : std::uint8_t { Cpu, Io };
+  /// Cpu: the pair's OB 72/121; Io: the master systems' S7 events (OB 70/86) and OB 85;
+  /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...).
+  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm };
   bus::Ticks time = 0;
   int rack = -1;                  ///< the CPU the OB runs on; -1 = both
   CpuRole role = CpuRole::None;   ///< the role of that CPU (both: Master)
@@ -73,6 +79,10 @@ struct HSystemEvent {
   int system = -1;                ///< master system index (Io), -1 for CPU events
   int line = -1;                  ///< Io: the line concerned
   std::uint8_t station = 0xFF;    ///< Io: the station, 0xFF for the whole master system
+  /// When it happened: = time, except for an alarm held during an update (time = delivery
+  /// after t5 or the abort, original_time = when the master system received it).
+  bus::Ticks original_time = 0;
+  bool incoming = true;  ///< Program (7960) and OB 85: false = outgoing ("gone")
 };
 
 enum class BusLed : std::uint8_t { Off, On, Flashing };
@@ -99,6 +109,15 @@ class HSystemModel final : public bus::EventTarget {
   // ---- the program ----
   /// scan_time <= 0 is replaced by 1 ms. An empty hook stops the scans.
   void set_program(Program hook, bus::Ticks scan_time);
+  /// The real program (h_program.hpp) on both CPUs with comparison (RedundantExecution) over
+  /// the I/O map's PII/PIQ; scan time from the spec. Replaces a hook. Throws
+  /// std::invalid_argument("program: " + validate()'s first message).
+  void set_program(const ProgramSpec& spec);
+  /// The running RedundantExecution, nullptr without a spec.
+  const RedundantExecution* execution() const { return m_exec.get(); }
+  /// Flips bits of one byte on one CPU only (scenario fault "comparison_error"): the comparison
+  /// finds it at the next Redundant scan. False without a spec, bad rack or offset.
+  bool inject_divergence(int rack, Area area, std::uint32_t offset, std::uint8_t xor_mask);
   void set_io_gate(IoGate gate) { m_gate = std::move(gate); }
 
   // ---- operations (at scheduler.now(), then reconciliation) ----
@@ -135,6 +154,8 @@ class HSystemModel final : public bus::EventTarget {
   /// What side `rack` of master system `system` was last set to.
   SideMode side_mode(std::size_t system, int rack) const;
   const std::vector<HSystemEvent>& events() const { return m_events; }
+  /// Every update's measured times, oldest first (h_update_measure.hpp).
+  const std::vector<UpdateMeasure>& update_measures() const { return m_measures; }
   /// Called with every event as it is added to events() (for a runtime's report or capture).
   /// The model owns the MasterSystems' on_event callbacks: read them through this or
   /// MasterSystem::events().
@@ -154,9 +175,13 @@ class HSystemModel final : public bus::EventTarget {
   void arm_deadline();
   void arm_scan(bus::Ticks at);
   bool program_runs() const;
+  bool has_program() const { return m_program || m_exec; }
   SideMode target(int rack) const;
   void apply(std::size_t system, int rack, SideMode to);
   void scan(bus::Ticks now);
+  void scan_execution(bus::Ticks now);  // h_system_program.cpp
+  void track_update(bus::Ticks now);    // h_system_update.cpp
+  void on_program_event(const ProgramEvent& e, std::array<bool, 2> ran);
   void on_pair_event(const HEvent& e);
   void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
   void add_event(HSystemEvent e);
@@ -169,6 +194,11 @@ class HSystemModel final : public bus::EventTarget {
   HIoMap m_map;
   std::vector<std::uint8_t> m_pii, m_piq;
   Program m_program;
+  std::unique_ptr<RedundantExecution> m_exec;
+  std::vector<UpdateMeasure> m_measures;
+  bool m_update_copied = false;
+  bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1  ///< the last measure's output/state copy (t4) is done
+  std::string m_ob72_note;  ///< appended to the next OB 72 ComparisonError text (F16's place)
   IoGate m_gate;
   bus::Ticks m_scan_time = bus::kTicksPerMs;
   bool m_scan_armed = false;

@@ -1,0 +1,156 @@
+// HSystemModel running the real program (set_program(ProgramSpec), RedundantExecution): the
+// fixture of h_system_fixture.hpp (h_system_test.cpp has its layout and timing). Timing used
+// here: power_on_both at 12 ms, Solo at 1.012 s, UPDATE at 3.012 s, Redundant at t5 = 3.157 s
+// (W = 75 ms + 0.7 ms x 100 KB = 145 ms). OB 1 every 10 ms from 1.012 s; the scan at 3.012 s
+// falls into the no-I/O window [3.012, 3.157) and is not run; OB 1 restarts at t5 = 3.157 s and
+// lies on 3.157 + k x 10 ms after it.
+#include <gmock/gmock.h>
+
+#include "h_system_fixture.hpp"
+
+namespace pbvbus::devices {
+namespace {
+
+using ::testing::HasSubstr;
+
+// Two counters into the switched stations' outputs (QB 0..1 station 5, QB 2..3 station 6),
+// +1 every 10 ms: the Sampler's "never 0, never older" holds for them.
+ProgramSpec counters_spec() {
+  ProgramSpec p;
+  p.scan_time = kScan;
+  p.counters.push_back({0, 2, 10 * kMs, 1, 0, 0, 0});
+  p.counters.push_back({2, 2, 10 * kMs, 1, 0, 0, 0});
+  return p;
+}
+
+TEST(HSystemProgram, BadSpecThrowsWithPrefixAndNoExecution) {
+  HSys s;
+  ProgramSpec p;
+  p.copies.push_back({0, 0, 9});  // PII is 8 octets
+  try {
+    s.h->set_program(p);
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("program: copy 0", 0), 0u) << e.what();
+  }
+  EXPECT_EQ(s.h->execution(), nullptr);
+  EXPECT_FALSE(s.h->inject_divergence(0, Area::Piq, 0, 1));
+}
+
+// A copy network from IB 4..5 (one-sided slave 10 on line A) to QB 0..1 (station 5).
+TEST(HSystemProgram, CopyThroughTheMapBothCpusRunInRedundant) {
+  HSys s;
+  ProgramSpec p;
+  p.scan_time = kScan;
+  p.copies.push_back({4, 0, 2});
+  s.h->set_program(p);
+  ASSERT_NE(s.h->execution(), nullptr);
+  ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0xA5, 0x3C}));
+  s.bring_up();  // until 3.457 s
+  EXPECT_EQ(s.station(kFast).outputs()[0], 0xA5);
+  EXPECT_EQ(s.station(kFast).outputs()[1], 0x3C);
+  // Rack 0 alone from 1.012 s: scans at 1.012 + k x 10 ms up to 3.002 s = 200 scans; both from
+  // 3.157 s: 3.157 .. 3.457 s inclusive = 31 scans on each CPU.
+  EXPECT_EQ(s.h->execution()->scans(0), 231u);
+  EXPECT_EQ(s.h->execution()->scans(1), 31u);
+  EXPECT_EQ(s.h->scans(), 231u);
+  EXPECT_EQ(s.h->execution()->image(0), s.h->execution()->image(1));
+}
+
+// F16 found by the comparison: a bit of the standby's memory flipped at 3.460 s (counter 0's
+// flags byte, memory offset 12: 01 -> 03, it never reaches the PIQ) is found by the comparison
+// after the next Redundant scan at 3.467 s: standby ERROR-SEARCH, OB 72 on the master, Solo.
+TEST(HSystemProgram, F16DivergenceFoundByTheComparison) {
+  HSys s;
+  Sampler smp(s);
+  s.h->set_program(counters_spec());
+  s.bring_up();
+  s.run_until(kRedundant + 303 * kMs);  // 3.460 s
+  ASSERT_TRUE(s.h->inject_divergence(1, Area::Memory, 12, 0x02));
+  s.run_until(kRedundant + 309 * kMs);  // 3.466 s: no scan yet
+  EXPECT_EQ(s.h->pair().state(1), CpuState::Run);
+  s.run_until(kRedundant + 310 * kMs);  // 3.467 s
+  EXPECT_EQ(s.h->pair().state(1), CpuState::ErrorSearch);
+  EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Solo);
+  const auto cpu = s.events(Src::Cpu);
+  ASSERT_EQ(cpu.size(), 1u);
+  EXPECT_EQ(cpu[0].ob, 72);
+  EXPECT_EQ(cpu[0].rack, 0);
+  EXPECT_EQ(cpu[0].time, kRedundant + 310 * kMs);
+  EXPECT_THAT(cpu[0].text, HasSubstr("memory offset 12: 01 (rack 0) / 03 (rack 1)"));
+  s.run_until(kRedundant + 1000 * kMs);
+  smp.expect_no_pulse(0);
+}
+
+// A discrepancy monitor over IB 4 (slave 10, line A) and IB 0 (station 5): IB 4 set to 01 at
+// 3.460 s reaches the PII by the scan at 3.467 s (the DP cycle of line A is a few ms), the
+// episode starts there; 100 ms later, at the scan at 3.567 s, error 7960 incoming on both CPUs
+// (rack -1); IB 4 back to 00 at 3.600 s -> outgoing at the scan at 3.607 s.
+TEST(HSystemProgram, DiscrepancyMonitor7960IncomingOutgoing) {
+  HSys s;
+  ProgramSpec p = counters_spec();
+  p.monitors.push_back({4, 0, 1, 0xFF, 4, 100 * kMs});
+  s.h->set_program(p);
+  s.bring_up();
+  s.run_until(kRedundant + 303 * kMs);
+  ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0x01, 0x00}));
+  s.run_until(kRedundant + 443 * kMs);  // 3.600 s
+  ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0x00, 0x00}));
+  s.run_until(kRedundant + 600 * kMs);
+  const auto ev = s.events(Src::Program);
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(ev[0].code, 0x7960);
+  EXPECT_TRUE(ev[0].incoming);
+  EXPECT_EQ(ev[0].time, kRedundant + 410 * kMs);  // 3.567 = 3.467 + 0.100
+  EXPECT_EQ(ev[0].rack, -1);
+  EXPECT_EQ(ev[1].code, 0x7960);
+  EXPECT_FALSE(ev[1].incoming);
+  EXPECT_EQ(ev[1].time, kRedundant + 450 * kMs);  // 3.607
+  EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Redundant);
+}
+
+// F18: the same monitor; the standby's "difference first seen" time loses bit 33 (about
+// 2.36 s earlier) at 3.460 s, so at the scan at 3.567 s... no: at the next scan (3.467 s) the
+// standby finds the discrepancy time expired and raises 7960, the master does not: the CPUs
+// took different paths -> sync error: standby STOP, Solo, OB 72 on the master, "sync error" in
+// both diagnostic buffers. No 7960 reported (the master's run raised none).
+TEST(HSystemProgram, F18SyncErrorStandbyStop) {
+  HSys s;
+  Sampler smp(s);
+  ProgramSpec p = counters_spec();
+  p.monitors.push_back({4, 0, 1, 0xFF, 4, 1000 * kMs});
+  s.h->set_program(p);
+  s.bring_up();
+  s.run_until(kRedundant + 200 * kMs);  // 3.357 s
+  ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0x01, 0x00}));
+  s.run_until(kRedundant + 303 * kMs);  // 3.460 s: episode running since 3.367 s
+  const std::size_t mon = s.h->execution()->program().monitor_state_offset(0);
+  // since = 3.367 s = 12 242 412 000 ticks = 0x2_D9B4_6860: bit 33 (byte 3, bit 1) set.
+  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(1).memory()[mon + i]);
+  std::printf(" mon=%zu\n", mon);
+  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(0).memory()[mon + i]);
+  for (int i = 0; i < 8; ++i) std::printf("%02X ", s.h->pii()[i]);
+  std::printf(" mode=%d now=%lld\n", int(s.h->pair().system_mode()), (long long)s.sched.now());
+  ASSERT_EQ(s.h->execution()->image(1).memory()[mon + 3] & 0x02, 0x02);
+  ASSERT_TRUE(s.h->inject_divergence(1, Area::Memory, static_cast<std::uint32_t>(mon + 3), 0x02));
+  s.run_until(kRedundant + 310 * kMs);  // 3.467 s
+  EXPECT_EQ(s.h->pair().state(1), CpuState::Stop);
+  EXPECT_EQ(s.h->pair().state(0), CpuState::Run);
+  EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Solo);
+  const auto cpu = s.events(Src::Cpu);
+  ASSERT_EQ(cpu.size(), 1u);
+  EXPECT_EQ(cpu[0].ob, 72);
+  EXPECT_EQ(cpu[0].time, kRedundant + 310 * kMs);
+  EXPECT_TRUE(s.events(Src::Program).empty());
+  for (int r = 0; r < 2; ++r) {
+    const auto d = s.h->diag_buffer(r);
+    EXPECT_TRUE(std::any_of(d.begin(), d.end(), [](const DiagEntry& e) {
+      return e.text.rfind("sync error", 0) == 0;
+    })) << r;
+  }
+  s.run_until(kRedundant + 1000 * kMs);
+  smp.expect_no_pulse(0);
+}
+
+}  // namespace
+}  // namespace pbvbus::devices

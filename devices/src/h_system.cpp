@@ -295,6 +295,7 @@ void HSystemModel::add_event(HSystemEvent e) {
 }
 
 void HSystemModel::on_pair_event(const HEvent& e) {
+  if (m_pair_handler) m_pair_handler(e);
   if (e.kind != HEvent::Kind::Ob) return;
   HSystemEvent h;
   h.time = e.at;

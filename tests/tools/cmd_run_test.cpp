@@ -118,11 +118,13 @@ TEST(CmdRun, CaptureThatCannotBeWrittenIsAUsageError) {
       << r.err;
 }
 
-TEST(CmdRun, DefaultScenarioRunsAndReports) {
-  const auto r = run({});
+// The former built-in default (examples/dp-line.textproto since the H-system became the default).
+TEST(CmdRun, DpLineScenarioRunsAndReports) {
+  const std::string file = PBVBUS_SOURCE_DIR "/examples/dp-line.textproto";
+  const auto r = run({file});
   ASSERT_EQ(r.rc, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
-  EXPECT_EQ(r.out.rfind("scenario default (<built-in default>), seed 1\nsimulated 2.000 s in ", 0), 0u)
+  EXPECT_EQ(r.out.rfind("scenario dp-line (" + file + "), seed 1\nsimulated 2.000 s in ", 0), 0u)
       << r.out;
   // A DP master and an FDL master in one ring; three DP slaves built from the shipped GSDs and
   // one passive FDL station; slave 4's power loss and return are reported by the line and seen
@@ -219,7 +221,7 @@ TEST(CmdRun, CaptureToStdoutSendsTheReportToStderr) {
   EXPECT_EQ(bytes.substr(8, 4), std::string("\x4D\x3C\x2B\x1A", 4));
   std::ifstream e(errf);
   std::string err((std::istreambuf_iterator<char>(e)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(err.rfind("scenario default (<built-in default>), seed 1\n", 0), 0u) << err;
+  EXPECT_EQ(err.rfind("scenario h-system (<built-in default>), seed 8\n", 0), 0u) << err;
 }
 
 }  // namespace

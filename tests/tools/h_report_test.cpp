@@ -110,7 +110,10 @@ TEST(HReport, TextShowsEachCpusTimelineThroughR1F5F1) {
                        "CPU 0: role none -> standby"),
            std::string("    14.145    RUN          standby  Redundant     off    off                  "
                        "system mode Update -> Redundant"),
-           std::string("  CPU 1 (rack 1) diagnostic buffer (15 entries):"),
+           // 15 state/role/OB/fibre entries, plus the update phases' own: "LINK-UP: copying the
+           // load memory" at its two link-ups as standby and "UPDATE: ..." at each of the three
+           // updates (as standby at 3 and 6 s, as master at 14 s) = 20.
+           std::string("  CPU 1 (rack 1) diagnostic buffer (20 entries):"),
            std::string("    10.000    master   OB 72: master CPU lost"),
            std::string("  I/O events: none"),
            std::string("    CPU 1: t1 3.000 s, t5 3.145 s (145.000 ms); T_P15 window - / planned -: not measured; "

@@ -193,6 +193,8 @@ class HPlanner {
     } catch (const std::exception& e) {
       error(i, "dp_system", "h_system \"" + hp.name + "\": cannot plan the update: " + e.what());
     }
+    // The pair monitors its updates with the configured set (T_P15, T_PH: HCpuPair rules 18-20).
+    rt.pair.h_parameters = hp.params;
     hp.runtime = std::move(rt);
   }
 

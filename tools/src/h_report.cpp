@@ -289,6 +289,21 @@ void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os) {
         os << d.text << "\n";
       }
     }
+    if (!s.io_map.empty()) {
+      os << "  process images (IB = inputs, QB = outputs):\n";
+      for (const HIoMapRow& m : s.io_map) {
+        os << "    station " << static_cast<int>(m.address) << " module " << m.module << ":";
+        if (m.in_len != 0)
+          os << " IB " << m.in_addr << ".." << (m.in_addr + m.in_len - 1);
+        if (m.out_len != 0)
+          os << " QB " << m.out_addr << ".." << (m.out_addr + m.out_len - 1);
+        os << "\n";
+      }
+    }
+    if (!s.faults.empty()) {
+      os << "  H faults:\n";
+      for (const auto& [at, text] : s.faults) os << "    " << pad(format_s_ms(at), 10) << text << "\n";
+    }
     if (s.io_events.empty()) {
       os << "  I/O events: none\n";
     } else {
@@ -363,6 +378,19 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
            << ",\"reason\":" << json_quote(devices::to_string(e.reason)) << "}";
       }
       os << "]}";
+    }
+    os << "],\"faults\":[";
+    for (std::size_t k = 0; k < s.faults.size(); ++k) {
+      os << (k ? "," : "") << "{";
+      json_time(os, "time", s.faults[k].first);
+      os << ",\"text\":" << json_quote(s.faults[k].second) << "}";
+    }
+    os << "],\"io_map\":[";
+    for (std::size_t k = 0; k < s.io_map.size(); ++k) {
+      const HIoMapRow& m = s.io_map[k];
+      os << (k ? "," : "") << "{\"station\":" << static_cast<int>(m.address) << ",\"module\":" << m.module
+         << ",\"in_addr\":" << m.in_addr << ",\"in_len\":" << m.in_len << ",\"out_addr\":" << m.out_addr
+         << ",\"out_len\":" << m.out_len << "}";
     }
     os << "],\"io_events\":[";
     for (std::size_t k = 0; k < s.io_events.size(); ++k) {

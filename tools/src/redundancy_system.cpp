@@ -52,7 +52,8 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
   } catch (const std::exception& e) {
     throw std::runtime_error("redundant master system \"" + rp.name + "\": " + e.what());
   }
-  m_model->system().on_event([this](const redundancy::SystemEvent& e) { on_system_event(e); });
+  m_model->system().add_event_listener(
+      [this](const redundancy::SystemEvent& e) { on_system_event(e); });
   // The program: once for the system, at every token receipt of either master.
   m_model->set_cycle_hook([this](devices::RedundantMasterSystemModel& m, int, bus::Ticks) {
     ++m_cycles;
@@ -149,6 +150,22 @@ std::string RedundantSystemNode::apply(const PlanFault& f, bool on) {
 
 void RedundantSystemNode::on_system_event(const redundancy::SystemEvent& e) {
   bus::Ticks now = e.time;
+  // A line lost because its CPU failed or stopped (an H-system drives the system): that is
+  // the switchovers' fault, at this instant, unless a scenario fault was noted at it (a CPU
+  // fault's reaction may come much later: a master swap ends an update seconds after it was
+  // requested).
+  if (e.kind == redundancy::SystemEvent::Kind::MasterSystemFailure &&
+      (m_faults.empty() || m_faults.back().at < now)) {
+    const auto loss = m_model->system().line_loss(e.line);
+    if (loss == redundancy::LineLoss::CpuFailure || loss == redundancy::LineLoss::MasterStop) {
+      const bool failed = loss == redundancy::LineLoss::CpuFailure;
+      m_faults.push_back({now,
+                          "line " + line_name(e.line) + "'s DP master " +
+                              (failed ? "loses power with its CPU" : "stops with its CPU"),
+                          failed ? PlanFault::Kind::MasterFailure : PlanFault::Kind::MasterStop,
+                          true});
+    }
+  }
   if (e.kind == redundancy::SystemEvent::Kind::Switchover &&
       e.cause != redundancy::SystemEvent::Cause::StartUp) {
     Switch s;

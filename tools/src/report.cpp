@@ -131,6 +131,7 @@ void write_text(const Report& r, std::ostream& os) {
   write_dp_text(r.dp_masters, os);
   write_dp_slaves_text(r.dp_slaves, os);
   write_redundancy_text(r.redundancy, os);
+  write_h_text(r.h_systems, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -233,6 +234,7 @@ void write_json(const Report& r, std::ostream& os) {
   write_dp_json(r.dp_masters, os);
   write_dp_slaves_json(r.dp_slaves, os);
   write_redundancy_json(r.redundancy, os);
+  write_h_json(r.h_systems, os);
   os << "}\n";
 }
 

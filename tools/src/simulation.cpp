@@ -293,6 +293,18 @@ void Simulation::start() {
     // capture keeps the power-on events).
     ls->stats.faults.clear();
   }
+  // The CPU pairs after the lines are powered (their models unpower the DP masters of the
+  // CPUs that are off), before the faults.
+  std::vector<RedundantSystemNode*> systems;
+  for (auto& node : m_redundant) systems.push_back(node.get());
+  for (std::size_t k = 0; k < m_plan.h_systems.size(); ++k) {
+    if (!m_plan.h_systems[k].runtime) continue;
+    m_h.push_back(std::make_unique<HSystemNode>(m_plan, static_cast<int>(k), m_sched, systems));
+    m_h.back()->set_capture(m_opts.capture);
+    m_h.back()->start();
+  }
+  // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
+  for (auto& ls : m_lines) ls->stats.faults.clear();
   schedule_faults();
 }
 
@@ -315,8 +327,12 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
-  // H-system faults: applied by the H-system runtime (next step).
-  if (is_h_fault(f.kind)) return;
+  if (is_h_fault(f.kind)) {
+    for (auto& h : m_h)
+      if (h->plan().source == m_plan.h_systems.at(static_cast<std::size_t>(f.h_system)).source)
+        h->apply(f, on);
+    return;
+  }
   LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
   bus::Line& l = *ls.line;
   using K = PlanFault::Kind;
@@ -352,7 +368,7 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
       ls.stats.faults.push_back({m_sched.now(), std::move(text)});
       break;
     }
-    default: break;  // H-system faults: applied by the H-system runtime (next step)
+    default: break;  // H-system faults: applied above
   }
 }
 
@@ -505,6 +521,7 @@ Report Simulation::report(double wall_seconds) const {
     r.lines.push_back(std::move(lr));
   }
   for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
+  for (const auto& h : m_h) r.h_systems.push_back(h->report());
   return r;
 }
 

@@ -189,6 +189,7 @@ void MasterSystem::emit(SystemEvent::Kind k, bus::Ticks t, int line, std::uint8_
   e.from = from;
   m_events.push_back(e);
   if (m_cb) m_cb(e);
+  for (const auto& l : m_listeners) l(e);
 }
 
 void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {

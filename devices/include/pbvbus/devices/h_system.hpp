@@ -136,6 +136,16 @@ class HSystemModel final : public bus::EventTarget {
   void inject_hardware_fault(int rack);
   void repair_cpu(int rack);
   bool request_master_swap();
+  // The pair's link-up/update operations (h_system_ops.cpp), for the scenario's H faults.
+  void set_changed_db_kb(std::uint32_t kb);  ///< F19: the next update copies `kb` KB
+  HChangeResult load_change(HChange kind);   ///< F22
+  void set_standby_parameter_change(bool may_not_change);  ///< F23 (then a swap: W#16#5966)
+  bool memory_reset(int rack);                              ///< F20: clears a reset request
+  /// Every event of the pair (state, role, system mode, OB) as it happens, after the model
+  /// took it in (for a runtime's capture; events() keeps only the OBs).
+  void set_pair_event_handler(std::function<void(const HEvent&)> h) {
+    m_pair_handler = std::move(h);
+  }
   /// Brings every side in line with its CPU now (the operations do it themselves).
   void reconcile();
 
@@ -207,6 +217,7 @@ class HSystemModel final : public bus::EventTarget {
   bus::Ticks m_armed_at = bus::kNever;
   std::vector<HSystemEvent> m_events;
   std::function<void(const HSystemEvent&)> m_handler;
+  std::function<void(const HEvent&)> m_pair_handler;
   std::array<std::vector<DiagEntry>, 2> m_io_diag;
 };
 

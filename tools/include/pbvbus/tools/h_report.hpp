@@ -81,6 +81,14 @@ struct HUpdateWindow {
   bool completed = true;  ///< false: the update ended without RUN (aborted)
 };
 
+/// One slave module in the process images (devices::HIoMap): where its inputs and outputs are.
+struct HIoMapRow {
+  std::uint8_t address = 0;
+  std::size_t module = 0;
+  std::size_t in_addr = 0, in_len = 0;
+  std::size_t out_addr = 0, out_len = 0;
+};
+
 struct HSystemReport {
   std::string name;
   devices::HProfile profile = devices::HProfile::S7_400H;
@@ -90,6 +98,10 @@ struct HSystemReport {
   std::vector<HUpdateWindow> updates;
   /// The planned T_P15 and T_PH (h_update_timing), set by the owner that has the plan.
   std::optional<bus::Ticks> planned_t_p15, planned_t_ph;
+  /// The scenario's H faults and repairs as applied (time, text), filled by the runtime.
+  std::vector<std::pair<bus::Ticks, std::string>> faults;
+  /// The process-image map of the driven DP master systems, filled by the runtime.
+  std::vector<HIoMapRow> io_map;
 };
 
 /// Everything the pair knows: final states, LEDs, buffers, the timeline from its events and

@@ -132,6 +132,7 @@
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/dp_system.hpp"
 #include "pbvbus/tools/line_stats.hpp"
+#include "pbvbus/tools/h_report.hpp"
 #include "pbvbus/tools/redundancy_system.hpp"
 
 namespace pbvbus::tools {
@@ -216,6 +217,7 @@ struct Report {
   std::vector<DpMasterReport> dp_masters;
   std::vector<DpSlaveView> dp_slaves;
   std::vector<RedundancyReport> redundancy;  ///< redundant master systems (issue 7)
+  std::vector<HSystemReport> h_systems;      ///< simulated H-system CPU pairs (issue 8)
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

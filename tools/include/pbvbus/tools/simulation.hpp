@@ -30,6 +30,7 @@
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/tools/capture_probes.hpp"
+#include "pbvbus/tools/h_system_node.hpp"
 #include "pbvbus/tools/redundancy_system.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
@@ -83,6 +84,10 @@ class Simulation {
   std::size_t redundant_system_count() const { return m_redundant.size(); }
   RedundantSystemNode& redundant_system(std::size_t i) { return *m_redundant.at(i); }
   const RedundantSystemNode& redundant_system(std::size_t i) const { return *m_redundant.at(i); }
+  /// The simulated h_systems (entries with a cpu part), in file order; built by start().
+  std::size_t h_system_count() const { return m_h.size(); }
+  HSystemNode& h_system(std::size_t i) { return *m_h.at(i); }
+  const HSystemNode& h_system(std::size_t i) const { return *m_h.at(i); }
 
   /// Whether something outside the process is attached (a pty): then the run must be paced.
   bool has_external_attachments() const { return !m_serial.empty(); }
@@ -126,6 +131,8 @@ class Simulation {
   // after them.
   std::vector<std::unique_ptr<RedundantSystemNode>> m_redundant;
   std::vector<std::unique_ptr<LineState>> m_lines;
+  // H-systems drive the redundant systems' models and schedule on m_sched: destroyed first.
+  std::vector<std::unique_ptr<HSystemNode>> m_h;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;
   std::vector<std::string> m_links;  ///< symlinks to ptys, removed at the end

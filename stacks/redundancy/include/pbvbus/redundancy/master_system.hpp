@@ -219,6 +219,12 @@ class MasterSystem {
   const dp::MasterImage* active_image(std::uint8_t address) const;
 
   void on_event(std::function<void(const SystemEvent&)> cb) { m_cb = std::move(cb); }
+  /// A further listener, called after the on_event callback for every event and never
+  /// replaced by on_event (the scenario runtime's report and capture keep theirs when an
+  /// H-system model takes on_event over).
+  void add_event_listener(std::function<void(const SystemEvent&)> cb) {
+    m_listeners.push_back(std::move(cb));
+  }
   void on_alarm(std::function<void(const SystemAlarm&)> cb) { m_alarm_cb = std::move(cb); }
   const std::vector<SystemAlarm>& alarms() const { return m_alarms; }
   /// Alarms a station raised again after a switchover that were recognised and not delivered.
@@ -303,6 +309,7 @@ class MasterSystem {
   } m_line[2];
   std::vector<SystemEvent> m_events;
   std::function<void(const SystemEvent&)> m_cb;
+  std::vector<std::function<void(const SystemEvent&)>> m_listeners;
   std::uint64_t m_switchovers = 0;
   std::function<void(const SystemAlarm&)> m_alarm_cb;
   std::vector<SystemAlarm> m_alarms;

@@ -1,0 +1,218 @@
+// A scenario's simulated h_system at run time (h_system_node.hpp).
+#include "pbvbus/tools/h_system_node.hpp"
+
+#include <functional>
+#include <stdexcept>
+
+#include "pbvbus/captures/pcapng_writer.hpp"
+#include "pbvbus/devices/h_update_timing.hpp"
+#include "pbvbus/tools/h_plan.hpp"
+#include "pbvbus/tools/redundancy_system.hpp"
+
+namespace pbvbus::tools {
+
+namespace {
+
+bool has_networks(const devices::ProgramSpec& p) {
+  return !p.copies.empty() || !p.counters.empty() || !p.monitors.empty();
+}
+
+devices::HChange to_change(HProgramChangeKind k) {
+  switch (k) {
+    case HProgramChangeKind::StructuralFbInterface: return devices::HChange::StructuralFbInterface;
+    case HProgramChangeKind::GlobalDb: return devices::HChange::GlobalDb;
+    case HProgramChangeKind::Allowed: break;
+  }
+  return devices::HChange::Allowed;
+}
+
+}  // namespace
+
+std::string HSystemNode::io_event_text(const devices::HSystemEvent& e) const {
+  if (e.source != devices::HSystemEvent::Source::Io) return e.text;
+  std::string kind;
+  switch (e.code) {
+    case 0x73A3: kind = "redundancy loss"; break;
+    case 0x72A3: kind = "redundancy restored"; break;
+    case 0x39C4: kind = "station failure"; break;
+    case 0x38C4: kind = "station return"; break;
+    case 0x39C3: kind = "master system failure"; break;
+    case 0x38C3: kind = "master system return"; break;
+    default: return e.text;
+  }
+  const HRuntimePlan& rt = *plan().runtime;
+  std::string text = kind;
+  if (e.system >= 0 && static_cast<std::size_t>(e.system) < rt.systems.size()) {
+    const RedundancyPlan& rp =
+        m_plan.redundant_systems.at(static_cast<std::size_t>(rt.systems[static_cast<std::size_t>(e.system)]));
+    text += ": DP master system \"" + rp.name + "\"";
+    if (e.line == 0 || e.line == 1)
+      text += ", line " + m_plan.lines.at(static_cast<std::size_t>(rp.line[e.line])).name;
+  }
+  if (e.station != 0xFF) text += ", station " + std::to_string(e.station);
+  return text;
+}
+
+HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sched,
+                         const std::vector<RedundantSystemNode*>& systems)
+    : m_plan(plan), m_index(index), m_sched(sched) {
+  const HSystemPlan& hp = this->plan();
+  if (!hp.runtime) throw std::runtime_error("h_system \"" + hp.name + "\" has no cpu part");
+  const HRuntimePlan& rt = *hp.runtime;
+  std::vector<devices::RedundantMasterSystemModel*> models;
+  for (int k : rt.systems) {
+    RedundantSystemNode* node = systems.at(static_cast<std::size_t>(k));
+    // The pair's program writes the outputs, not the system's own counter.
+    node->model().set_cycle_hook({});
+    models.push_back(&node->model());
+  }
+  try {
+    m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models));
+    if (has_networks(rt.program)) m_model->set_program(rt.program);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("h_system \"" + hp.name + "\": " + e.what());
+  }
+  m_model->set_pair_event_handler([this](const devices::HEvent& e) { on_pair_event(e); });
+  try {
+    const devices::UpdatePlan up = devices::plan_update(h_update_input(plan, hp));
+    m_planned_t_ph = devices::to_ticks(up.t_ph);
+    if (up.t_p15) m_planned_t_p15 = devices::to_ticks(*up.t_p15);
+  } catch (const std::exception&) {
+    // No plan (the switchover planner refused the lines): the report shows no bounds.
+  }
+}
+
+HSystemNode::~HSystemNode() = default;
+
+const HSystemPlan& HSystemNode::plan() const {
+  return m_plan.h_systems.at(static_cast<std::size_t>(m_index));
+}
+
+void HSystemNode::start() {
+  if (m_started) return;
+  m_started = true;
+  const HRuntimePlan& rt = *plan().runtime;
+  if (!rt.fibres_connected_at_power_on) {
+    m_model->cut_both_fibres();
+    note("sync link: both fibres not connected at power-on");
+  }
+  // A power-on at the start of the run happens now (part of powering up, not a later event).
+  const auto at = [this](bus::Ticks t, std::function<void()> fn) {
+    if (t <= m_sched.now()) fn();
+    else m_sched.schedule(t, std::move(fn));
+  };
+  const auto& on = rt.power_on;
+  if (on[0] && on[1] && *on[0] == *on[1]) {
+    at(*on[0], [this] { m_model->power_on_both(); });
+    return;
+  }
+  for (int r = 0; r < 2; ++r)
+    if (on[static_cast<std::size_t>(r)])
+      at(*on[static_cast<std::size_t>(r)], [this, r] { m_model->power_on(r); });
+}
+
+std::string HSystemNode::apply(const PlanFault& f, bool on) {
+  using K = PlanFault::Kind;
+  devices::HSystemModel& m = *m_model;
+  std::string text = on ? f.description : "repair of " + f.description;
+  switch (f.kind) {
+    case K::CpuFailure: on ? m.power_off(f.rack) : m.power_on(f.rack); break;
+    case K::CpuStop: on ? m.switch_to_stop(f.rack) : m.switch_to_run(f.rack); break;
+    case K::FibreCut: on ? m.cut_fibre(f.fibre) : m.repair_fibre(f.fibre); break;
+    case K::FibresCut:
+      if (on) {
+        m.cut_both_fibres();
+      } else {
+        m.repair_fibre(0);
+        m.repair_fibre(1);
+      }
+      break;
+    case K::ComparisonError: {
+      const devices::RedundantExecution* x = m.execution();
+      const int standby = m.pair().master() >= 0 ? 1 - m.pair().master() : 1;
+      if (x != nullptr && !x->image(standby).memory().empty()) {
+        m.inject_divergence(standby, devices::Area::Memory, 0, 0x01);
+        text += " (one bit of CPU " + std::to_string(standby) + "'s memory)";
+      } else if (!m.inject_comparison_error()) {
+        text += ": not in Redundant mode, nothing happens";
+      }
+      break;
+    }
+    case K::OneSidedOb121:
+      if (!m.one_sided_ob121(f.rack)) text += ": not in Redundant mode, nothing happens";
+      break;
+    case K::HardwareFault: on ? m.inject_hardware_fault(f.rack) : m.repair_cpu(f.rack); break;
+    case K::CpuHold:
+      if (on ? !m.hold(f.rack) : !m.release_hold(f.rack)) text += ": refused";
+      break;
+    case K::HMasterSwap:
+      if (!m.request_master_swap()) text += ": refused";
+      break;
+    case K::UpdateLoad: m.set_changed_db_kb(static_cast<std::uint32_t>(f.kb)); break;
+    case K::ProgramChange:
+      text += std::string(": ") + std::string(devices::to_string(m.load_change(to_change(f.change))));
+      break;
+    case K::ParameterChange:
+      m.set_standby_parameter_change(true);
+      if (!m.request_master_swap()) text += ": swap refused";
+      break;
+    case K::MemoryReset:
+      if (!m.memory_reset(f.rack)) text += ": refused";
+      break;
+    default: break;
+  }
+  note(text);
+  return text;
+}
+
+void HSystemNode::note(std::string text) {
+  m_faults.emplace_back(m_sched.now(), text);
+  if (m_capture == nullptr) return;
+  captures::EventRecord r;
+  r.category = captures::EventCategory::Note;
+  r.text = plan().name + ": " + text;
+  m_capture->write_event(m_sched.now(), r);
+}
+
+void HSystemNode::on_pair_event(const devices::HEvent& e) {
+  if (m_capture == nullptr) return;
+  m_capture->write_event(e.at, h_event_record(e, m_model->pair().params().profile, plan().name));
+}
+
+HSystemReport HSystemNode::report() const {
+  HSystemReport r = make_h_report(plan().name, m_model->pair());
+  r.planned_t_p15 = m_planned_t_p15;
+  r.planned_t_ph = m_planned_t_ph;
+  r.faults = m_faults;
+  for (const devices::HSystemEvent& e : m_model->events()) {
+    if (e.source == devices::HSystemEvent::Source::Cpu) continue;  // in the timeline already
+    HIoEvent x;
+    x.at = e.time;
+    if (e.rack < 0) x.racks = {0, 1};
+    else x.racks = {e.rack};
+    x.ob = e.ob;
+    x.code = e.code;
+    x.text = io_event_text(e);
+    r.io_events.push_back(std::move(x));
+  }
+  // The phases of each update as the model measured them (t1 matches the pair's).
+  for (const devices::UpdateMeasure& u : m_model->update_measures())
+    for (HUpdateWindow& w : r.updates)
+      if (w.t1 == u.t1 && u.done) {
+        w.t3 = u.t3;
+        if (u.standby_operate_from != bus::kNever) w.t4 = u.standby_operate_from;
+      }
+  for (const devices::HIoEntry& e : m_model->io_map().entries()) {
+    HIoMapRow row;
+    row.address = e.address;
+    row.module = e.module;
+    row.in_addr = e.in_addr;
+    row.in_len = e.in_len;
+    row.out_addr = e.out_addr;
+    row.out_len = e.out_len;
+    r.io_map.push_back(row);
+  }
+  return r;
+}
+
+}  // namespace pbvbus::tools

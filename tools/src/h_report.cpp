@@ -333,6 +333,13 @@ void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os) {
           else os << "-";
           os << ": " << c->verdict;
         }
+        if (w.last_io_before && w.first_io_after) {
+          const bus::Ticks gap = *w.first_io_after - *w.last_io_before;
+          os << "; no I/O update for " << bus::format_duration(gap) << " (OB 1 at "
+             << format_s_ms(*w.last_io_before) << " s and " << format_s_ms(*w.first_io_after) << " s)";
+          if (s.planned_t_p15)
+            os << ": " << window_verdict(gap, *s.planned_t_p15 + w.scan_time) << " T_P15 + scan time";
+        }
         os << "\n";
       }
     }
@@ -423,7 +430,11 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
       json_opt_time(os, "t_ph_window", ph.measured);
       os << ",";
       json_opt_time(os, "planned_t_ph", ph.planned);
-      os << ",\"t_ph_verdict\":" << json_quote(ph.verdict) << "}";
+      os << ",\"t_ph_verdict\":" << json_quote(ph.verdict) << ",";
+      json_opt_time(os, "last_io_before", w.last_io_before);
+      os << ",";
+      json_opt_time(os, "first_io_after", w.first_io_after);
+      os << "}";
     }
     os << "]}";
   }

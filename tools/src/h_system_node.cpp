@@ -201,6 +201,9 @@ HSystemReport HSystemNode::report() const {
       if (w.t1 == u.t1 && u.done) {
         w.t3 = u.t3;
         if (u.standby_operate_from != bus::kNever) w.t4 = u.standby_operate_from;
+        if (u.last_scan_before != bus::kNever) w.last_io_before = u.last_scan_before;
+        if (u.first_scan_after != bus::kNever) w.first_io_after = u.first_scan_after;
+        w.scan_time = plan().runtime->program.scan_time;
       }
   for (const devices::HIoEntry& e : m_model->io_map().entries()) {
     HIoMapRow row;

@@ -79,6 +79,12 @@ struct HUpdateWindow {
   std::optional<bus::Ticks> t3, t4;
   bus::Ticks t5 = 0;
   bool completed = true;  ///< false: the update ended without RUN (aborted)
+  /// Measured by the runtime from the program: the last OB 1 (with its I/O update) before t3
+  /// and the first one after t5. Their distance is the gap the process sees; it is at most
+  /// the no-I/O window + one scan time (the last scan before t3 started up to one scan time
+  /// before it; the first one after runs at t5 itself).
+  std::optional<bus::Ticks> last_io_before, first_io_after;
+  bus::Ticks scan_time = 0;
 };
 
 /// One slave module in the process images (devices::HIoMap): where its inputs and outputs are.

@@ -109,9 +109,9 @@ TEST(HSystemProgram, DiscrepancyMonitor7960IncomingOutgoing) {
   EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Redundant);
 }
 
-// F18: the same monitor; the standby's "difference first seen" time loses bit 33 (about
-// 2.36 s earlier) at 3.460 s, so at the scan at 3.567 s... no: at the next scan (3.467 s) the
-// standby finds the discrepancy time expired and raises 7960, the master does not: the CPUs
+// F18: the same monitor (discrepancy time 1 s), IB 4 set at 3.360 s: the episode starts at the
+// scan at 3.367 s on both CPUs. At 3.460 s the standby's "difference first seen" time loses bit
+// 33 (2^33 ticks = 2.362 s earlier), so at the next scan (3.467 s) the standby finds the discrepancy time expired and raises 7960, the master does not: the CPUs
 // took different paths -> sync error: standby STOP, Solo, OB 72 on the master, "sync error" in
 // both diagnostic buffers. No 7960 reported (the master's run raised none).
 TEST(HSystemProgram, F18SyncErrorStandbyStop) {
@@ -120,17 +120,13 @@ TEST(HSystemProgram, F18SyncErrorStandbyStop) {
   ProgramSpec p = counters_spec();
   p.monitors.push_back({4, 0, 1, 0xFF, 4, 1000 * kMs});
   s.h->set_program(p);
-  s.bring_up();
-  s.run_until(kRedundant + 200 * kMs);  // 3.357 s
+  s.at(kT0);
+  s.h->power_on_both();
+  s.run_until(kRedundant + 203 * kMs);  // 3.360 s
   ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0x01, 0x00}));
   s.run_until(kRedundant + 303 * kMs);  // 3.460 s: episode running since 3.367 s
   const std::size_t mon = s.h->execution()->program().monitor_state_offset(0);
   // since = 3.367 s = 12 242 412 000 ticks = 0x2_D9B4_6860: bit 33 (byte 3, bit 1) set.
-  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(1).memory()[mon + i]);
-  std::printf(" mon=%zu\n", mon);
-  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(0).memory()[mon + i]);
-  for (int i = 0; i < 8; ++i) std::printf("%02X ", s.h->pii()[i]);
-  std::printf(" mode=%d now=%lld\n", int(s.h->pair().system_mode()), (long long)s.sched.now());
   ASSERT_EQ(s.h->execution()->image(1).memory()[mon + 3] & 0x02, 0x02);
   ASSERT_TRUE(s.h->inject_divergence(1, Area::Memory, static_cast<std::uint32_t>(mon + 3), 0x02));
   s.run_until(kRedundant + 310 * kMs);  // 3.467 s

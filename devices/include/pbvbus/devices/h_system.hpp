@@ -60,6 +60,7 @@
 #include "pbvbus/devices/h_io_map.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/devices/h_system_records.hpp"
 #include "pbvbus/devices/h_update_measure.hpp"
 #include "pbvbus/devices/redundant_master_system.hpp"
 
@@ -67,8 +68,9 @@ namespace pbvbus::devices {
 
 struct HSystemEvent {
   /// Cpu: the pair's OB 72/121; Io: the master systems' S7 events (OB 70/86) and OB 85;
-  /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...).
-  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm };
+  /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...);
+  /// Image: OB 85 (process-image transfer error).
+  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm, Image };
   bus::Ticks time = 0;
   int rack = -1;                  ///< the CPU the OB runs on; -1 = both
   CpuRole role = CpuRole::None;   ///< the role of that CPU (both: Master)
@@ -136,6 +138,19 @@ class HSystemModel final : public bus::EventTarget {
   void inject_hardware_fault(int rack);
   void repair_cpu(int rack);
   bool request_master_swap();
+  // ---- data-record jobs, SFC 51 (R7; h_system_records.hpp) ----
+  /// SFC 59 over MasterSystem::read. Returns 0 (started: `cb` gets the final result later) or
+  /// a code at once (cb not called): W#16#80C3 during the update, W#16#8090 for a bad
+  /// system/station or no active channel.
+  std::uint16_t read_record(std::size_t system, std::uint8_t station, std::uint8_t slot,
+                            std::uint8_t index, std::uint8_t length, RecordJobCallback cb);
+  /// SFC 58 over MasterSystem::write; as read_record.
+  std::uint16_t write_record(std::size_t system, std::uint8_t station, std::uint8_t slot,
+                             std::uint8_t index, std::span<const std::uint8_t> data,
+                             RecordJobCallback cb);
+  /// SFC 51 for the H-system state: W#16#8085 during the update.
+  HSystemState read_system_state(bus::Ticks now);
+
   /// Brings every side in line with its CPU now (the operations do it themselves).
   void reconcile();
 
@@ -181,6 +196,13 @@ class HSystemModel final : public bus::EventTarget {
   void scan(bus::Ticks now);
   void scan_execution(bus::Ticks now);  // h_system_program.cpp
   void track_update(bus::Ticks now);    // h_system_update.cpp
+  void on_alarm(std::size_t system, const redundancy::SystemAlarm& a);  // h_system_alarms.cpp
+  void deliver_alarm(HSystemEvent h, bus::Ticks now);
+  void deliver_held(bus::Ticks now);
+  std::uint16_t start_record(std::size_t system, std::uint8_t station, bool write,
+                             std::uint8_t slot, std::uint8_t index, std::uint8_t length,
+                             std::span<const std::uint8_t> data, RecordJobCallback cb);
+  void check_process_image(bus::Ticks now);  // OB 85, h_system_alarms.cpp
   void on_program_event(const ProgramEvent& e, std::array<bool, 2> ran);
   void on_pair_event(const HEvent& e);
   void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
@@ -198,7 +220,14 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<UpdateMeasure> m_measures;
   bool m_update_copied = false;
   bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1  ///< the last measure's output/state copy (t4) is done
-  std::string m_ob72_note;  ///< appended to the next OB 72 ComparisonError text (F16's place)
+  std::string m_ob72_note;
+  std::vector<HSystemEvent> m_held_alarms;  ///< received while interrupts_held()
+  struct HeldRecord {
+    RecordJobCallback cb;
+    RecordJobResult res;
+  };
+  std::vector<HeldRecord> m_held_records;  ///< jobs completed during the update (80C3 after t5)
+  std::vector<std::vector<bool>> m_ob85;   ///< [system][address]: OB 85 episode open  ///< appended to the next OB 72 ComparisonError text (F16's place)
   IoGate m_gate;
   bus::Ticks m_scan_time = bus::kTicksPerMs;
   bool m_scan_armed = false;

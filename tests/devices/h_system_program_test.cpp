@@ -148,5 +148,42 @@ TEST(HSystemProgram, F18SyncErrorStandbyStop) {
   smp.expect_no_pulse(0);
 }
 
+// OB 85: slave 10 (one-sided, line A) loses power at 4 s in Redundant mode; the master system
+// reports its failure (OB 86 W#16#39C4) at some frame time E; the first OB 1 at or after E
+// (OB 1 on 3.157 + k x 10 ms) finds no active image: OB 85 W#16#39B1 incoming on both CPUs,
+// once; power back at 5 s: at the first OB 1 after the return (38C4) OB 85 W#16#38B1 outgoing.
+TEST(HSystemProgram, Ob85OncePerEpisode) {
+  HSys s;
+  s.h->set_program(counters_spec());
+  s.bring_up();
+  s.at(4000 * kMs);
+  s.line[0].set_power(s.one_att[0], false);
+  s.run_until(5000 * kMs);
+  s.line[0].set_power(s.one_att[0], true);
+  s.run_until(7000 * kMs);
+  std::vector<bus::Ticks> fail, back;
+  for (const auto& e : s.s7()) {
+    if (e.station != kOneA) continue;
+    (e.code() == 0x39C4 ? fail : back).push_back(e.time);
+  }
+  ASSERT_EQ(fail.size(), 1u);
+  ASSERT_EQ(back.size(), 1u);
+  auto next_scan = [](bus::Ticks t) {  // first 3.157 s + k x 10 ms at or after t
+    const bus::Ticks k = (t - kRedundant + kScan - 1) / kScan;
+    return kRedundant + k * kScan;
+  };
+  const auto ob85 = s.events(Src::Image);
+  ASSERT_EQ(ob85.size(), 2u);
+  EXPECT_EQ(ob85[0].ob, 85);
+  EXPECT_EQ(ob85[0].code, 0x39B1);
+  EXPECT_TRUE(ob85[0].incoming);
+  EXPECT_EQ(ob85[0].station, kOneA);
+  EXPECT_EQ(ob85[0].rack, -1);
+  EXPECT_EQ(ob85[0].time, next_scan(fail[0]));
+  EXPECT_EQ(ob85[1].code, 0x38B1);
+  EXPECT_FALSE(ob85[1].incoming);
+  EXPECT_EQ(ob85[1].time, next_scan(back[0]));
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

@@ -15,8 +15,8 @@
 //     running -> Operate while the master CPU's program runs (dp_master_operate(master())),
 //       else Clear (a master CPU in STOP/STARTUP still accesses the switched I/O, digest §1,
 //       with the outputs disabled). With two masters (F6/F7) each side follows its own CPU
-//       (dp_master_operate(r)). A standby in UPDATE therefore already sends the master's
-//       outputs: one program, write_outputs writes both images.
+//       (dp_master_operate(r)). Except the standby in UPDATE: Clear until t4, Operate from t4
+//       (below); one program, write_outputs writes both images.
 //   A side whose master never ran is idle (MasterSystem::mark_line_idle): no 39C3, no 73A3 for
 //   its channels; when it starts its channels come up without any event. Order: when a side
 //   goes away the MasterSystem is told first (it switches every station on that line to the
@@ -29,6 +29,40 @@
 //   when g(now) is false the scan is skipped entirely (not counted), the next one is still
 //   scheduled. With two masters one program runs (the same user program on both CPUs; their
 //   divergence is not modelled).
+// - The real program: set_program(ProgramSpec) builds a RedundantExecution with the I/O map's
+//   PII/PIQ sizes (bad spec: std::invalid_argument "program: <validate()'s first message>",
+//   the model unchanged). Each OB 1: the PII from the map -> set_inputs (both CPUs, the sync
+//   point), scan(now, running, master) with running[r] = dp_master_operate(r) (RUN: the master,
+//   or the standby in Redundant), the output rack's PIQ -> write_outputs. The comparison's
+//   difference -> HCpuPair::inject_comparison_error (F16; the OB 72 text names area, offset and
+//   both bytes). A sync error (F18) -> the standby's switch_to_stop (exactly: standby STOP,
+//   Solo, OB 72 StandbyStop on the master; a STOP -> RUN restarts it, as after any fault STOP)
+//   plus a "sync error" entry in both diagnostic buffers; F18 is checked before F16 (the sync
+//   error happens during the run, the comparison at its end). Program events (7960) ->
+//   events() with source Program, code 0x7960, no OB. Two masters (F6/F7): each CPU scans alone
+//   (no comparison), rack 0's PIQ is sent. set_program(hook) replaces a spec and vice versa.
+// - Update phases (400H, pair rules: io_frozen, outputs_held_by_both, interrupts_held): no OB 1
+//   and no I/O update (inputs or outputs) while io_frozen() ([t3, t5)); a scan due then is
+//   dropped and OB 1 restarts AT t5 (or the abort) — a late OB 1 starts at once — so the
+//   measured no-I/O window (first scan after - last scan before) is <= W + one scan time (the
+//   last scan before t3 started less than one scan time before t3). A pair deadline and a scan
+//   at the same instant: the deadline first. The standby's side of every master system is Clear
+//   from the start of its UPDATE until t4 and Operate from t4 (the output copy: both CPUs drive
+//   during T_PH); at t4 the execution's copy_state(master, standby) (the update copies images
+//   and memory). Clear before t4 is no pulse: every station is active on the master's line (the
+//   standby's line only just started, silently), and a station whose only channel is the
+//   standby's was failed and is just returning. T_PH = 0: t4 = t5. update_measures() records
+//   each update (h_update_measure.hpp).
+// - Interrupts (digest §4): the MasterSystems' DP-V1 alarms (on_alarm, once each) become OB
+//   events (source Alarm): type 1 OB 82, 2 OB 40, 3/4 OB 83, 5 OB 55, 6 OB 56, others OB 57, on
+//   the CPUs running the program; while interrupts_held() ([t1, t5)) they are stored and
+//   delivered at t5 (or the abort) in their order (time = delivery, original_time = receipt).
+// - Data-record jobs (R7, h_system_records.hpp): refused at once during the update
+//   (pair().record_job_result: 80C3); a job running when an update starts returns 80C3, held
+//   until t5 if it completes inside; SFC 51 -> 8085 during the update.
+// - OB 85 (source Image): at a scan, a mapped station with no active image that the master
+//   system counts as failed opens an episode (W#16#39B1, once); at the first scan that finds
+//   it back: W#16#38B1. An idle line's one-sided slave is not failed: no OB 85.
 // - Events: events() merges, in time order, the pair's OB events (72, 121; source Cpu) and
 //   every S7 event of the master systems (OB 70/86; source Io). An I/O OB runs on every CPU that
 //   runs a program (dp_master_operate): rack -1 when both do (Redundant), the one rack in Solo;

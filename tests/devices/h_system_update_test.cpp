@@ -129,19 +129,21 @@ TEST(HSystemUpdate, StandbyPowerLossAbortEndsTheFreeze) {
   HSys s(manual_params());
   s.h->set_program(counters_spec());
   start(s);
-  s.run_until(3100 * kMs - 1);
+  s.at(3100 * kMs);
+  EXPECT_TRUE(s.h->pair().io_frozen());
   EXPECT_EQ(s.h->scans(), 200u);
-  s.h->power_off(1);  // at 3.100 s - 1 tick: the scheduler's now
-  s.run_until(3100 * kMs);
+  s.h->power_off(1);
   EXPECT_FALSE(s.h->pair().io_frozen());
+  s.run_until(3100 * kMs);  // the OB 1 armed at the abort instant
   EXPECT_EQ(s.h->scans(), 201u);
   ASSERT_EQ(s.h->update_measures().size(), 1u);
   const UpdateMeasure& m = s.h->update_measures()[0];
   EXPECT_TRUE(m.aborted);
-  EXPECT_EQ(m.t5, 3100 * kMs - 1);
-  EXPECT_EQ(m.first_scan_after, 3100 * kMs - 1);
+  EXPECT_EQ(m.t5, 3100 * kMs);
+  EXPECT_EQ(m.first_scan_after, 3100 * kMs);
   EXPECT_EQ(m.standby_operate_from, bus::kNever);  // before t4
-  EXPECT_EQ(m.no_io_window(), 3100 * kMs - 1 - 3002 * kMs);
+  EXPECT_EQ(m.no_io_window(), 98 * kMs);            // 3.100 - 3.002
+  EXPECT_EQ(s.h->side_mode(0, 1), Mode::Unpowered);
   EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Solo);
 }
 

@@ -42,9 +42,12 @@ HSystemModel::HSystemModel(bus::Scheduler& sched, HCpuPairParams params,
   m_pii.assign(m_map.pii_size(), 0);
   m_piq.assign(m_map.piq_size(), 0);
   m_pair.on_event([this](const HEvent& e) { on_pair_event(e); });
-  for (std::size_t s = 0; s < m_systems.size(); ++s)
+  for (std::size_t s = 0; s < m_systems.size(); ++s) {
     m_systems[s]->system().on_event(
         [this, s](const redundancy::SystemEvent& e) { on_io_event(s, e); });
+    m_systems[s]->system().on_alarm(
+        [this, s](const redundancy::SystemAlarm& a) { on_alarm(s, a); });
+  }
   reconcile();
   arm_deadline();
 }
@@ -158,6 +161,7 @@ void HSystemModel::reconcile() {
     for (std::size_t s = 0; s < m_systems.size(); ++s) apply(s, r, to);
   }
   track_update(m_sched.now());
+  deliver_held(m_sched.now());
   if (has_program() && !m_scan_armed && program_runs() && !m_pair.io_frozen())
     arm_scan(m_sched.now());
 }
@@ -269,6 +273,7 @@ void HSystemModel::scan(bus::Ticks now) {
       m_measures.back().first_scan_after == bus::kNever)
     m_measures.back().first_scan_after = now;
   m_last_scan = now;
+  check_process_image(now);
   if (m_exec) {
     scan_execution(now);
     return;

@@ -109,9 +109,9 @@ TEST(HSystemProgram, DiscrepancyMonitor7960IncomingOutgoing) {
   EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Redundant);
 }
 
-// F18: the same monitor; the standby's "difference first seen" time loses bit 33 (about
-// 2.36 s earlier) at 3.460 s, so at the scan at 3.567 s... no: at the next scan (3.467 s) the
-// standby finds the discrepancy time expired and raises 7960, the master does not: the CPUs
+// F18: the same monitor (discrepancy time 1 s), IB 4 set at 3.360 s: the episode starts at the
+// scan at 3.367 s on both CPUs. At 3.460 s the standby's "difference first seen" time loses bit
+// 33 (2^33 ticks = 2.362 s earlier), so at the next scan (3.467 s) the standby finds the discrepancy time expired and raises 7960, the master does not: the CPUs
 // took different paths -> sync error: standby STOP, Solo, OB 72 on the master, "sync error" in
 // both diagnostic buffers. No 7960 reported (the master's run raised none).
 TEST(HSystemProgram, F18SyncErrorStandbyStop) {
@@ -120,17 +120,13 @@ TEST(HSystemProgram, F18SyncErrorStandbyStop) {
   ProgramSpec p = counters_spec();
   p.monitors.push_back({4, 0, 1, 0xFF, 4, 1000 * kMs});
   s.h->set_program(p);
-  s.bring_up();
-  s.run_until(kRedundant + 200 * kMs);  // 3.357 s
+  s.at(kT0);
+  s.h->power_on_both();
+  s.run_until(kRedundant + 203 * kMs);  // 3.360 s
   ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0x01, 0x00}));
   s.run_until(kRedundant + 303 * kMs);  // 3.460 s: episode running since 3.367 s
   const std::size_t mon = s.h->execution()->program().monitor_state_offset(0);
   // since = 3.367 s = 12 242 412 000 ticks = 0x2_D9B4_6860: bit 33 (byte 3, bit 1) set.
-  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(1).memory()[mon + i]);
-  std::printf(" mon=%zu\n", mon);
-  for (int i = 0; i < 9; ++i) std::printf("%02X ", s.h->execution()->image(0).memory()[mon + i]);
-  for (int i = 0; i < 8; ++i) std::printf("%02X ", s.h->pii()[i]);
-  std::printf(" mode=%d now=%lld\n", int(s.h->pair().system_mode()), (long long)s.sched.now());
   ASSERT_EQ(s.h->execution()->image(1).memory()[mon + 3] & 0x02, 0x02);
   ASSERT_TRUE(s.h->inject_divergence(1, Area::Memory, static_cast<std::uint32_t>(mon + 3), 0x02));
   s.run_until(kRedundant + 310 * kMs);  // 3.467 s
@@ -150,6 +146,43 @@ TEST(HSystemProgram, F18SyncErrorStandbyStop) {
   }
   s.run_until(kRedundant + 1000 * kMs);
   smp.expect_no_pulse(0);
+}
+
+// OB 85: slave 10 (one-sided, line A) loses power at 4 s in Redundant mode; the master system
+// reports its failure (OB 86 W#16#39C4) at some frame time E; the first OB 1 at or after E
+// (OB 1 on 3.157 + k x 10 ms) finds no active image: OB 85 W#16#39B1 incoming on both CPUs,
+// once; power back at 5 s: at the first OB 1 after the return (38C4) OB 85 W#16#38B1 outgoing.
+TEST(HSystemProgram, Ob85OncePerEpisode) {
+  HSys s;
+  s.h->set_program(counters_spec());
+  s.bring_up();
+  s.at(4000 * kMs);
+  s.line[0].set_power(s.one_att[0], false);
+  s.run_until(5000 * kMs);
+  s.line[0].set_power(s.one_att[0], true);
+  s.run_until(7000 * kMs);
+  std::vector<bus::Ticks> fail, back;
+  for (const auto& e : s.s7()) {
+    if (e.station != kOneA) continue;
+    (e.code() == 0x39C4 ? fail : back).push_back(e.time);
+  }
+  ASSERT_EQ(fail.size(), 1u);
+  ASSERT_EQ(back.size(), 1u);
+  auto next_scan = [](bus::Ticks t) {  // first 3.157 s + k x 10 ms at or after t
+    const bus::Ticks k = (t - kRedundant + kScan - 1) / kScan;
+    return kRedundant + k * kScan;
+  };
+  const auto ob85 = s.events(Src::Image);
+  ASSERT_EQ(ob85.size(), 2u);
+  EXPECT_EQ(ob85[0].ob, 85);
+  EXPECT_EQ(ob85[0].code, 0x39B1);
+  EXPECT_TRUE(ob85[0].incoming);
+  EXPECT_EQ(ob85[0].station, kOneA);
+  EXPECT_EQ(ob85[0].rack, -1);
+  EXPECT_EQ(ob85[0].time, next_scan(fail[0]));
+  EXPECT_EQ(ob85[1].code, 0x38B1);
+  EXPECT_FALSE(ob85[1].incoming);
+  EXPECT_EQ(ob85[1].time, next_scan(back[0]));
 }
 
 }  // namespace

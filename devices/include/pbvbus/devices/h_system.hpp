@@ -15,8 +15,8 @@
 //     running -> Operate while the master CPU's program runs (dp_master_operate(master())),
 //       else Clear (a master CPU in STOP/STARTUP still accesses the switched I/O, digest §1,
 //       with the outputs disabled). With two masters (F6/F7) each side follows its own CPU
-//       (dp_master_operate(r)). A standby in UPDATE therefore already sends the master's
-//       outputs: one program, write_outputs writes both images.
+//       (dp_master_operate(r)). Except the standby in UPDATE: Clear until t4, Operate from t4
+//       (below); one program, write_outputs writes both images.
 //   A side whose master never ran is idle (MasterSystem::mark_line_idle): no 39C3, no 73A3 for
 //   its channels; when it starts its channels come up without any event. Order: when a side
 //   goes away the MasterSystem is told first (it switches every station on that line to the
@@ -29,6 +29,40 @@
 //   when g(now) is false the scan is skipped entirely (not counted), the next one is still
 //   scheduled. With two masters one program runs (the same user program on both CPUs; their
 //   divergence is not modelled).
+// - The real program: set_program(ProgramSpec) builds a RedundantExecution with the I/O map's
+//   PII/PIQ sizes (bad spec: std::invalid_argument "program: <validate()'s first message>",
+//   the model unchanged). Each OB 1: the PII from the map -> set_inputs (both CPUs, the sync
+//   point), scan(now, running, master) with running[r] = dp_master_operate(r) (RUN: the master,
+//   or the standby in Redundant), the output rack's PIQ -> write_outputs. The comparison's
+//   difference -> HCpuPair::inject_comparison_error (F16; the OB 72 text names area, offset and
+//   both bytes). A sync error (F18) -> the standby's switch_to_stop (exactly: standby STOP,
+//   Solo, OB 72 StandbyStop on the master; a STOP -> RUN restarts it, as after any fault STOP)
+//   plus a "sync error" entry in both diagnostic buffers; F18 is checked before F16 (the sync
+//   error happens during the run, the comparison at its end). Program events (7960) ->
+//   events() with source Program, code 0x7960, no OB. Two masters (F6/F7): each CPU scans alone
+//   (no comparison), rack 0's PIQ is sent. set_program(hook) replaces a spec and vice versa.
+// - Update phases (400H, pair rules: io_frozen, outputs_held_by_both, interrupts_held): no OB 1
+//   and no I/O update (inputs or outputs) while io_frozen() ([t3, t5)); a scan due then is
+//   dropped and OB 1 restarts AT t5 (or the abort) — a late OB 1 starts at once — so the
+//   measured no-I/O window (first scan after - last scan before) is <= W + one scan time (the
+//   last scan before t3 started less than one scan time before t3). A pair deadline and a scan
+//   at the same instant: the deadline first. The standby's side of every master system is Clear
+//   from the start of its UPDATE until t4 and Operate from t4 (the output copy: both CPUs drive
+//   during T_PH); at t4 the execution's copy_state(master, standby) (the update copies images
+//   and memory). Clear before t4 is no pulse: every station is active on the master's line (the
+//   standby's line only just started, silently), and a station whose only channel is the
+//   standby's was failed and is just returning. T_PH = 0: t4 = t5. update_measures() records
+//   each update (h_update_measure.hpp).
+// - Interrupts (digest §4): the MasterSystems' DP-V1 alarms (on_alarm, once each) become OB
+//   events (source Alarm): type 1 OB 82, 2 OB 40, 3/4 OB 83, 5 OB 55, 6 OB 56, others OB 57, on
+//   the CPUs running the program; while interrupts_held() ([t1, t5)) they are stored and
+//   delivered at t5 (or the abort) in their order (time = delivery, original_time = receipt).
+// - Data-record jobs (R7, h_system_records.hpp): refused at once during the update
+//   (pair().record_job_result: 80C3); a job running when an update starts returns 80C3, held
+//   until t5 if it completes inside; SFC 51 -> 8085 during the update.
+// - OB 85 (source Image): at a scan, a mapped station with no active image that the master
+//   system counts as failed opens an episode (W#16#39B1, once); at the first scan that finds
+//   it back: W#16#38B1. An idle line's one-sided slave is not failed: no OB 85.
 // - Events: events() merges, in time order, the pair's OB events (72, 121; source Cpu) and
 //   every S7 event of the master systems (OB 70/86; source Io). An I/O OB runs on every CPU that
 //   runs a program (dp_master_operate): rack -1 when both do (Redundant), the one rack in Solo;
@@ -60,6 +94,7 @@
 #include "pbvbus/devices/h_io_map.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/devices/h_system_records.hpp"
 #include "pbvbus/devices/h_update_measure.hpp"
 #include "pbvbus/devices/redundant_master_system.hpp"
 
@@ -67,8 +102,9 @@ namespace pbvbus::devices {
 
 struct HSystemEvent {
   /// Cpu: the pair's OB 72/121; Io: the master systems' S7 events (OB 70/86) and OB 85;
-  /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...).
-  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm };
+  /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...);
+  /// Image: OB 85 (process-image transfer error).
+  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm, Image };
   bus::Ticks time = 0;
   int rack = -1;                  ///< the CPU the OB runs on; -1 = both
   CpuRole role = CpuRole::None;   ///< the role of that CPU (both: Master)
@@ -146,6 +182,19 @@ class HSystemModel final : public bus::EventTarget {
   void set_pair_event_handler(std::function<void(const HEvent&)> h) {
     m_pair_handler = std::move(h);
   }
+  // ---- data-record jobs, SFC 51 (R7; h_system_records.hpp) ----
+  /// SFC 59 over MasterSystem::read. Returns 0 (started: `cb` gets the final result later) or
+  /// a code at once (cb not called): W#16#80C3 during the update, W#16#8090 for a bad
+  /// system/station or no active channel.
+  std::uint16_t read_record(std::size_t system, std::uint8_t station, std::uint8_t slot,
+                            std::uint8_t index, std::uint8_t length, RecordJobCallback cb);
+  /// SFC 58 over MasterSystem::write; as read_record.
+  std::uint16_t write_record(std::size_t system, std::uint8_t station, std::uint8_t slot,
+                             std::uint8_t index, std::span<const std::uint8_t> data,
+                             RecordJobCallback cb);
+  /// SFC 51 for the H-system state: W#16#8085 during the update.
+  HSystemState read_system_state(bus::Ticks now);
+
   /// Brings every side in line with its CPU now (the operations do it themselves).
   void reconcile();
 
@@ -191,6 +240,13 @@ class HSystemModel final : public bus::EventTarget {
   void scan(bus::Ticks now);
   void scan_execution(bus::Ticks now);  // h_system_program.cpp
   void track_update(bus::Ticks now);    // h_system_update.cpp
+  void on_alarm(std::size_t system, const redundancy::SystemAlarm& a);  // h_system_alarms.cpp
+  void deliver_alarm(HSystemEvent h, bus::Ticks now);
+  void deliver_held(bus::Ticks now);
+  std::uint16_t start_record(std::size_t system, std::uint8_t station, bool write,
+                             std::uint8_t slot, std::uint8_t index, std::uint8_t length,
+                             std::span<const std::uint8_t> data, RecordJobCallback cb);
+  void check_process_image(bus::Ticks now);  // OB 85, h_system_alarms.cpp
   void on_program_event(const ProgramEvent& e, std::array<bool, 2> ran);
   void on_pair_event(const HEvent& e);
   void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
@@ -208,7 +264,14 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<UpdateMeasure> m_measures;
   bool m_update_copied = false;
   bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1  ///< the last measure's output/state copy (t4) is done
-  std::string m_ob72_note;  ///< appended to the next OB 72 ComparisonError text (F16's place)
+  std::string m_ob72_note;
+  std::vector<HSystemEvent> m_held_alarms;  ///< received while interrupts_held()
+  struct HeldRecord {
+    RecordJobCallback cb;
+    RecordJobResult res;
+  };
+  std::vector<HeldRecord> m_held_records;  ///< jobs completed during the update (80C3 after t5)
+  std::vector<std::vector<bool>> m_ob85;   ///< [system][address]: OB 85 episode open  ///< appended to the next OB 72 ComparisonError text (F16's place)
   IoGate m_gate;
   bus::Ticks m_scan_time = bus::kTicksPerMs;
   bool m_scan_armed = false;

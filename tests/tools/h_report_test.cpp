@@ -160,7 +160,9 @@ TEST(HReport, UpdateWindowsAgainstThePlan) {
                           "\"t5_ms\":3145.000,\"completed\":true,\"t_p15_window_ns\":95000000,"
                           "\"t_p15_window_ms\":95.000,\"planned_t_p15_ns\":194000000,\"planned_t_p15_ms\":194.000,"
                           "\"t_p15_verdict\":\"within\",\"t_ph_window_ns\":100000000,\"t_ph_window_ms\":100.000,"
-                          "\"planned_t_ph_ns\":90000000,\"planned_t_ph_ms\":90.000,\"t_ph_verdict\":\"EXCEEDED\"}"),
+                          "\"planned_t_ph_ns\":90000000,\"planned_t_ph_ms\":90.000,\"t_ph_verdict\":\"EXCEEDED\","
+                       "\"last_io_before_ns\":null,\"last_io_before_ms\":null,\"first_io_after_ns\":null,"
+                       "\"first_io_after_ms\":null}"),
             std::string::npos)
       << js.str();
 }

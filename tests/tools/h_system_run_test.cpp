@@ -104,7 +104,14 @@ TEST(HSystemRun, IoEventsWithCodesRacksAndTimes) {
   };
   const std::vector<Want> want = {
       {5000 * kMs, 5000 * kMs, {0}, 86, 0x39C3, "master system failure: DP master system \"H-DP 1\", line DP_B"},
+      // OB 85 at the first OB 1 that finds the one-sided slave 11 (on DP_B) gone: the scans
+      // restarted at the end of the update (3.145 s) every 10 ms, so 5.005 s.
+      {5005 * kMs, 5005 * kMs, {0}, 85, 0x39B1,
+       "process-image transfer error incoming: DP master system \"H-DP 1\", station 11"},
       {9000 * kMs, 9000 * kMs, {0}, 86, 0x38C3, "master system return: DP master system \"H-DP 1\", line DP_B"},
+      // Outgoing at the first OB 1 after the update (t5 = 9.145 s), on both CPUs (Redundant).
+      {9145 * kMs, 9145 * kMs, {0, 1}, 85, 0x38B1,
+       "process-image transfer error outgoing: DP master system \"H-DP 1\", station 11"},
       {10000 * kMs, 10000 * kMs + rec_a, {0, 1}, 70, 0x73A3,
        "redundancy loss: DP master system \"H-DP 1\", line DP_A, station 3"},
       // Back in data exchange after the repair: a start-up (Slave_Diag, Set_Prm, Chk_Cfg,
@@ -112,7 +119,12 @@ TEST(HSystemRun, IoEventsWithCodesRacksAndTimes) {
       {11000 * kMs, 11100 * kMs, {0, 1}, 70, 0x72A3,
        "redundancy restored: DP master system \"H-DP 1\", line DP_A, station 3"},
       {12000 * kMs, 12000 * kMs, {1}, 86, 0x39C3, "master system failure: DP master system \"H-DP 1\", line DP_A"},
+      // Scan grid from 9.145 s: 12.005 s finds the one-sided slave 10 (on DP_A) gone.
+      {12005 * kMs, 12005 * kMs, {1}, 85, 0x39B1,
+       "process-image transfer error incoming: DP master system \"H-DP 1\", station 10"},
       {16000 * kMs, 16000 * kMs, {1}, 86, 0x38C3, "master system return: DP master system \"H-DP 1\", line DP_A"},
+      {16145 * kMs, 16145 * kMs, {0, 1}, 85, 0x38B1,
+       "process-image transfer error outgoing: DP master system \"H-DP 1\", station 10"},
   };
   ASSERT_EQ(h.io_events.size(), want.size());
   for (std::size_t k = 0; k < want.size(); ++k) {

@@ -29,9 +29,12 @@ devices::HChange to_change(HProgramChangeKind k) {
 }  // namespace
 
 std::string HSystemNode::io_event_text(const devices::HSystemEvent& e) const {
-  if (e.source != devices::HSystemEvent::Source::Io) return e.text;
+  if (e.source != devices::HSystemEvent::Source::Io && e.source != devices::HSystemEvent::Source::Image)
+    return e.text;
   std::string kind;
   switch (e.code) {
+    case 0x39B1: kind = "process-image transfer error incoming"; break;
+    case 0x38B1: kind = "process-image transfer error outgoing"; break;
     case 0x73A3: kind = "redundancy loss"; break;
     case 0x72A3: kind = "redundancy restored"; break;
     case 0x39C4: kind = "station failure"; break;

@@ -23,12 +23,14 @@ constexpr char kDefault[] = R"pb(# pbvbus scenario: an S7-400H-style H-system, t
 # A CPU pair (rack 0 and rack 1, sync link of two fibres) drives one redundant DP master system
 # "H-DP 1" on two lines at 1.5 Mbit/s: DP_A belongs to rack 0, DP_B to rack 1. Two switched
 # stations (ET 200M with two IM 153-2, examples/gsd/PBVB0A10.gsd) and one one-sided slave per
-# line (PBVB0A01.gsd). The program: a counter on QB 0..1 with a pulse on Q 2.0, and a copy of
-# the inputs of station 3 (IB 0..1) to the outputs of station 4 (QB 4..5).
+# line (PBVB0A01.gsd). The process images (the report prints the map): station 3 IB 0..1 /
+# QB 0..1, station 4 IB 2..3 / QB 2..3, slave 10 IB 4..5 / QB 4..5, slave 11 IB 6..7 / QB 6..7.
+# The program: a counter on QB 0..1 (station 3's outputs) with a pulse on Q 2.0 (station 4),
+# and a copy of station 3's inputs (IB 0..1) to slave 10's outputs (QB 4..5).
 #
-# What to expect once the H-system runtime runs it (the loader and `pbvbus timing` take it
-# today; the times come from the pair's defaults: startup 1 s, link-up 2 s, update 75 ms +
-# 0.7 ms x 100 KB = 145 ms):
+# What to expect (`pbvbus run` runs this as its built-in default; the times come from the
+# pair's settings below: startup 1 s, link-up 2 s, update W = MAX(75 ms + 0.7 ms x 100 KB,
+# 50 ms + T_PH 30 ms) = 145 ms, both CPUs driving the outputs for the last 30 ms of it):
 #   0 s      both CPUs power on together (simultaneous POWER ON, rack 0 master): CPU 0 STOP ->
 #            STARTUP; CPU 1 waits in STOP (standby).
 #   1 s      CPU 0 RUN, system mode Solo; CPU 1 LINK-UP (REDF 0.5 Hz).
@@ -43,6 +45,8 @@ constexpr char kDefault[] = R"pb(# pbvbus scenario: an S7-400H-style H-system, t
 #            lost); DP_A's master stops with its CPU: one W#16#39C3, all stations on DP_B.
 #   14 s     CPU 0's power returns: it is standby, links up by itself (14 s -> 16 s), update ->
 #            16.145 s Redundant, now with CPU 1 as master.
+#   Also: OB 85 (process-image transfer error, W#16#39B1 / 38B1) at the first OB 1 that finds
+#   a one-sided slave of the lost side gone (5.005 s, 12.005 s) and back (9.145 s, 16.145 s).
 #   18 s     end.
 name: "h-system"
 description: "An H-system CPU pair on a redundant DP master system: power-up to Redundant, F5, an IM failure, F1 and the return of the failed CPU."

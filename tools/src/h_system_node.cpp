@@ -4,6 +4,7 @@
 #include <functional>
 #include <stdexcept>
 
+#include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/devices/h_update_timing.hpp"
 #include "pbvbus/tools/h_plan.hpp"
@@ -76,6 +77,7 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     throw std::runtime_error("h_system \"" + hp.name + "\": " + e.what());
   }
   m_model->set_pair_event_handler([this](const devices::HEvent& e) { on_pair_event(e); });
+  m_model->set_event_handler([this](const devices::HSystemEvent& e) { on_model_event(e); });
   try {
     const devices::UpdatePlan up = devices::plan_update(h_update_input(plan, hp));
     m_planned_t_ph = devices::to_ticks(up.t_ph);
@@ -118,6 +120,8 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
   using K = PlanFault::Kind;
   devices::HSystemModel& m = *m_model;
   std::string text = on ? f.description : "repair of " + f.description;
+  // The record before the reactions it causes (same instant, earlier in the capture).
+  note(text);
   switch (f.kind) {
     case K::CpuFailure: on ? m.power_off(f.rack) : m.power_on(f.rack); break;
     case K::CpuStop: on ? m.switch_to_stop(f.rack) : m.switch_to_run(f.rack); break;
@@ -164,7 +168,7 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
       break;
     default: break;
   }
-  note(text);
+  m_faults.back().second = text;  // with what the pair answered ("refused", ...)
   return text;
 }
 
@@ -175,6 +179,23 @@ void HSystemNode::note(std::string text) {
   r.category = captures::EventCategory::Note;
   r.text = plan().name + ": " + text;
   m_capture->write_event(m_sched.now(), r);
+}
+
+void HSystemNode::on_model_event(const devices::HSystemEvent& e) {
+  // OB 72/121 come with the pair's events, OB 70/86 with the redundancy records: the rest
+  // (OB 85, the alarms' OB 40/82/83..., the program's 7960) as Cpu records of kind Ob.
+  if (m_capture == nullptr || e.source == devices::HSystemEvent::Source::Cpu ||
+      e.source == devices::HSystemEvent::Source::Io)
+    return;
+  captures::CpuEventFields f;
+  f.kind = captures::CpuEventKind::Ob;
+  f.rack = e.rack;  // -1: both CPUs
+  f.role = static_cast<int>(e.role);
+  f.event_id = e.code;
+  f.ob = static_cast<std::uint8_t>(e.ob);
+  f.text = plan().name + ": " + (e.rack < 0 ? std::string("CPU 0+1") : "CPU " + std::to_string(e.rack)) +
+           ": " + io_event_text(e);
+  m_capture->write_event(e.time, captures::cpu_event_record(f));
 }
 
 void HSystemNode::on_pair_event(const devices::HEvent& e) {

@@ -19,7 +19,9 @@
 //   directly. parameter_change: the standby's parameter that may not change, then the operator
 //   master swap, which the pair refuses with W#16#5966 (F23).
 // - Capture: every event of the pair (state, role, system mode, OB 72/121) as a Cpu record
-//   (h_event_record), and each H fault as a Note record, at its virtual time.
+//   (h_event_record); the model's other OBs (85, the alarms' 40/82/83..., the program's 7960)
+//   as Cpu records of kind Ob (a = rack, -1 = both CPUs); each H fault as a Note record before
+//   the reactions it causes; all at their virtual time. OB 70/86 are the redundancy records.
 #include <memory>
 #include <optional>
 #include <string>
@@ -62,6 +64,7 @@ class HSystemNode {
 
  private:
   void on_pair_event(const devices::HEvent& e);
+  void on_model_event(const devices::HSystemEvent& e);
   /// An I/O event as the report shows it beside its OB and code: "master system failure: DP
   /// master system \"H-DP 1\", line DP_B".
   std::string io_event_text(const devices::HSystemEvent& e) const;

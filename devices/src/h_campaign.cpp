@@ -76,6 +76,8 @@ using Bytes = std::vector<std::uint8_t>;
 using Src = HSystemEvent::Source;
 constexpr bus::Ticks kMs = bus::kTicksPerMs;
 constexpr bus::Ticks kDefectiveWindow = 7 * 24 * 3600 * bus::kTicksPerSecond;  // F17, fixed
+/// A frame whose start lies at most this long after its side stopped was committed before.
+constexpr bus::Ticks kCommitted = kMs / 2;
 constexpr std::uint8_t kSw[2] = {20, 21};
 constexpr std::uint8_t kOne[2] = {40, 60};
 
@@ -149,6 +151,7 @@ struct Observer {
   // prog_until).
   bus::Ticks run_from[2] = {bus::kNever, bus::kNever}, run_until[2] = {bus::kNever, bus::kNever};
   bus::Ticks prog_from[2] = {bus::kNever, bus::kNever};
+  bus::Ticks stopped_at[2] = {bus::kNever, bus::kNever};  ///< the side's last stop
   bus::Ticks prog_until[2] = {bus::kNever, bus::kNever};
   bool iface_ok[2][2] = {{true, true}, {true, true}};
   bool shorted[2] = {false, false}, mfail[2] = {false, false};
@@ -369,13 +372,21 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
        fdl::fc_request_fn(t.fc) == fdl::RequestFn::SrdHigh) &&
       (t.da == kSw[0] || t.da == kSw[1])) {
     ++m_r.dx_requests;
-    if (!m_obs.side_runs(l, f.start)) {
+    // A request the FDL had already committed when the side stopped (its start bit lies after
+    // the stop only by the idle time) is no new Data_Exchange: kCommitted of grace.
+    const bool committed = f.start >= m_obs.stopped_at[l] && f.start < m_obs.stopped_at[l] + kCommitted;
+    if (!m_obs.side_runs(l, f.start) && !committed) {
       ++m_r.stray_dx;
       if (m_stray_step != m_steps.size())
         m_r.mismatches.push_back(fmt_time(f.start) + ": after '" + step_name() +
                                  "': Data_Exchange to station " + std::to_string(t.da) +
                                  " on line " + std::to_string(l) +
-                                 " whose DP master should not run");
+                                 " whose DP master should not run (it runs in [" +
+                                 fmt_time(m_obs.run_from[l]) + ", " +
+                                 fmt_time(m_obs.run_until[l]) + "), frame " +
+                                 fmt_time(f.start) + ".." + fmt_time(f.end) + ", stop at " +
+                                 fmt_time(m_obs.stopped_at[l]) + ", FC " +
+                                 std::to_string(t.fc) + ")");
       m_stray_step = m_steps.size();
     }
   }
@@ -422,6 +433,7 @@ void HCampaignRun::switch_away(int l) {
 void HCampaignRun::lose_side(int r, bus::Ticks t, std::vector<Expect>& ex) {
   const bool ran = m_obs.side_runs(r, t);
   m_obs.run_until[r] = t;
+  m_obs.stopped_at[r] = t;
   m_obs.prog_until[r] = std::min(m_obs.prog_until[r], t);
   if (!ran) return;
   ex.push_back(io(0x39C3, r, 0xFF, t, t));

@@ -70,7 +70,7 @@ TEST(HCampaign, ObserverCatchesAFaultItWasNotToldAbout) {
   o.tamper.hidden_fault_at = 1;
   const HCampaignResult r = run_h_campaign(o);
   print(r);
-  EXPECT_TRUE(has(r, "hidden fault", "unexpected [OB 72 standby lost"));
+  EXPECT_TRUE(has(r, "hidden fault", "unexpected [OB 72 standby CPU lost"));
   EXPECT_TRUE(has(r, "hidden fault", "unexpected [OB 86 39C3"));
   EXPECT_TRUE(has(r, "hidden repair", "unexpected [OB 86 38C3"));
 }

@@ -112,7 +112,7 @@ struct HCampaignOptions {
   bus::Baud baud = bus::Baud::k1_5M;
   std::string gsd_dir;  ///< where PBVB0A10/0A11/0A01.gsd are (e.g. <source>/examples/gsd)
   /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out.
-  std::array<int, kHFaultKinds> weights{2, 2, 1, 1, 2, 2, 2, 2, 1, 1, 2, 2, 1};
+  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;
   bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;           ///< ERROR-SEARCH (90 s default)
   bus::Ticks cyclic_self_test_period = 30 * bus::kTicksPerSecond;  ///< 90 min default

@@ -4,7 +4,8 @@
 // their repairs, on two lines with the CPU pair, two switched stations (PBVB0A10, PBVB0A11) and
 // one one-sided slave per line, checked by the campaign's independent observer.
 //
-//   BM_HCampaign/<seed>/<steps>/<baud>   baud 0 = 1.5 Mbit/s, 1 = 12 Mbit/s. Counters: faults,
+//   BM_HCampaign/<seed>/<steps>/<baud>   baud 0 = 1.5 Mbit/s, 1 = 12 Mbit/s (PBVB0A11's GSD has
+//     no 12M_supp: the station model refuses it and the run is skipped). Counters: faults,
 //     repairs, pulses, mismatches, events (observed) and expected_events, samples, dx,
 //     split_frames, second_master_frames, stray_dx, role_swaps, defective, comparison_stops,
 //     virt_s, virt_s_per_wall_s, virt_s_per_cpu_s (std::clock), max_settle_ms.
@@ -18,6 +19,7 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <exception>
 #include <string>
 
 #include "pbvbus/devices/h_campaign.hpp"
@@ -52,7 +54,12 @@ void BM_HCampaign(benchmark::State& state) {
   double cpu_s = 0;
   for (auto _ : state) {
     const std::clock_t c0 = std::clock();
-    r = devices::run_h_campaign(o);
+    try {
+      r = devices::run_h_campaign(o);
+    } catch (const std::exception& e) {
+      state.SkipWithError(e.what());
+      return;
+    }
     cpu_s = static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
     benchmark::DoNotOptimize(r.pulses);
   }
@@ -81,7 +88,6 @@ void BM_HCampaign(benchmark::State& state) {
 }
 BENCHMARK(BM_HCampaign)
     ->Args({1, 1000, 0})
-    ->Args({1, 1000, 1})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();

@@ -291,7 +291,9 @@ void HCampaignRun::build() {
     so.address = kSw[k];
     so.bus_params = m_bp;
     auto b = SwitchedStationModel::build(g, switched_modules(), so);
-    if (!b.ok()) throw std::runtime_error("h campaign: switched station");
+    if (!b.ok())
+      throw std::runtime_error("h campaign: switched station " + std::to_string(kSw[k]) + ": " +
+                               (b.errors.empty() ? std::string("?") : b.errors[0]));
     m_sw[k].model = std::move(b.model);
     auto sp = master_slave_params(g, switched_modules(), kSw[k]);
     if (!sp.ok()) throw std::runtime_error("h campaign: master params of a switched station");
@@ -374,7 +376,9 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     ++m_r.dx_requests;
     // A request the FDL had already committed when the side stopped (its start bit lies after
     // the stop only by the idle time) is no new Data_Exchange: kCommitted of grace.
-    const bool committed = f.start >= m_obs.stopped_at[l] && f.start < m_obs.stopped_at[l] + kCommitted;
+    // A frame that was on the wire at the stop is no new one either.
+    const bool committed =
+        f.end >= m_obs.stopped_at[l] && f.start < m_obs.stopped_at[l] + kCommitted;
     if (!m_obs.side_runs(l, f.start) && !committed) {
       ++m_r.stray_dx;
       if (m_stray_step != m_steps.size())

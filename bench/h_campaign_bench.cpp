@@ -17,9 +17,9 @@
 
 #include <cstdlib>
 #include <ctime>
+#include <exception>
 #include <filesystem>
 #include <iostream>
-#include <exception>
 #include <string>
 
 #include "pbvbus/devices/h_campaign.hpp"
@@ -45,10 +45,26 @@ void BM_HCampaign(benchmark::State& state) {
   o.seed = static_cast<std::uint64_t>(state.range(0));
   o.steps = static_cast<int>(state.range(1));
   o.baud = state.range(2) == 1 ? bus::Baud::k12M : bus::Baud::k1_5M;
-  if (const char* e = std::getenv("PBVBUS_HCAMPAIGN_SEED")) o.seed = std::stoull(e);
-  if (const char* e = std::getenv("PBVBUS_HCAMPAIGN_STEPS")) o.steps = std::stoi(e);
-  state.SetLabel("seed " + std::to_string(o.seed) +
-                 (o.baud == bus::Baud::k12M ? " 12M" : " 1.5M"));
+  // Bad values are reported, not thrown.
+  if (const char* e = std::getenv("PBVBUS_HCAMPAIGN_SEED")) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(e, &end, 10);
+    if (end == e || *end != '\0') {
+      state.SkipWithError("PBVBUS_HCAMPAIGN_SEED is not a number");
+      return;
+    }
+    o.seed = v;
+  }
+  if (const char* e = std::getenv("PBVBUS_HCAMPAIGN_STEPS")) {
+    char* end = nullptr;
+    const long v = std::strtol(e, &end, 10);
+    if (end == e || *end != '\0' || v < 1 || v > 1000000) {
+      state.SkipWithError("PBVBUS_HCAMPAIGN_STEPS is not a number in 1..1000000");
+      return;
+    }
+    o.steps = static_cast<int>(v);
+  }
+  state.SetLabel("seed " + std::to_string(o.seed) + (o.baud == bus::Baud::k12M ? " 12M" : " 1.5M"));
   o.gsd_dir = h_gsd_dir();
   devices::HCampaignResult r;
   double cpu_s = 0;
@@ -86,10 +102,6 @@ void BM_HCampaign(benchmark::State& state) {
   state.counters["virt_s_per_cpu_s"] = cpu_s > 0 ? virt / cpu_s : 0;
   state.counters["max_settle_ms"] = static_cast<double>(r.max_settle) / bus::kTicksPerMs;
 }
-BENCHMARK(BM_HCampaign)
-    ->Args({1, 1000, 0})
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond)
-    ->UseRealTime();
+BENCHMARK(BM_HCampaign)->Args({1, 1000, 0})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 }  // namespace

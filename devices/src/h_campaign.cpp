@@ -25,19 +25,32 @@ namespace pbvbus::devices {
 
 std::string_view to_string(HFault f) {
   switch (f) {
-    case HFault::MasterPower: return "master CPU power (F1)";
-    case HFault::StandbyPower: return "standby CPU power (F1)";
-    case HFault::MasterStop: return "master CPU STOP";
-    case HFault::StandbyStop: return "standby CPU STOP";
-    case HFault::OneFibre: return "one fibre (F5)";
-    case HFault::BothFibres: return "both fibres at once (F6)";
-    case HFault::ActiveIm: return "active IM (F10)";
-    case HFault::PassiveIm: return "passive IM (F10)";
-    case HFault::ShortCircuit: return "short circuit (F14)";
-    case HFault::DpMasterFailure: return "DP master module (F9)";
-    case HFault::ComparisonError: return "comparison error (F16)";
-    case HFault::OneSidedOb121: return "one-sided OB 121 (F17)";
-    case HFault::MasterSwap: return "operator master swap";
+    case HFault::MasterPower:
+      return "master CPU power (F1)";
+    case HFault::StandbyPower:
+      return "standby CPU power (F1)";
+    case HFault::MasterStop:
+      return "master CPU STOP";
+    case HFault::StandbyStop:
+      return "standby CPU STOP";
+    case HFault::OneFibre:
+      return "one fibre (F5)";
+    case HFault::BothFibres:
+      return "both fibres at once (F6)";
+    case HFault::ActiveIm:
+      return "active IM (F10)";
+    case HFault::PassiveIm:
+      return "passive IM (F10)";
+    case HFault::ShortCircuit:
+      return "short circuit (F14)";
+    case HFault::DpMasterFailure:
+      return "DP master module (F9)";
+    case HFault::ComparisonError:
+      return "comparison error (F16)";
+    case HFault::OneSidedOb121:
+      return "one-sided OB 121 (F17)";
+    case HFault::MasterSwap:
+      return "operator master swap";
   }
   return "?";
 }
@@ -101,8 +114,7 @@ struct Expect {
 };
 
 bool same(const Expect& x, const HSystemEvent& e) {
-  if (x.src != e.source || x.ob != e.ob || x.code != e.code || x.rack != e.rack ||
-      x.role != e.role)
+  if (x.src != e.source || x.ob != e.ob || x.code != e.code || x.rack != e.rack || x.role != e.role)
     return false;
   if (x.src == Src::Cpu) return x.text == e.text;
   return x.line == e.line && x.station == e.station && e.system == 0;
@@ -141,7 +153,9 @@ GsdFile load(const std::string& dir, const char* name) {
 std::vector<ModuleChoice> switched_modules() {
   return {ModuleChoice::named("16DI DC24V"), ModuleChoice::named("16DO DC24V/0.5A")};
 }
-std::vector<ModuleChoice> plain_modules() { return {ModuleChoice::named("16DI/16DO DC24V")}; }
+std::vector<ModuleChoice> plain_modules() {
+  return {ModuleChoice::named("16DI/16DO DC24V")};
+}
 
 /// The observer's own model (nothing here is read from HSystemModel or HCpuPair).
 struct Observer {
@@ -273,7 +287,9 @@ class HCampaignRun {
   HCampaignResult m_r;
 };
 
-void Tap::on_frame(const bus::TapFrame& f) { camp.on_frame(f); }
+void Tap::on_frame(const bus::TapFrame& f) {
+  camp.on_frame(f);
+}
 
 void HCampaignRun::build() {
   const GsdFile fast = load(m_o.gsd_dir, "PBVB0A10.gsd");
@@ -382,15 +398,13 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     if (!m_obs.side_runs(l, f.start) && !committed) {
       ++m_r.stray_dx;
       if (m_stray_step != m_steps.size())
-        m_r.mismatches.push_back(fmt_time(f.start) + ": after '" + step_name() +
-                                 "': Data_Exchange to station " + std::to_string(t.da) +
-                                 " on line " + std::to_string(l) +
-                                 " whose DP master should not run (it runs in [" +
-                                 fmt_time(m_obs.run_from[l]) + ", " +
-                                 fmt_time(m_obs.run_until[l]) + "), frame " +
-                                 fmt_time(f.start) + ".." + fmt_time(f.end) + ", stop at " +
-                                 fmt_time(m_obs.stopped_at[l]) + ", FC " +
-                                 std::to_string(t.fc) + ")");
+        m_r.mismatches.push_back(
+            fmt_time(f.start) + ": after '" + step_name() + "': Data_Exchange to station " +
+            std::to_string(t.da) + " on line " + std::to_string(l) +
+            " whose DP master should not run (it runs in [" + fmt_time(m_obs.run_from[l]) + ", " +
+            fmt_time(m_obs.run_until[l]) + "), frame " + fmt_time(f.start) + ".." +
+            fmt_time(f.end) + ", stop at " + fmt_time(m_obs.stopped_at[l]) + ", FC " +
+            std::to_string(t.fc) + ")");
       m_stray_step = m_steps.size();
     }
   }
@@ -417,10 +431,9 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     if (!bad.empty()) {
       ++m_r.pulses;
       if (m_r.pulse_reports.size() < 20)
-        m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) +
-                                    " " + bad + " (" + std::to_string(v) + " after " +
-                                    std::to_string(s.last) + "), step '" + step_name() +
-                                    "'");
+        m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) + " " +
+                                    bad + " (" + std::to_string(v) + " after " +
+                                    std::to_string(s.last) + "), step '" + step_name() + "'");
     }
     if (v != 0) s.last = v;
   }
@@ -474,8 +487,8 @@ bool HCampaignRun::satisfied(const Step& s) const {
   std::vector<bool> used(s.expect.size(), false);
   const auto& all = m_h->events();
   // Events are in time order; the step's begin at s.at (the injection ran just before).
-  const auto first = std::lower_bound(all.begin(), all.end(), s.at,
-                                      [](const HSystemEvent& e, bus::Ticks t) { return e.time < t; });
+  const auto first = std::lower_bound(
+      all.begin(), all.end(), s.at, [](const HSystemEvent& e, bus::Ticks t) { return e.time < t; });
   for (std::size_t n = static_cast<std::size_t>(first - all.begin()); n < all.size(); ++n)
     for (std::size_t i = 0; i < s.expect.size(); ++i)
       if (!used[i] && same(s.expect[i], all[n])) {
@@ -531,19 +544,18 @@ void HCampaignRun::wait_recovered(bus::Ticks since) {
 void HCampaignRun::check_roles() {
   const HCpuPair& p = m_h->pair();
   if (p.master_count() != 1 || p.master() != m_obs.master)
-    m_r.mismatches.push_back(fmt_time(now()) + ": after '" + step_name() +
-                             "': expected master " + rack_name(m_obs.master) + ", the pair has " +
+    m_r.mismatches.push_back(fmt_time(now()) + ": after '" + step_name() + "': expected master " +
+                             rack_name(m_obs.master) + ", the pair has " +
                              std::to_string(p.master_count()) + " master(s), master() " +
                              std::to_string(p.master()));
   for (int k = 0; k < 2; ++k) {
     const int prim = m_sw[k].model->primary();
     const int sys = m_sys->system().active(kSw[k]);
     if (prim != m_obs.act[k] || sys != m_obs.act[k])
-      m_r.mismatches.push_back(fmt_time(now()) + ": after '" + step_name() +
-                               "': station " + std::to_string(kSw[k]) + " expected active line " +
-                               std::to_string(m_obs.act[k]) + ", station primary " +
-                               std::to_string(prim) + ", MasterSystem active " +
-                               std::to_string(sys));
+      m_r.mismatches.push_back(
+          fmt_time(now()) + ": after '" + step_name() + "': station " + std::to_string(kSw[k]) +
+          " expected active line " + std::to_string(m_obs.act[k]) + ", station primary " +
+          std::to_string(prim) + ", MasterSystem active " + std::to_string(sys));
   }
 }
 
@@ -772,8 +784,8 @@ void HCampaignRun::cycle(HFault f) {
       const int r = draw_int(0, 1), p = 1 - r;
       const bool repeated = m_obs.last121[r] && t - *m_obs.last121[r] <= kDefectiveWindow;
       m_obs.last121[r] = t;
-      ex.push_back(cpu_ob(121, r, r == M ? CpuRole::Master : CpuRole::Standby,
-                          HReason::OneSidedOb121, t));
+      ex.push_back(
+          cpu_ob(121, r, r == M ? CpuRole::Master : CpuRole::Standby, HReason::OneSidedOb121, t));
       ex.push_back(cpu_ob(72, p, CpuRole::Master, HReason::OneSidedOb121, t));
       m_obs.prog_until[r] = t;
       set_master(p);

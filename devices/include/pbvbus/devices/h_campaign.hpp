@@ -114,12 +114,12 @@ struct HCampaignOptions {
   /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out.
   std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;
-  bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;           ///< ERROR-SEARCH (90 s default)
+  bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;             ///< ERROR-SEARCH (90 s default)
   bus::Ticks cyclic_self_test_period = 30 * bus::kTicksPerSecond;  ///< 90 min default
   bus::Ticks fault_min = 200 * bus::kTicksPerMs, fault_max = 1000 * bus::kTicksPerMs;
   bus::Ticks gap_min = 100 * bus::kTicksPerMs, gap_max = 500 * bus::kTicksPerMs;
-  bus::Ticks recognition = 50 * bus::kTicksPerMs;  ///< window for a bus fault's events
-  bus::Ticks startup = 2000 * bus::kTicksPerMs;    ///< window for a bus repair's events
+  bus::Ticks recognition = 50 * bus::kTicksPerMs;       ///< window for a bus fault's events
+  bus::Ticks startup = 2000 * bus::kTicksPerMs;         ///< window for a bus repair's events
   bus::Ticks settle_limit = 15 * bus::kTicksPerSecond;  ///< back to Redundant + data exchange
   HCampaignTamper tamper;
 };

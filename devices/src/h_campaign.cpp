@@ -197,6 +197,17 @@ struct Tap final : bus::Tap {
 class HCampaignRun {
  public:
   explicit HCampaignRun(const HCampaignOptions& o) : m_o(o), m_rng(o.seed), m_tap(*this) {
+    int sum = 0;
+    for (int w : o.weights) {
+      if (w < 0) throw std::invalid_argument("h campaign: a negative fault weight");
+      sum += w;
+    }
+    if (sum <= 0) throw std::invalid_argument("h campaign: every fault weight is 0");
+    if (o.fault_min < 0 || o.fault_min > o.fault_max || o.gap_min < 0 || o.gap_min > o.gap_max)
+      throw std::invalid_argument("h campaign: fault/gap durations: 0 <= min <= max");
+    if (o.scan_time <= 0 || o.self_test_time < 0 || o.settle_limit <= 0 || o.recognition < 0 ||
+        o.startup < 0)
+      throw std::invalid_argument("h campaign: times must not be negative (scan, settle > 0)");
     build();
   }
   HCampaignResult run();

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <iostream>
+#include <stdexcept>
 #include <string>
 
 namespace pbvbus::devices {
@@ -90,6 +91,25 @@ TEST(HCampaign, ComparisonErrorsSettleAfterSearchLinkUpAndUpdate) {
   EXPECT_EQ(r.ob72, cycles + 2 * (cycles - r.comparison_stops));
   EXPECT_EQ(r.events_with(0x39C3), cycles);
   EXPECT_EQ(r.events_with(0x38C3), cycles);
+}
+
+// Unusable options are refused with a clear error, nothing runs.
+TEST(HCampaign, BadOptionsAreRefused) {
+  HCampaignOptions o = reduced(1, 10);
+  o.weights = {};
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.weights[3] = -1;
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.fault_min = o.fault_max + 1;
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.gsd_dir = "/nonexistent";
+  EXPECT_THROW(run_h_campaign(o), std::runtime_error);
+  o = reduced(1, 10);
+  o.baud = bus::Baud::k12M;  // PBVB0A11 has no 12M_supp
+  EXPECT_THROW(run_h_campaign(o), std::runtime_error);
 }
 
 // The standby CPU off and on again without telling the observer: its OB 72 and the 39C3 /

@@ -154,7 +154,9 @@ struct HCampaignResult {
   std::string summary() const;
 };
 
-/// Runs the campaign. Throws std::runtime_error when the system cannot be built (GSD missing).
+/// Runs the campaign. Throws std::invalid_argument for unusable options (a negative weight, all
+/// weights 0, min > max, a scan time or settle limit <= 0) and std::runtime_error when the
+/// system cannot be built (GSD missing, a baud rate a station does not support).
 HCampaignResult run_h_campaign(const HCampaignOptions& o);
 
 }  // namespace pbvbus::devices

@@ -1,0 +1,162 @@
+#pragma once
+// A seeded fault campaign over the whole H-system (issue 8 "Must show"; seeds-digest.md §1, §7
+// F1, F5, F6, F9, F10, F14, F16, F17, §11 R1-R5; docs/h-campaign.md): the HSystemModel (CPU
+// pair) driving one redundant DP master system on two lines (rack r <-> line r), two switched
+// stations (PBVB0A10 at 20, PBVB0A11 at 21, the slow one) and one one-sided slave per line
+// (PBVB0A01 at 40 on A, 60 on B). The program (OB 1 every scan_time) writes one 16-bit counter
+// (never 0) into every output module through the I/O map.
+//
+// Start: power_on_both, wait for Redundant. Then, one at a time, a fault drawn with a seeded
+// std::mt19937_64 and its repair; after each cycle the campaign waits (bounded by settle_limit,
+// a mismatch when exceeded) for Redundant mode with every reachable channel in data exchange.
+//   MasterPower / StandbyPower (F1)    power_off(M|S); repair power_on -> standby, link-up, update
+//   MasterStop / StandbyStop           switch_to_stop; repair switch_to_run
+//   OneFibre (F5)                      cut_fibre(f); repair repair_fibre + switch_to_run(standby)
+//   BothFibres (F6)                    cut_both_fibres: two masters; repair both fibres and
+//                                      switch_to_stop(X) (X random: it becomes standby), later
+//                                      switch_to_run(X)
+//   ActiveIm / PassiveIm (F10)         one interface of a switched station fails; repaired
+//   ShortCircuit (F14)                 line l short-circuited; repaired
+//   DpMasterFailure (F9)               line l's DP master module fails; repaired
+//   ComparisonError (F16)              standby -> ERROR-SEARCH (self_test_time, 2 s here instead
+//                                      of 90 s), re-link, automatic swap (R5); the repair is
+//                                      automatic. Repeated within the first self-test cycle after
+//                                      such a swap (cyclic_self_test_period, 30 s here instead of
+//                                      90 min, so both branches occur): standby STOP; repair
+//                                      switch_to_run.
+//   OneSidedOb121 (F17)                OB 121 on rack r (random) -> ERROR-SEARCH, swap to r
+//                                      after it; repeated within 7 days -> DEFECTIVE; repair
+//                                      repair_cpu + switch_to_run (history cleared)
+//   MasterSwap                         the operator's swap: standby switch STOP, request, the
+//                                      old master STOPs at the end of the update; switch_to_run
+// Each injection is one step (faults + repairs; automatic recoveries are no injection).
+//
+// The observer is independent of HSystemModel's reconciliation: it keeps its own model of the
+// master rack (from the faults it injected and the role rules: F1/STOP of the master -> the
+// standby; F6 -> two masters until one is stopped; ERROR-SEARCH without fault -> the searched
+// CPU; the operator swap -> the old standby), of which side's DP master runs (a timed model:
+// from restart + link_up_time (+ self_test_time) on; the update formula 75 ms + 0.7 ms/KB), of
+// which channels are reachable and of which line each switched station is active on (away from
+// a lost line, never back). From these it derives every event the manual asks for:
+//   OB 72 with its reason on the right rack and role; OB 121; W#16#39C3/38C3 for a side whose
+//   DP master stops/starts again (CPU, STOP, ERROR-SEARCH, DEFECTIVE, short circuit); 73A3/72A3
+//   per switched station and 39C4/38C4 per one-sided slave (F9, F10); the rack an I/O OB runs
+//   on (-1 when both CPUs run the program, else the one that does),
+// each with the time window it must occur in (the CPU's own reactions at the instant, the
+// update start at restart + link_up_time exactly, bus detection within `recognition`, a bus
+// repair within `startup`), and compares them with HSystemModel::events() as a multiset per
+// step (an event belongs to the step in whose time span it lies).
+// Per frame (a whole-line tap on both lines):
+//   - two masters driving: the racks that are master (HCpuPair roles) AND whose DP master is in
+//     Operate with its attachment powered (dp::Master::mode, RedundantMasterSystemModel) - never
+//     two unless the observer's model is in the F6 split. The wire cannot tell (one program
+//     writes both lines alike; in Redundant both lines carry Data_Exchange with outputs), so
+//     this is read from the pair's roles and the DP masters, not from HSystemModel's SideMode;
+//   - from the wire: a Data_Exchange request with outputs to a switched station on line l while
+//     the observer's model says side l's DP master does not run (started after the stop);
+//   - every switched station's backplane outputs: never 0 once started (except while the
+//     observer says no channel is reachable), never an older counter value (mod 2^16).
+// After each settled cycle: the role rules (pair master == the observer's), the stations'
+// primary interface and MasterSystem::active() == the observer's active line.
+//
+// Tamper options (the observer's own tests): a fault it is not told about, a doctored event
+// list, a program glitch writing 0, a forced second master outside F6 (both fibres cut while
+// the observer is told one fibre).
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pbvbus/bus/time.hpp"
+#include "pbvbus/devices/h_system.hpp"
+
+namespace pbvbus::devices {
+
+enum class HFault : std::uint8_t {
+  MasterPower,
+  StandbyPower,
+  MasterStop,
+  StandbyStop,
+  OneFibre,
+  BothFibres,
+  ActiveIm,
+  PassiveIm,
+  ShortCircuit,
+  DpMasterFailure,
+  ComparisonError,
+  OneSidedOb121,
+  MasterSwap,
+};
+inline constexpr int kHFaultKinds = 13;
+std::string_view to_string(HFault f);
+
+struct HCampaignTamper {
+  /// At this cycle (0-based): the standby CPU is powered off and on again without telling the
+  /// observer (-1: never).
+  int hidden_fault_at = -1;
+  /// Applied to (a copy of) HSystemModel::events() before the observer compares.
+  std::function<void(std::vector<HSystemEvent>&)> doctor_events;
+  /// The first scan at or after this virtual time writes 0 into every output module.
+  bus::Ticks zero_output_at = bus::kNever;
+  /// At this cycle: both fibres are cut while the observer is told one fibre (F5) - a second
+  /// master outside its F6 model (-1: never).
+  int second_master_at = -1;
+};
+
+struct HCampaignOptions {
+  std::uint64_t seed = 1;
+  int steps = 1000;  ///< injections (faults + repairs) to reach; the last cycle is completed
+  bus::Baud baud = bus::Baud::k1_5M;
+  std::string gsd_dir;  ///< where PBVB0A10/0A11/0A01.gsd are (e.g. <source>/examples/gsd)
+  /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out.
+  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  bus::Ticks scan_time = 10 * bus::kTicksPerMs;
+  bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;             ///< ERROR-SEARCH (90 s default)
+  bus::Ticks cyclic_self_test_period = 30 * bus::kTicksPerSecond;  ///< 90 min default
+  bus::Ticks fault_min = 200 * bus::kTicksPerMs, fault_max = 1000 * bus::kTicksPerMs;
+  bus::Ticks gap_min = 100 * bus::kTicksPerMs, gap_max = 500 * bus::kTicksPerMs;
+  bus::Ticks recognition = 50 * bus::kTicksPerMs;       ///< window for a bus fault's events
+  bus::Ticks startup = 2000 * bus::kTicksPerMs;         ///< window for a bus repair's events
+  bus::Ticks settle_limit = 15 * bus::kTicksPerSecond;  ///< back to Redundant + data exchange
+  HCampaignTamper tamper;
+};
+
+struct HCampaignResult {
+  std::array<int, kHFaultKinds> drawn{};  ///< cycles per kind
+  int faults = 0;                         ///< fault injections
+  int repairs = 0;                        ///< repair injections
+  int defective = 0;                      ///< F17 cycles that made a CPU DEFECTIVE
+  int comparison_stops = 0;               ///< F16 cycles that stopped the standby (repeat)
+  int role_swaps = 0;                     ///< master changes the observer expected
+  /// Events of HSystemModel::events() by code (I/O) or OB (72, 121).
+  std::array<std::pair<std::uint16_t, int>, 6> io_events{};
+  int ob72 = 0, ob121 = 0;
+  int expected_events = 0;
+  int observed_events = 0;
+  std::uint64_t output_samples = 0;
+  std::uint64_t pulses = 0;
+  std::vector<std::string> pulse_reports;  ///< the first few
+  std::uint64_t dx_requests = 0;           ///< Data_Exchange requests to switched stations seen
+  std::uint64_t split_frames = 0;          ///< frames while two masters drove (F6 only)
+  std::uint64_t second_master_frames = 0;  ///< frames with two drivers outside F6 (must be 0)
+  std::uint64_t stray_dx = 0;              ///< DX on a side that should not run (must be 0)
+  std::vector<std::string> mismatches;
+  bus::Ticks max_settle = 0;  ///< longest repair -> Redundant + data exchange
+  bus::Ticks simulated = 0;
+  double wall_seconds = 0;
+  std::uint64_t frames = 0;
+
+  int injections() const { return faults + repairs; }
+  int events_with(std::uint16_t code) const;
+  std::string summary() const;
+};
+
+/// Runs the campaign. Throws std::invalid_argument for unusable options (a negative weight, all
+/// weights 0, min > max, a scan time or settle limit <= 0) and std::runtime_error when the
+/// system cannot be built (GSD missing, a baud rate a station does not support).
+HCampaignResult run_h_campaign(const HCampaignOptions& o);
+
+}  // namespace pbvbus::devices

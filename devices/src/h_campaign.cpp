@@ -1,0 +1,960 @@
+// The seeded fault campaign over the H-system and its observer (h_campaign.hpp has the
+// decisions, docs/h-campaign.md the reasons).
+#include "pbvbus/devices/h_campaign.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "pbvbus/bus/line.hpp"
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/bus/tap.hpp"
+#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/devices/redundant_master_system.hpp"
+#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/fdl/telegram.hpp"
+
+namespace pbvbus::devices {
+
+std::string_view to_string(HFault f) {
+  switch (f) {
+    case HFault::MasterPower:
+      return "master CPU power (F1)";
+    case HFault::StandbyPower:
+      return "standby CPU power (F1)";
+    case HFault::MasterStop:
+      return "master CPU STOP";
+    case HFault::StandbyStop:
+      return "standby CPU STOP";
+    case HFault::OneFibre:
+      return "one fibre (F5)";
+    case HFault::BothFibres:
+      return "both fibres at once (F6)";
+    case HFault::ActiveIm:
+      return "active IM (F10)";
+    case HFault::PassiveIm:
+      return "passive IM (F10)";
+    case HFault::ShortCircuit:
+      return "short circuit (F14)";
+    case HFault::DpMasterFailure:
+      return "DP master module (F9)";
+    case HFault::ComparisonError:
+      return "comparison error (F16)";
+    case HFault::OneSidedOb121:
+      return "one-sided OB 121 (F17)";
+    case HFault::MasterSwap:
+      return "operator master swap";
+  }
+  return "?";
+}
+
+int HCampaignResult::events_with(std::uint16_t code) const {
+  for (const auto& [c, n] : io_events)
+    if (c == code) return n;
+  return 0;
+}
+
+std::string HCampaignResult::summary() const {
+  std::ostringstream o;
+  o << "faults " << faults << " repairs " << repairs << " (cycles:";
+  for (int k = 0; k < kHFaultKinds; ++k)
+    o << ' ' << to_string(static_cast<HFault>(k)) << '=' << drawn[k];
+  o << ") defective " << defective << " comparison-stops " << comparison_stops << " role swaps "
+    << role_swaps << "; events";
+  for (const auto& [c, n] : io_events) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, " %04X=", c);
+    o << buf << n;
+  }
+  o << " OB72=" << ob72 << " OB121=" << ob121 << " (observed " << observed_events << ", expected "
+    << expected_events << "); samples " << output_samples << " pulses " << pulses << "; DX "
+    << dx_requests << " stray " << stray_dx << "; split frames " << split_frames
+    << " second-master frames " << second_master_frames << "; mismatches " << mismatches.size()
+    << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
+    << static_cast<double>(simulated) / bus::kTicksPerSecond << " s in " << wall_seconds
+    << " s wall; frames " << frames;
+  return o.str();
+}
+
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+using Src = HSystemEvent::Source;
+constexpr bus::Ticks kMs = bus::kTicksPerMs;
+constexpr bus::Ticks kDefectiveWindow = 7 * 24 * 3600 * bus::kTicksPerSecond;  // F17, fixed
+/// A frame whose start lies at most this long after its side stopped was committed before.
+constexpr bus::Ticks kCommitted = kMs / 2;
+constexpr std::uint8_t kSw[2] = {20, 21};
+constexpr std::uint8_t kOne[2] = {40, 60};
+
+std::string fmt_time(bus::Ticks t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f ms", static_cast<double>(t) / static_cast<double>(kMs));
+  return buf;
+}
+
+/// One expected event: an OB of the pair (72/121, with its reason) or an I/O event.
+struct Expect {
+  Src src = Src::Io;
+  int ob = 0;
+  std::uint16_t code = 0;
+  int rack = -1;
+  CpuRole role = CpuRole::Master;
+  int line = -1;
+  std::uint8_t station = 0xFF;
+  std::string text;  ///< Cpu: the OB's text ("OB 72 <reason>")
+  bus::Ticks earliest = 0, latest = 0;
+};
+
+bool same(const Expect& x, const HSystemEvent& e) {
+  if (x.src != e.source || x.ob != e.ob || x.code != e.code || x.rack != e.rack || x.role != e.role)
+    return false;
+  if (x.src == Src::Cpu) return x.text == e.text;
+  return x.line == e.line && x.station == e.station && e.system == 0;
+}
+
+std::string fmt_ev(Src src, int ob, std::uint16_t code, int rack, CpuRole role, int line,
+                   std::uint8_t station, const std::string& text) {
+  char buf[96];
+  if (src == Src::Cpu)
+    std::snprintf(buf, sizeof buf, "[%s rack %d %s]", text.c_str(), rack,
+                  std::string(to_string(role)).c_str());
+  else
+    std::snprintf(buf, sizeof buf, "[OB %d %04X L%d @%d rack %d]", ob, code, line, int(station),
+                  rack);
+  return buf;
+}
+std::string fmt(const Expect& x) {
+  return fmt_ev(x.src, x.ob, x.code, x.rack, x.role, x.line, x.station, x.text);
+}
+std::string fmt(const HSystemEvent& e) {
+  return fmt_ev(e.source, e.ob, e.code, e.rack, e.role, e.line, e.station, e.text);
+}
+
+struct Step {
+  bus::Ticks at = 0;
+  bool repair = false;
+  std::string what;
+  std::vector<Expect> expect;
+};
+
+GsdFile load(const std::string& dir, const char* name) {
+  auto r = load_gsd(std::filesystem::path(dir) / name);
+  if (!r.ok() || !r.file) throw std::runtime_error(std::string("h campaign: cannot load ") + name);
+  return *r.file;
+}
+std::vector<ModuleChoice> switched_modules() {
+  return {ModuleChoice::named("16DI DC24V"), ModuleChoice::named("16DO DC24V/0.5A")};
+}
+std::vector<ModuleChoice> plain_modules() {
+  return {ModuleChoice::named("16DI/16DO DC24V")};
+}
+
+/// The observer's own model (nothing here is read from HSystemModel or HCpuPair).
+struct Observer {
+  int master = 0;
+  bool split = false;  ///< F6: two masters
+  // Side r's DP master runs in [run_from, run_until); CPU r runs the program in [prog_from,
+  // prog_until).
+  bus::Ticks run_from[2] = {bus::kNever, bus::kNever}, run_until[2] = {bus::kNever, bus::kNever};
+  bus::Ticks prog_from[2] = {bus::kNever, bus::kNever};
+  bus::Ticks stopped_at[2] = {bus::kNever, bus::kNever};  ///< the side's last stop
+  bus::Ticks prog_until[2] = {bus::kNever, bus::kNever};
+  bool iface_ok[2][2] = {{true, true}, {true, true}};
+  bool shorted[2] = {false, false}, mfail[2] = {false, false};
+  int act[2] = {0, 0};
+  std::optional<bus::Ticks> last121[2];
+  bus::Ticks swap_at = bus::kNever;  ///< the last automatic swap after ERROR-SEARCH
+
+  bool side_runs(int r, bus::Ticks t) const { return run_from[r] <= t && t < run_until[r]; }
+  bool prog(int r, bus::Ticks t) const { return prog_from[r] <= t && t < prog_until[r]; }
+  /// The rack an I/O OB runs on at t: -1 when both CPUs run the program.
+  int io_rack(bus::Ticks t) const {
+    const bool a = prog(0, t), b = prog(1, t);
+    return a && b ? -1 : (a ? 0 : (b ? 1 : -2));
+  }
+  bool line_ok(int l) const { return !shorted[l] && !mfail[l]; }
+  bool reach(int k, int l, bus::Ticks t) const {
+    return iface_ok[k][l] && line_ok(l) && side_runs(l, t);
+  }
+};
+
+class HCampaignRun;
+
+struct Tap final : bus::Tap {
+  explicit Tap(HCampaignRun& c) : camp(c) {}
+  void on_frame(const bus::TapFrame& f) override;
+  HCampaignRun& camp;
+};
+
+class HCampaignRun {
+ public:
+  explicit HCampaignRun(const HCampaignOptions& o) : m_o(o), m_rng(o.seed), m_tap(*this) {
+    int sum = 0;
+    for (int w : o.weights) {
+      if (w < 0) throw std::invalid_argument("h campaign: a negative fault weight");
+      sum += w;
+    }
+    if (sum <= 0) throw std::invalid_argument("h campaign: every fault weight is 0");
+    if (o.fault_min < 0 || o.fault_min > o.fault_max || o.gap_min < 0 || o.gap_min > o.gap_max)
+      throw std::invalid_argument("h campaign: fault/gap durations: 0 <= min <= max");
+    if (o.scan_time <= 0 || o.self_test_time < 0 || o.settle_limit <= 0 || o.recognition < 0 ||
+        o.startup < 0)
+      throw std::invalid_argument("h campaign: times must not be negative (scan, settle > 0)");
+    build();
+  }
+  HCampaignResult run();
+  void on_frame(const bus::TapFrame& f);
+
+ private:
+  struct Sw {
+    std::unique_ptr<SwitchedStationModel> model;
+    bool started = false;
+    bool exempt = false;
+    std::uint16_t last = 0;
+  };
+  void build();
+  bus::Ticks now() const { return m_sched.now(); }
+  void run_to(bus::Ticks t) { m_sched.run_until(t); }
+  std::string step_name() const { return m_steps.empty() ? "(none)" : m_steps.back().what; }
+  bus::Ticks draw(bus::Ticks lo, bus::Ticks hi) {
+    return std::uniform_int_distribution<bus::Ticks>(lo, hi)(m_rng);
+  }
+  int draw_int(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(m_rng); }
+  bus::Ticks update_w() const { return default_update_time(m_params.update_db_kb); }
+
+  // Expectations.
+  Expect cpu_ob(int ob, int rack, CpuRole role, HReason why, bus::Ticks at) const {
+    Expect x;
+    x.src = Src::Cpu;
+    x.ob = ob;
+    x.rack = rack;
+    x.role = role;
+    x.text = "OB " + std::to_string(ob) + " " + std::string(to_string(why));
+    x.earliest = x.latest = at;
+    return x;
+  }
+  Expect io(std::uint16_t code, int line, std::uint8_t station, bus::Ticks from, bus::Ticks to) {
+    Expect x;
+    x.src = Src::Io;
+    x.ob = (code == 0x73A3 || code == 0x72A3) ? 70 : 86;
+    x.code = code;
+    x.line = line;
+    x.station = station;
+    x.rack = m_obs.io_rack(from);
+    x.earliest = from;
+    x.latest = to;
+    return x;
+  }
+  /// Side r's DP master stops at t (its CPU off, STOP, ERROR-SEARCH, DEFECTIVE): one 39C3,
+  /// every station active on r to the other line.
+  void lose_side(int r, bus::Ticks t, std::vector<Expect>& ex);
+  /// CPU r (standby) starts its link-up at t0: its DP master runs from the UPDATE on (38C3),
+  /// its program from the end of the update.
+  void restart_side(int r, bus::Ticks t0, std::vector<Expect>& ex);
+  void switch_away(int l);
+  void set_master(int m) {
+    if (m != m_obs.master) ++m_r.role_swaps;
+    m_obs.master = m;
+  }
+
+  void begin_step(std::string what, bool repair, std::vector<Expect> ex);
+  bool satisfied(const Step& s) const;
+  void settle_step();
+  bool recovered() const;
+  void wait_recovered(bus::Ticks since);
+  void check_roles();
+  void match_all();
+
+  void cycle(HFault f);
+  void hidden_cycle();
+  void dwell() { run_to(now() + draw(m_o.fault_min, m_o.fault_max)); }
+  std::string rack_name(int r) const { return "rack " + std::to_string(r); }
+
+  HCampaignOptions m_o;
+  std::mt19937_64 m_rng;
+  HCpuPairParams m_params;
+  bus::Scheduler m_sched;
+  std::unique_ptr<bus::Line> m_bus[2];
+  fdl::BusParams m_bp;
+  std::unique_ptr<RedundantMasterSystemModel> m_sys;
+  Sw m_sw[2];
+  std::unique_ptr<SlaveModel> m_one[2];
+  std::unique_ptr<HSystemModel> m_h;
+  Tap m_tap;
+  std::uint16_t m_counter = 0;
+  bool m_zero_done = false;
+  Observer m_obs;
+  std::vector<Step> m_steps;
+  std::size_t m_reported_step = static_cast<std::size_t>(-1);  ///< two-master report, once
+  std::size_t m_stray_step = static_cast<std::size_t>(-1);
+  HCampaignResult m_r;
+};
+
+void Tap::on_frame(const bus::TapFrame& f) {
+  camp.on_frame(f);
+}
+
+void HCampaignRun::build() {
+  const GsdFile fast = load(m_o.gsd_dir, "PBVB0A10.gsd");
+  const GsdFile slow = load(m_o.gsd_dir, "PBVB0A11.gsd");
+  const GsdFile plain = load(m_o.gsd_dir, "PBVB0A01.gsd");
+  m_bp = fdl::BusParams::defaults(m_o.baud);
+  m_bp.hsa = 12;
+  m_bus[0] = std::make_unique<bus::Line>(m_sched, "A", m_o.baud, m_o.seed * 2 + 1);
+  m_bus[1] = std::make_unique<bus::Line>(m_sched, "B", m_o.baud, m_o.seed * 2 + 2);
+  std::vector<dp::SlaveParams> cfg[2];
+  std::vector<redundancy::SwitchedStationRef> refs;
+  for (int k = 0; k < 2; ++k) {
+    const GsdFile& g = k == 1 ? slow : fast;
+    SwitchedStationOptions so;
+    so.address = kSw[k];
+    so.bus_params = m_bp;
+    auto b = SwitchedStationModel::build(g, switched_modules(), so);
+    if (!b.ok())
+      throw std::runtime_error("h campaign: switched station " + std::to_string(kSw[k]) + ": " +
+                               (b.errors.empty() ? std::string("?") : b.errors[0]));
+    m_sw[k].model = std::move(b.model);
+    auto sp = master_slave_params(g, switched_modules(), kSw[k]);
+    if (!sp.ok()) throw std::runtime_error("h campaign: master params of a switched station");
+    dp::SlaveParams p = *sp.value;
+    p.prm_cmd.assign(8, 0);
+    cfg[0].push_back(p);
+    cfg[1].push_back(p);
+    refs.push_back({kSw[k], m_sw[k].model->t_slave_um().value_or(0), false});
+  }
+  for (int l = 0; l < 2; ++l) {
+    auto sp = master_slave_params(plain, plain_modules(), kOne[l]);
+    if (!sp.ok()) throw std::runtime_error("h campaign: master params of a one-sided slave");
+    cfg[l].push_back(*sp.value);
+    SlaveModelOptions so;
+    so.address = kOne[l];
+    so.bus_params = m_bp;
+    auto b = SlaveModel::build(plain, plain_modules(), so);
+    if (!b.ok()) throw std::runtime_error("h campaign: one-sided slave");
+    m_one[l] = std::move(b.model);
+  }
+  RedundantMasterSystemOptions mo;
+  mo.bus_params = m_bp;
+  m_sys = std::make_unique<RedundantMasterSystemModel>(mo, cfg[0], cfg[1], refs);
+  for (int l = 0; l < 2; ++l) m_sys->attach(l, *m_bus[l], "master");
+  for (auto& s : m_sw)
+    for (int l = 0; l < 2; ++l) s.model->attach(l, *m_bus[l]);
+  for (int l = 0; l < 2; ++l) {
+    m_bus[l]->attach(*m_one[l], "one-sided");
+    m_bus[l]->add_tap(m_tap);
+    m_bus[l]->start();
+  }
+  m_params.self_test_time = m_o.self_test_time;
+  m_params.cyclic_self_test_period = m_o.cyclic_self_test_period;
+  m_h = std::make_unique<HSystemModel>(m_sched, m_params,
+                                       std::vector<RedundantMasterSystemModel*>{m_sys.get()});
+  m_h->set_program(
+      [this](std::span<const std::uint8_t>, std::span<std::uint8_t> piq, bus::Ticks t) {
+        if (++m_counter == 0) m_counter = 1;  // 0 is the modules' safe state: never written
+        std::uint16_t v = m_counter;
+        if (!m_zero_done && t >= m_o.tamper.zero_output_at) {
+          v = 0;
+          m_zero_done = true;
+        }
+        for (std::size_t i = 0; i + 1 < piq.size(); i += 2) {
+          piq[i] = static_cast<std::uint8_t>(v >> 8);
+          piq[i + 1] = static_cast<std::uint8_t>(v);
+        }
+      },
+      m_o.scan_time);
+}
+
+// ---- the per-frame checks ------------------------------------------------------------------
+
+void HCampaignRun::on_frame(const bus::TapFrame& f) {
+  const int l = f.line == m_bus[1].get() ? 1 : 0;
+  // Two masters driving the switched outputs: from the pair's roles and the DP masters' modes.
+  int drivers = 0;
+  for (int r = 0; r < 2; ++r)
+    if (m_h->pair().is_master(r) && m_sys->master(r).mode() == dp::MasterMode::Operate &&
+        m_sys->attachment_powered(r))
+      ++drivers;
+  if (drivers >= 2) {
+    if (m_obs.split) {
+      ++m_r.split_frames;
+    } else {
+      ++m_r.second_master_frames;
+      if (m_reported_step != m_steps.size())
+        m_r.mismatches.push_back(fmt_time(f.end) + ": after '" + step_name() +
+                                 "': two masters drive the switched outputs outside F6");
+      m_reported_step = m_steps.size();
+    }
+  }
+  // From the wire: Data_Exchange with outputs to a switched station (SRD without SAPs).
+  fdl::Telegram t;
+  if (fdl::decode(f.bytes, t) == fdl::DecodeError::None && t.is_request() && !t.dsap &&
+      !t.data.empty() &&
+      (fdl::fc_request_fn(t.fc) == fdl::RequestFn::SrdLow ||
+       fdl::fc_request_fn(t.fc) == fdl::RequestFn::SrdHigh) &&
+      (t.da == kSw[0] || t.da == kSw[1])) {
+    ++m_r.dx_requests;
+    // A request the FDL had already committed when the side stopped (its start bit lies after
+    // the stop only by the idle time) is no new Data_Exchange: kCommitted of grace.
+    // A frame that was on the wire at the stop is no new one either.
+    const bool committed =
+        f.end >= m_obs.stopped_at[l] && f.start < m_obs.stopped_at[l] + kCommitted;
+    if (!m_obs.side_runs(l, f.start) && !committed) {
+      ++m_r.stray_dx;
+      if (m_stray_step != m_steps.size())
+        m_r.mismatches.push_back(
+            fmt_time(f.start) + ": after '" + step_name() + "': Data_Exchange to station " +
+            std::to_string(t.da) + " on line " + std::to_string(l) +
+            " whose DP master should not run (it runs in [" + fmt_time(m_obs.run_from[l]) + ", " +
+            fmt_time(m_obs.run_until[l]) + "), frame " + fmt_time(f.start) + ".." +
+            fmt_time(f.end) + ", stop at " + fmt_time(m_obs.stopped_at[l]) + ", FC " +
+            std::to_string(t.fc) + ")");
+      m_stray_step = m_steps.size();
+    }
+  }
+  // The backplane outputs of the switched stations.
+  for (int k = 0; k < 2; ++k) {
+    Sw& s = m_sw[k];
+    const auto out = s.model->outputs();
+    const auto v = static_cast<std::uint16_t>((out[0] << 8) | out[1]);
+    if (!s.started) {
+      s.started = v != 0;
+      s.last = v;
+      continue;
+    }
+    ++m_r.output_samples;
+    const bool none = !m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end);
+    if (none) s.exempt = true;
+    std::string bad;
+    if (v == 0) {
+      if (!s.exempt) bad = "outputs 0";
+    } else {
+      if (static_cast<std::uint16_t>(v - s.last) >= 0x8000) bad = "older value";
+      if (!none && v != s.last) s.exempt = false;
+    }
+    if (!bad.empty()) {
+      ++m_r.pulses;
+      if (m_r.pulse_reports.size() < 20)
+        m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) + " " +
+                                    bad + " (" + std::to_string(v) + " after " +
+                                    std::to_string(s.last) + "), step '" + step_name() + "'");
+    }
+    if (v != 0) s.last = v;
+  }
+}
+
+// ---- the observer's rules ------------------------------------------------------------------
+
+void HCampaignRun::switch_away(int l) {
+  const bus::Ticks t = now();
+  for (int k = 0; k < 2; ++k)
+    if (m_obs.act[k] == l && m_obs.reach(k, 1 - l, t)) m_obs.act[k] = 1 - l;
+}
+
+void HCampaignRun::lose_side(int r, bus::Ticks t, std::vector<Expect>& ex) {
+  const bool ran = m_obs.side_runs(r, t);
+  m_obs.run_until[r] = t;
+  m_obs.stopped_at[r] = t;
+  m_obs.prog_until[r] = std::min(m_obs.prog_until[r], t);
+  if (!ran) return;
+  ex.push_back(io(0x39C3, r, 0xFF, t, t));
+  for (int k = 0; k < 2; ++k)
+    if (m_obs.act[k] == r && m_obs.iface_ok[k][1 - r] && m_obs.line_ok(1 - r)) m_obs.act[k] = 1 - r;
+}
+
+void HCampaignRun::restart_side(int r, bus::Ticks t0, std::vector<Expect>& ex) {
+  const bus::Ticks up = t0 + m_params.link_up_time;
+  m_obs.run_from[r] = up;
+  m_obs.run_until[r] = bus::kNever;
+  m_obs.prog_from[r] = up + update_w();
+  m_obs.prog_until[r] = bus::kNever;
+  ex.push_back(io(0x38C3, r, 0xFF, up, up));  // the OB runs on the master: r is in UPDATE
+}
+
+// ---- steps ---------------------------------------------------------------------------------
+
+void HCampaignRun::begin_step(std::string what, bool repair, std::vector<Expect> ex) {
+  Step s;
+  s.at = now();
+  s.repair = repair;
+  s.what = std::move(what);
+  s.expect = std::move(ex);
+  m_r.expected_events += static_cast<int>(s.expect.size());
+  m_steps.push_back(std::move(s));
+  if (repair)
+    ++m_r.repairs;
+  else
+    ++m_r.faults;
+}
+
+bool HCampaignRun::satisfied(const Step& s) const {
+  std::vector<bool> used(s.expect.size(), false);
+  const auto& all = m_h->events();
+  // Events are in time order; the step's begin at s.at (the injection ran just before).
+  const auto first = std::lower_bound(
+      all.begin(), all.end(), s.at, [](const HSystemEvent& e, bus::Ticks t) { return e.time < t; });
+  for (std::size_t n = static_cast<std::size_t>(first - all.begin()); n < all.size(); ++n)
+    for (std::size_t i = 0; i < s.expect.size(); ++i)
+      if (!used[i] && same(s.expect[i], all[n])) {
+        used[i] = true;
+        break;
+      }
+  return std::all_of(used.begin(), used.end(), [](bool b) { return b; });
+}
+
+void HCampaignRun::settle_step() {
+  const Step& s = m_steps.back();
+  bus::Ticks limit = s.at;
+  for (const auto& x : s.expect) limit = std::max(limit, x.latest);
+  while (!satisfied(s) && now() <= limit) run_to(std::min(limit + 1, now() + 5 * kMs));
+}
+
+bool HCampaignRun::recovered() const {
+  using St = dp::SlaveStatusState;
+  const HCpuPair& p = m_h->pair();
+  if (p.system_mode() != SystemMode::Redundant || p.state(0) != CpuState::Run ||
+      p.state(1) != CpuState::Run)
+    return false;
+  const bus::Ticks t = now();
+  for (int k = 0; k < 2; ++k) {
+    for (int l = 0; l < 2; ++l) {
+      if (!m_obs.reach(k, l, t)) continue;
+      if (m_sys->master(l).slave_state(kSw[k]) != St::DataExchange) return false;
+      const auto role = m_sw[k].model->role(l);
+      if (role != redundancy::Role::Primary && role != redundancy::Role::Backup) return false;
+    }
+    if (m_sw[k].model->primary() < 0) return false;
+  }
+  for (int l = 0; l < 2; ++l)
+    if (m_obs.line_ok(l) && m_obs.side_runs(l, t) &&
+        m_sys->master(l).slave_state(kOne[l]) != St::DataExchange)
+      return false;
+  return true;
+}
+
+void HCampaignRun::wait_recovered(bus::Ticks since) {
+  const bus::Ticks limit = since + m_o.settle_limit;
+  while (!recovered() && now() < limit) run_to(now() + 10 * kMs);
+  if (!recovered()) {
+    m_r.mismatches.push_back(fmt_time(now()) + ": after '" + step_name() +
+                             "': not back in Redundant mode with every channel in data exchange "
+                             "within " +
+                             fmt_time(m_o.settle_limit));
+    return;
+  }
+  m_r.max_settle = std::max(m_r.max_settle, now() - since);
+}
+
+void HCampaignRun::check_roles() {
+  const HCpuPair& p = m_h->pair();
+  if (p.master_count() != 1 || p.master() != m_obs.master)
+    m_r.mismatches.push_back(fmt_time(now()) + ": after '" + step_name() + "': expected master " +
+                             rack_name(m_obs.master) + ", the pair has " +
+                             std::to_string(p.master_count()) + " master(s), master() " +
+                             std::to_string(p.master()));
+  for (int k = 0; k < 2; ++k) {
+    const int prim = m_sw[k].model->primary();
+    const int sys = m_sys->system().active(kSw[k]);
+    if (prim != m_obs.act[k] || sys != m_obs.act[k])
+      m_r.mismatches.push_back(
+          fmt_time(now()) + ": after '" + step_name() + "': station " + std::to_string(kSw[k]) +
+          " expected active line " + std::to_string(m_obs.act[k]) + ", station primary " +
+          std::to_string(prim) + ", MasterSystem active " + std::to_string(sys));
+  }
+}
+
+void HCampaignRun::match_all() {
+  std::vector<HSystemEvent> ev = m_h->events();
+  if (m_o.tamper.doctor_events) m_o.tamper.doctor_events(ev);
+  m_r.observed_events = static_cast<int>(ev.size());
+  std::size_t i = 0;
+  for (std::size_t si = 0; si < m_steps.size(); ++si) {
+    const Step& s = m_steps[si];
+    const bus::Ticks end = si + 1 < m_steps.size() ? m_steps[si + 1].at : bus::kNever;
+    while (i < ev.size() && ev[i].time < s.at) {
+      m_r.mismatches.push_back(fmt_time(ev[i].time) + ": event " + fmt(ev[i]) + " out of any step");
+      ++i;
+    }
+    std::vector<const HSystemEvent*> seen;
+    while (i < ev.size() && ev[i].time < end) seen.push_back(&ev[i++]);
+    std::vector<bool> used(seen.size(), false);
+    std::vector<std::string> missing, late;
+    for (const auto& x : s.expect) {
+      bool found = false;
+      for (std::size_t j = 0; j < seen.size() && !found; ++j) {
+        if (used[j] || !same(x, *seen[j])) continue;
+        used[j] = found = true;
+        if (seen[j]->time < x.earliest || seen[j]->time > x.latest)
+          late.push_back(fmt(x) + " at " + fmt_time(seen[j]->time) + ", expected " +
+                         fmt_time(x.earliest) + ".." + fmt_time(x.latest));
+      }
+      if (!found) missing.push_back(fmt(x));
+    }
+    std::vector<std::string> extra;
+    for (std::size_t j = 0; j < seen.size(); ++j)
+      if (!used[j]) extra.push_back(fmt(*seen[j]) + " at " + fmt_time(seen[j]->time));
+    if (missing.empty() && late.empty() && extra.empty()) continue;
+    std::string m = fmt_time(s.at) + ": " + s.what + ":";
+    for (const auto& x : missing) m += " missing " + x + ";";
+    for (const auto& x : extra) m += " unexpected " + x + ";";
+    for (const auto& x : late) m += " out of time " + x + ";";
+    m_r.mismatches.push_back(std::move(m));
+  }
+}
+
+// ---- the fault cycles ----------------------------------------------------------------------
+
+void HCampaignRun::cycle(HFault f) {
+  const std::string name(to_string(f));
+  const int M = m_obs.master, S = 1 - M;
+  const bus::Ticks t = now();
+  std::vector<Expect> ex;
+  bus::Ticks since = t;  // when the last repair began (the settle time counts from it)
+  switch (f) {
+    case HFault::MasterPower:
+    case HFault::StandbyPower:
+    case HFault::MasterStop:
+    case HFault::StandbyStop: {
+      const bool power = f == HFault::MasterPower || f == HFault::StandbyPower;
+      const bool of_master = f == HFault::MasterPower || f == HFault::MasterStop;
+      const int r = of_master ? M : S;
+      // Leaving Redundant (§1, F1): the partner of a lost master is master, OB 72 on it; a lost
+      // standby: OB 72 on the master.
+      const HReason why = of_master ? (power ? HReason::MasterLost : HReason::MasterStop)
+                                    : (power ? HReason::StandbyLost : HReason::StandbyStop);
+      m_obs.prog_until[r] = t;
+      ex.push_back(cpu_ob(72, 1 - r, CpuRole::Master, why, t));
+      lose_side(r, t, ex);
+      if (of_master) set_master(S);
+      if (power)
+        m_h->power_off(r);
+      else
+        m_h->switch_to_stop(r);
+      begin_step(name + ": " + rack_name(r), false, std::move(ex));
+      settle_step();
+      dwell();
+      since = now();
+      ex.clear();
+      restart_side(r, since, ex);  // the returning CPU is standby (F1)
+      if (power)
+        m_h->power_on(r);
+      else
+        m_h->switch_to_run(r);
+      begin_step(std::string(power ? "power on " : "RUN ") + rack_name(r), true, std::move(ex));
+      break;
+    }
+    case HFault::OneFibre: {
+      const int fi = draw_int(0, 1);
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::LinkLost, t));
+      lose_side(S, t, ex);  // F5: the standby STOPs
+      m_h->cut_fibre(fi);
+      begin_step(name + ": fibre " + std::to_string(fi), false, std::move(ex));
+      settle_step();
+      dwell();
+      since = now();
+      ex.clear();
+      restart_side(S, since, ex);
+      m_h->repair_fibre(fi);
+      m_h->switch_to_run(S);
+      begin_step("repair fibre " + std::to_string(fi) + ", RUN " + rack_name(S), true,
+                 std::move(ex));
+      break;
+    }
+    case HFault::BothFibres: {
+      // F6: both CPUs log OB 72 and both are master in RUN; no side stops.
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::LinkLost, t));
+      ex.push_back(cpu_ob(72, S, CpuRole::Master, HReason::LinkLost, t));
+      m_obs.split = true;
+      m_h->cut_both_fibres();
+      begin_step(name, false, std::move(ex));
+      settle_step();
+      dwell();
+      // Repair: both fibres, then one of the masters to STOP: it becomes standby (no OB 72:
+      // the system was not redundant), its side is lost (39C3).
+      const int x = draw_int(0, 1);
+      const bus::Ticks t1 = now();
+      ex.clear();
+      m_obs.split = false;
+      m_obs.prog_until[x] = t1;
+      lose_side(x, t1, ex);
+      set_master(1 - x);
+      m_h->repair_fibre(0);
+      m_h->repair_fibre(1);
+      m_h->switch_to_stop(x);
+      begin_step("repair both fibres, STOP " + rack_name(x), true, std::move(ex));
+      settle_step();
+      run_to(now() + draw(100 * kMs, 300 * kMs));
+      since = now();
+      ex.clear();
+      restart_side(x, since, ex);
+      m_h->switch_to_run(x);
+      begin_step("RUN " + rack_name(x), true, std::move(ex));
+      break;
+    }
+    case HFault::ActiveIm:
+    case HFault::PassiveIm: {
+      const int k = draw_int(0, 1);
+      const int l = f == HFault::ActiveIm ? m_obs.act[k] : 1 - m_obs.act[k];
+      m_obs.iface_ok[k][l] = false;
+      ex.push_back(io(0x73A3, l, kSw[k], t, t + m_o.recognition));
+      if (m_obs.act[k] == l) m_obs.act[k] = 1 - l;
+      m_sw[k].model->fail_interface(l);
+      begin_step(name + ": station " + std::to_string(kSw[k]) + " line " + std::to_string(l), false,
+                 std::move(ex));
+      settle_step();
+      dwell();
+      since = now();
+      ex.clear();
+      m_obs.iface_ok[k][l] = true;
+      ex.push_back(io(0x72A3, l, kSw[k], since, since + m_o.startup));  // no switch back
+      m_sw[k].model->repair_interface(l);
+      begin_step("repair station " + std::to_string(kSw[k]) + " line " + std::to_string(l), true,
+                 std::move(ex));
+      break;
+    }
+    case HFault::ShortCircuit:
+    case HFault::DpMasterFailure: {
+      const int l = draw_int(0, 1);
+      const bool sc = f == HFault::ShortCircuit;
+      if (sc) {  // F14: only 39C3, every station switches
+        m_obs.shorted[l] = true;
+        ex.push_back(io(0x39C3, l, 0xFF, t, t + m_o.recognition));
+      } else {  // F9: per station, the switched ones served by the partner
+        m_obs.mfail[l] = true;
+        for (int k = 0; k < 2; ++k) ex.push_back(io(0x73A3, l, kSw[k], t, t + m_o.recognition));
+        ex.push_back(io(0x39C4, l, kOne[l], t, t + m_o.recognition));
+      }
+      switch_away(l);
+      if (sc) {
+        m_bus[l]->set_short_circuit(true);
+      } else {
+        m_sys->fail_master(l);
+        m_h->reconcile();
+      }
+      begin_step(name + ": line " + std::to_string(l), false, std::move(ex));
+      settle_step();
+      dwell();
+      since = now();
+      ex.clear();
+      if (sc) {
+        m_obs.shorted[l] = false;
+        ex.push_back(io(0x38C3, l, 0xFF, since, since + m_o.startup));
+        m_bus[l]->set_short_circuit(false);
+      } else {
+        m_obs.mfail[l] = false;
+        for (int k = 0; k < 2; ++k) ex.push_back(io(0x72A3, l, kSw[k], since, since + m_o.startup));
+        ex.push_back(io(0x38C4, l, kOne[l], since, since + m_o.startup));
+        m_sys->repair_master(l);
+        m_h->reconcile();
+      }
+      begin_step("repair line " + std::to_string(l), true, std::move(ex));
+      break;
+    }
+    case HFault::ComparisonError: {
+      // F16: standby -> ERROR-SEARCH, OB 72 on the master; again within the first self-test
+      // cycle after a search: standby STOP (000).
+      const bool repeated =
+          m_obs.swap_at != bus::kNever && t - m_obs.swap_at < m_o.cyclic_self_test_period;
+      m_obs.swap_at = bus::kNever;
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::ComparisonError, t));
+      lose_side(S, t, ex);
+      if (!repeated) {
+        // R5: no fault found -> re-link, and the searched CPU becomes master after the update.
+        restart_side(S, t + m_o.self_test_time, ex);
+        const bus::Ticks te = m_obs.prog_from[S];
+        ex.push_back(cpu_ob(72, S, CpuRole::Master, HReason::MasterSwap, te));
+        ex.push_back(cpu_ob(72, M, CpuRole::Standby, HReason::MasterSwap, te));
+        m_obs.swap_at = te;
+        set_master(S);
+      }
+      if (!m_h->inject_comparison_error())
+        m_r.mismatches.push_back(fmt_time(t) + ": comparison error refused in Redundant mode");
+      begin_step(name + (repeated ? " (again: standby STOP)" : ""), false, std::move(ex));
+      settle_step();
+      if (repeated) {
+        ++m_r.comparison_stops;
+        dwell();
+        since = now();
+        ex.clear();
+        restart_side(S, since, ex);
+        m_h->switch_to_run(S);
+        begin_step("RUN " + rack_name(S), true, std::move(ex));
+      }
+      break;
+    }
+    case HFault::OneSidedOb121: {
+      const int r = draw_int(0, 1), p = 1 - r;
+      const bool repeated = m_obs.last121[r] && t - *m_obs.last121[r] <= kDefectiveWindow;
+      m_obs.last121[r] = t;
+      ex.push_back(
+          cpu_ob(121, r, r == M ? CpuRole::Master : CpuRole::Standby, HReason::OneSidedOb121, t));
+      ex.push_back(cpu_ob(72, p, CpuRole::Master, HReason::OneSidedOb121, t));
+      m_obs.prog_until[r] = t;
+      set_master(p);
+      lose_side(r, t, ex);
+      if (!repeated) {
+        restart_side(r, t + m_o.self_test_time, ex);
+        const bus::Ticks te = m_obs.prog_from[r];
+        ex.push_back(cpu_ob(72, r, CpuRole::Master, HReason::MasterSwap, te));
+        ex.push_back(cpu_ob(72, p, CpuRole::Standby, HReason::MasterSwap, te));
+        m_obs.swap_at = te;
+        set_master(r);
+      }
+      if (!m_h->one_sided_ob121(r))
+        m_r.mismatches.push_back(fmt_time(t) + ": one-sided OB 121 refused in Redundant mode");
+      begin_step(name + ": " + rack_name(r) + (repeated ? " (again: DEFECTIVE)" : ""), false,
+                 std::move(ex));
+      settle_step();
+      if (repeated) {
+        ++m_r.defective;
+        dwell();
+        since = now();
+        ex.clear();
+        m_obs.last121[r].reset();  // the CPU is replaced: no history
+        restart_side(r, since, ex);
+        m_h->repair_cpu(r);
+        m_h->switch_to_run(r);
+        begin_step("replace CPU " + rack_name(r) + ", RUN", true, std::move(ex));
+      }
+      break;
+    }
+    case HFault::MasterSwap: {
+      // The operator: the standby's switch to STOP, the swap request (the standby links up and
+      // becomes master at the end of the update, the old master STOPs), then RUN again.
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::StandbyStop, t));
+      lose_side(S, t, ex);
+      m_h->switch_to_stop(S);
+      begin_step("master swap: STOP " + rack_name(S), false, std::move(ex));
+      settle_step();
+      run_to(now() + draw(100 * kMs, 300 * kMs));
+      const bus::Ticks t1 = now();
+      ex.clear();
+      restart_side(S, t1, ex);
+      const bus::Ticks te = m_obs.prog_from[S];
+      ex.push_back(cpu_ob(72, S, CpuRole::Master, HReason::MasterSwap, te));
+      m_obs.prog_until[M] = te;
+      m_obs.run_until[M] = te;
+      {
+        Expect x = io(0x39C3, M, 0xFF, te, te);
+        x.rack = S;  // at te only the new master runs the program
+        ex.push_back(x);
+      }
+      set_master(S);
+      if (!m_h->request_master_swap())
+        m_r.mismatches.push_back(fmt_time(t1) + ": master swap request refused");
+      begin_step("master swap: request", false, std::move(ex));
+      settle_step();
+      for (int k = 0; k < 2; ++k)
+        if (m_obs.act[k] == M && m_obs.iface_ok[k][S] && m_obs.line_ok(S)) m_obs.act[k] = S;
+      run_to(now() + draw(100 * kMs, 300 * kMs));
+      since = now();
+      ex.clear();
+      restart_side(M, since, ex);
+      m_h->switch_to_run(S);  // its mode switch back to RUN (it runs already)
+      m_h->switch_to_run(M);
+      begin_step("master swap: RUN " + rack_name(M), true, std::move(ex));
+      break;
+    }
+  }
+  settle_step();
+  wait_recovered(since);
+  check_roles();
+}
+
+void HCampaignRun::hidden_cycle() {
+  // Tamper: the standby CPU off and on again; the observer expects nothing.
+  const int S = 1 - m_obs.master;
+  m_h->power_off(S);
+  begin_step("(hidden fault: nothing expected)", false, {});
+  dwell();
+  m_h->power_on(S);
+  begin_step("(hidden repair: nothing expected)", true, {});
+  run_to(now() + m_params.link_up_time + update_w() + 500 * kMs);
+  wait_recovered(now());
+}
+
+HCampaignResult HCampaignRun::run() {
+  const auto w0 = std::chrono::steady_clock::now();
+  run_to(10 * kMs);
+  // Start: both CPUs at once; rack 0 master (STARTUP), rack 1 links up once it is in Solo RUN.
+  const bus::Ticks t0 = now();
+  m_obs.prog_from[0] = t0 + m_params.startup_time;
+  m_obs.run_from[0] = t0;  // the master's DP master runs from its STARTUP on (Clear)
+  m_obs.run_from[1] = m_obs.prog_from[0] + m_params.link_up_time;
+  m_obs.prog_from[1] = m_obs.run_from[1] + update_w();
+  m_h->power_on_both();
+  begin_step("start-up", true, {});
+  --m_r.repairs;  // the start-up is no injection
+  wait_recovered(t0);
+  check_roles();
+  int index = 0;
+  std::vector<int> w(m_o.weights.begin(), m_o.weights.end());
+  std::discrete_distribution<int> pick(w.begin(), w.end());
+  while (m_r.injections() < m_o.steps) {
+    run_to(now() + draw(m_o.gap_min, m_o.gap_max));
+    const auto f = static_cast<HFault>(pick(m_rng));
+    if (index == m_o.tamper.hidden_fault_at) {
+      hidden_cycle();
+      m_r.faults -= 1;
+      m_r.repairs -= 1;
+    } else if (index == m_o.tamper.second_master_at) {
+      // Tamper: the observer is told one fibre (F5), both are cut (F6).
+      const int M = m_obs.master, S = 1 - M;
+      const bus::Ticks t = now();
+      std::vector<Expect> ex;
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::LinkLost, t));
+      lose_side(S, t, ex);
+      m_h->cut_both_fibres();
+      begin_step("one fibre (F5) [tamper: both cut]", false, std::move(ex));
+      settle_step();
+      dwell();
+      ex.clear();
+      restart_side(S, now(), ex);
+      m_h->repair_fibre(0);
+      m_h->repair_fibre(1);
+      m_h->switch_to_stop(S);
+      m_h->switch_to_run(S);
+      begin_step("repair fibre, RUN " + rack_name(S), true, std::move(ex));
+      settle_step();
+      wait_recovered(now());
+    } else {
+      ++m_r.drawn[static_cast<int>(f)];
+      cycle(f);
+    }
+    ++index;
+  }
+  run_to(now() + 500 * kMs);
+  match_all();
+  const std::uint16_t codes[6] = {0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3, 0x38C3};
+  for (int c = 0; c < 6; ++c) m_r.io_events[c] = {codes[c], 0};
+  for (const auto& e : m_h->events()) {
+    if (e.ob == 72) ++m_r.ob72;
+    if (e.ob == 121) ++m_r.ob121;
+    for (auto& [c, n] : m_r.io_events)
+      if (e.source == Src::Io && e.code == c) ++n;
+  }
+  m_r.simulated = now();
+  m_r.frames = m_bus[0]->stats().frames + m_bus[1]->stats().frames;
+  m_r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  return m_r;
+}
+
+}  // namespace
+
+HCampaignResult run_h_campaign(const HCampaignOptions& o) {
+  auto c = std::make_unique<HCampaignRun>(o);
+  return c->run();
+}
+
+}  // namespace pbvbus::devices

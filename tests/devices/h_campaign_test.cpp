@@ -1,0 +1,162 @@
+// The seeded H-system fault campaign (devices/h_campaign.hpp), reduced for CI: seed 7, 150
+// injections over every fault kind (CPU power/STOP of master and standby, one fibre, both
+// fibres, active/passive IM, short circuit, DP master module, comparison error, one-sided
+// OB 121, operator master swap) on two lines at 1.5 Mbit/s with the CPU pair, two switched
+// stations and one one-sided slave per line. It must see 0 output pulses, 0 mismatches between
+// the events the observer derives and HSystemModel::events(), never two masters driving the
+// switched outputs outside F6. The observer's own tests: a fault it is not told about, a
+// doctored event list, a program writing 0 once and a second master outside F6 must each be
+// caught. The full campaign (>= 1000 injections) is bench/h_campaign_bench.cpp.
+#include "pbvbus/devices/h_campaign.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+
+namespace pbvbus::devices {
+namespace {
+
+HCampaignOptions reduced(std::uint64_t seed, int steps) {
+  HCampaignOptions o;
+  o.seed = seed;
+  o.steps = steps;
+  o.gsd_dir = std::string(PBVBUS_SOURCE_DIR) + "/examples/gsd";
+  return o;
+}
+
+void print(const HCampaignResult& r) {
+  std::cout << r.summary() << "\n";
+  for (std::size_t i = 0; i < r.mismatches.size() && i < 15; ++i)
+    std::cout << "  mismatch: " << r.mismatches[i] << "\n";
+  for (const auto& p : r.pulse_reports) std::cout << "  pulse: " << p << "\n";
+}
+
+bool has(const HCampaignResult& r, const char* a, const char* b = "") {
+  return std::any_of(r.mismatches.begin(), r.mismatches.end(), [&](const std::string& m) {
+    return m.find(a) != std::string::npos && m.find(b) != std::string::npos;
+  });
+}
+
+TEST(HCampaign, ReducedCampaignHasNoPulseAndNoMismatch) {
+  const HCampaignResult r = run_h_campaign(reduced(7, 150));
+  print(r);
+  EXPECT_GE(r.injections(), 150);
+  EXPECT_EQ(r.pulses, 0u);
+  for (const auto& m : r.mismatches) ADD_FAILURE() << m;
+  // The draws depend only on the seed and the observer's own model: pinned. Every kind occurs.
+  const std::array<int, kHFaultKinds> drawn{2, 7, 3, 8, 10, 6, 2, 7, 7, 4, 4, 6, 6};
+  EXPECT_EQ(r.drawn, drawn);
+  EXPECT_EQ(r.defective, 3);         // F17 again on the same rack within 7 days
+  EXPECT_EQ(r.comparison_stops, 2);  // F16 within the first self-test cycle after a search
+  // Injections per cycle: 2 for CPU power/STOP, F5, IM, short circuit, F9; 3 for F6 (fault,
+  // fibres + STOP, RUN) and the swap (STOP, request, RUN); 1 for F16/F17 (automatic recovery)
+  // plus 1 per repeat (RUN / replace). 2 x (2+7+3+8+10+2+7+7+4) + 3 x (6+6) + 4 + 6 + 2 + 3
+  // = 100 + 36 + 15 = 151.
+  EXPECT_EQ(r.injections(), 151);
+  EXPECT_EQ(r.second_master_frames, 0u);
+  EXPECT_EQ(r.stray_dx, 0u);
+  EXPECT_GT(r.split_frames, 0u);  // F6 was seen on the wire's time line, and allowed
+  EXPECT_GT(r.dx_requests, 10000u);
+  EXPECT_GT(r.output_samples, 100000u);
+  EXPECT_GT(r.role_swaps, 0);
+  // Every event was one the observer expected (the multiset matched, so the counts agree).
+  EXPECT_EQ(r.observed_events, r.expected_events);
+  for (int c : {0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3, 0x38C3})
+    EXPECT_GT(r.events_with(static_cast<std::uint16_t>(c)), 0) << std::hex << c;
+  EXPECT_GT(r.ob72, 0);
+  EXPECT_GT(r.ob121, 0);
+}
+
+// Only comparison errors (seed 5, 10 injections): each cycle without a repeat settles at
+// self_test_time + link_up_time + update = 2000 + 2000 + (75 + 0.7 x 100) = 4145 ms after the
+// fault (the campaign polls every 5 ms from the fault; 4145 = 829 x 5). A repeat's STOP branch
+// settles link-up + update = 2145 ms after its RUN.
+TEST(HCampaign, ComparisonErrorsSettleAfterSearchLinkUpAndUpdate) {
+  HCampaignOptions o = reduced(5, 10);
+  o.weights = {};
+  o.weights[static_cast<int>(HFault::ComparisonError)] = 1;
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  for (const auto& m : r.mismatches) ADD_FAILURE() << m;
+  EXPECT_EQ(r.pulses, 0u);
+  EXPECT_EQ(r.max_settle, 4145 * bus::kTicksPerMs);
+  EXPECT_EQ(r.drawn[static_cast<int>(HFault::ComparisonError)],
+            r.injections() - r.comparison_stops);
+  // Each cycle: OB 72 ComparisonError; without a repeat also OB 72 MasterSwap on both CPUs.
+  const int cycles = r.drawn[static_cast<int>(HFault::ComparisonError)];
+  EXPECT_EQ(r.ob72, cycles + 2 * (cycles - r.comparison_stops));
+  EXPECT_EQ(r.events_with(0x39C3), cycles);
+  EXPECT_EQ(r.events_with(0x38C3), cycles);
+}
+
+// Unusable options are refused with a clear error, nothing runs.
+TEST(HCampaign, BadOptionsAreRefused) {
+  HCampaignOptions o = reduced(1, 10);
+  o.weights = {};
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.weights[3] = -1;
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.fault_min = o.fault_max + 1;
+  EXPECT_THROW(run_h_campaign(o), std::invalid_argument);
+  o = reduced(1, 10);
+  o.gsd_dir = "/nonexistent";
+  EXPECT_THROW(run_h_campaign(o), std::runtime_error);
+  o = reduced(1, 10);
+  o.baud = bus::Baud::k12M;  // PBVB0A11 has no 12M_supp
+  EXPECT_THROW(run_h_campaign(o), std::runtime_error);
+}
+
+// The standby CPU off and on again without telling the observer: its OB 72 and the 39C3 /
+// 38C3 of its side are unexpected.
+TEST(HCampaign, ObserverCatchesAFaultItWasNotToldAbout) {
+  HCampaignOptions o = reduced(11, 6);
+  o.tamper.hidden_fault_at = 1;
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  EXPECT_TRUE(has(r, "hidden fault", "unexpected [OB 72 standby CPU lost"));
+  EXPECT_TRUE(has(r, "hidden fault", "unexpected [OB 86 39C3"));
+  EXPECT_TRUE(has(r, "hidden repair", "unexpected [OB 86 38C3"));
+}
+
+// One OB 72 dropped from the event list: missing.
+TEST(HCampaign, ObserverCatchesADoctoredEventList) {
+  HCampaignOptions o = reduced(11, 6);
+  o.tamper.doctor_events = [](std::vector<HSystemEvent>& ev) {
+    auto it = std::find_if(ev.begin(), ev.end(), [](const HSystemEvent& e) { return e.ob == 72; });
+    if (it != ev.end()) ev.erase(it);
+  };
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  EXPECT_TRUE(has(r, "missing [OB 72"));
+}
+
+// The program writes 0 once (at 6 s, in Redundant mode): a pulse on both switched stations.
+TEST(HCampaign, ObserverCatchesAProgramGlitchWritingZero) {
+  HCampaignOptions o = reduced(11, 4);
+  o.tamper.zero_output_at = 6000 * bus::kTicksPerMs;
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  EXPECT_GE(r.pulses, 2u);
+  ASSERT_FALSE(r.pulse_reports.empty());
+  EXPECT_NE(r.pulse_reports[0].find("outputs 0"), std::string::npos);
+}
+
+// Both fibres cut while the observer is told one fibre: two masters drive outside F6.
+TEST(HCampaign, ObserverCatchesASecondMasterOutsideF6) {
+  HCampaignOptions o = reduced(11, 6);
+  o.tamper.second_master_at = 1;
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  EXPECT_GT(r.second_master_frames, 0u);
+  EXPECT_TRUE(has(r, "two masters drive the switched outputs outside F6"));
+  EXPECT_GT(r.stray_dx, 0u);  // the standby's line kept its Data_Exchange
+}
+
+}  // namespace
+}  // namespace pbvbus::devices

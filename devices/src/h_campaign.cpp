@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
@@ -571,8 +572,30 @@ void HCampaignRun::check_roles() {
 }
 
 void HCampaignRun::match_all() {
-  std::vector<HSystemEvent> ev = m_h->events();
-  if (m_o.tamper.doctor_events) m_o.tamper.doctor_events(ev);
+  std::vector<HSystemEvent> all = m_h->events();
+  if (m_o.tamper.doctor_events) m_o.tamper.doctor_events(all);
+  // OB 85 (process-image transfer error) comes at the first OB 1 that misses a slave, on the
+  // model's scan grid, which this observer does not model: it is checked for consistency
+  // instead (only one-sided slaves, incoming and outgoing alternating per station, each
+  // episode closed once the system is back) and kept out of the per-step matching.
+  std::vector<HSystemEvent> ev;
+  std::map<int, bool> ob85_open;
+  for (const auto& e : all) {
+    if (e.source != Src::Image) {
+      ev.push_back(e);
+      continue;
+    }
+    ++m_r.ob85;
+    const bool one_sided = e.station == kOne[0] || e.station == kOne[1];
+    const bool in = e.code == 0x39B1;
+    bool& open = ob85_open[e.station];
+    if (!one_sided || e.ob != 85 || (e.code != 0x39B1 && e.code != 0x38B1) || open == in)
+      m_r.mismatches.push_back(fmt_time(e.time) + ": OB 85 out of order or for a switched station: " + fmt(e));
+    open = in;
+  }
+  for (const auto& [station, open] : ob85_open)
+    if (open)
+      m_r.mismatches.push_back("OB 85 for station " + std::to_string(station) + " never went outgoing");
   m_r.observed_events = static_cast<int>(ev.size());
   std::size_t i = 0;
   for (std::size_t si = 0; si < m_steps.size(); ++si) {

@@ -134,6 +134,7 @@ struct HCampaignResult {
   /// Events of HSystemModel::events() by code (I/O) or OB (72, 121).
   std::array<std::pair<std::uint16_t, int>, 6> io_events{};
   int ob72 = 0, ob121 = 0;
+  int ob85 = 0;  ///< OB 85 events (checked for consistency, not matched per step)
   int expected_events = 0;
   int observed_events = 0;
   std::uint64_t output_samples = 0;

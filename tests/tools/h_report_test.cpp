@@ -175,7 +175,7 @@ TEST(HReport, JsonKeysAndTimes) {
   EXPECT_EQ(j.rfind(",\"h_systems_run\":[{\"name\":\"H-CPU\",\"profile\":\"S7-400H\",\"system_mode\":\"Redundant\","
                     "\"cpus\":[{\"rack\":0,\"state\":\"RUN\",\"role\":\"standby\",\"system_mode\":\"Redundant\","
                     "\"leds\":{\"mstr\":false,\"rack0\":true,\"rack1\":false,\"redf\":\"off\",\"ifm1f\":false,"
-                    "\"ifm2f\":false},\"diag\":[{\"time_ns\":0,\"time_ms\":0.000,\"role\":\"none\",\"code\":0,"
+                    "\"ifm2f\":false,\"busf\":[]},\"diag\":[{\"time_ns\":0,\"time_ms\":0.000,\"role\":\"none\",\"code\":0,"
                     "\"text\":\"OFF -> STOP (power on)\"}",
                     0),
             0u)

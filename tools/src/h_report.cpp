@@ -269,7 +269,9 @@ void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os) {
          << devices::to_string(c.role, p) << ", sees " << devices::to_string(c.mode, p)
          << "; LEDs MSTR " << (l.mstr ? "on" : "off") << ", RACK" << c.rack << " "
          << ((c.rack == 0 ? l.rack0 : l.rack1) ? "on" : "off") << ", REDF " << devices::to_string(l.redf)
-         << ", IFM1F " << (l.ifm1f ? "on" : "off") << ", IFM2F " << (l.ifm2f ? "on" : "off") << "\n";
+         << ", IFM1F " << (l.ifm1f ? "on" : "off") << ", IFM2F " << (l.ifm2f ? "on" : "off");
+      for (std::size_t k = 0; k < c.busf.size(); ++k) os << ", BUS" << (k + 1) << "F " << c.busf[k];
+      os << "\n";
     }
     for (const HCpuReport& c : s.cpus) {
       os << "  " << cpu_name(c.rack) << " timeline:\n";
@@ -363,7 +365,9 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
          << ",\"system_mode\":" << json_quote(devices::to_string(c.mode)) << ",\"leds\":{\"mstr\":" << b(l.mstr)
          << ",\"rack0\":" << b(l.rack0) << ",\"rack1\":" << b(l.rack1)
          << ",\"redf\":" << json_quote(devices::to_string(l.redf)) << ",\"ifm1f\":" << b(l.ifm1f)
-         << ",\"ifm2f\":" << b(l.ifm2f) << "},\"diag\":[";
+         << ",\"ifm2f\":" << b(l.ifm2f) << ",\"busf\":[";
+      for (std::size_t x = 0; x < c.busf.size(); ++x) os << (x ? "," : "") << json_quote(c.busf[x]);
+      os << "]},\"diag\":[";
       for (std::size_t d = 0; d < c.diag.size(); ++d) {
         const auto& e = c.diag[d];
         os << (d ? "," : "") << "{";

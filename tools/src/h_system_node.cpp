@@ -205,6 +205,12 @@ void HSystemNode::on_pair_event(const devices::HEvent& e) {
 
 HSystemReport HSystemNode::report() const {
   HSystemReport r = make_h_report(plan().name, m_model->pair());
+  for (int rack = 0; rack < 2; ++rack) {
+    HCpuReport& c = r.cpus[static_cast<std::size_t>(rack)];
+    for (devices::BusLed l : m_model->leds(rack).busf) c.busf.emplace_back(devices::to_string(l));
+    // The buffer as the CPU has it: its own entries and the I/O events it logged.
+    c.diag = m_model->diag_buffer(rack);
+  }
   r.planned_t_p15 = m_planned_t_p15;
   r.planned_t_ph = m_planned_t_ph;
   r.faults = m_faults;

@@ -60,6 +60,10 @@ struct HCpuReport {
   devices::CpuRole role = devices::CpuRole::None;
   devices::SystemMode mode = devices::SystemMode::Stop;  ///< as this CPU sees it
   devices::CpuLeds leds;
+  /// BUS1F, BUS2F, ... per driven DP master system ("off", "on", "flashing"; devices::BusLed),
+  /// filled by the runtime; empty without one.
+  std::vector<std::string> busf;
+  /// Merged with the I/O events' entries by the runtime (HSystemModel::diag_buffer).
   std::vector<devices::DiagEntry> diag;
   std::vector<HTimelineRow> timeline;
 };

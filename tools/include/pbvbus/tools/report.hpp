@@ -103,7 +103,23 @@
 //                          "system_level": bool, "fault": str, "fault_ns": int,
 //                          "commanded_ns": int, "fresh_ns": int|null,
 //                          "measured_ns": int|null, "bound_ns": int, "exceeded": bool } ],
-//       "exceeded": int } ] }
+//       "exceeded": int } ],
+//     "h_systems_run": [ {          // every simulated h_system (docs/h-scenarios.md, h_report.hpp)
+//       "name","profile","system_mode": str,
+//       "cpus": [ { "rack": int, "state","role","system_mode": str,
+//                   "leds": { "mstr","rack0","rack1": bool, "redf": str, "ifm1f","ifm2f": bool,
+//                             "busf": [str] },               // per driven DP master system
+//                   "diag": [ { "time_ns","time_ms", "role": str, "code": int, "text": str } ],
+//                   "timeline": [ { "time_ns","time_ms", "kind","change","state","role",
+//                                   "system_mode","redf": str, "mstr": bool, "ob","code": int,
+//                                   "reason": str } ] } ],
+//       "faults": [ { "time_ns","time_ms", "text": str } ],
+//       "io_map": [ { "station","module","in_addr","in_len","out_addr","out_len": int } ],
+//       "io_events": [ { "time_ns","time_ms", "racks": [int], "ob","code": int, "text": str } ],
+//       "updates": [ { "rack": int, "t1_*","t3_*","t4_*","t5_*", "completed": bool,
+//                      "t_p15_window_*","planned_t_p15_*", "t_p15_verdict": str,
+//                      "t_ph_window_*","planned_t_ph_*", "t_ph_verdict": str,
+//                      "last_io_before_*","first_io_after_*" } ] } ] }   // *_ns, *_ms; null
 //
 // A DP slave's "requests" count each request that reached its DP layer once, from any master
 // (FCB repeats are answered by its FDL layer and counted under "fdl"."repeats"), so they match

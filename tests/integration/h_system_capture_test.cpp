@@ -10,6 +10,7 @@
 #include <fstream>
 #include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "../captures/tshark_helpers.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
@@ -23,7 +24,9 @@ namespace ts = pbvbus::test;
 
 const std::string& capture_file() {
   static const std::string path = [] {
-    const std::string p = std::string(PBVBUS_BINARY_DIR) + "/h_system_default.pcapng";
+    // One file per process: ctest runs each test in its own process, in parallel.
+    const std::string p = std::string(PBVBUS_BINARY_DIR) + "/h_system_default." +
+                          std::to_string(::getpid()) + ".pcapng";
     std::ofstream f(p, std::ios::binary);
     const auto loaded = parse_scenario(default_scenario_text(), "<default>");
     EXPECT_TRUE(loaded.ok());

@@ -129,9 +129,11 @@ TEST(HF2F18Scenario, RunShowsStopResetRequestAndSyncError) {
   EXPECT_TRUE(has_row(c1, 5 * kS, "CPU 1: role standby -> master"));
   EXPECT_TRUE(has_row(c1, 5 * kS, "CPU 1: OB 72 (master CPU in STOP)"));
   // The STOP -> RUN at 7 s is refused: no state row for CPU 0 between 5 s and 12 s.
-  for (const auto& t : c0.timeline)
-    if (t.kind == devices::HEvent::Kind::State)
+  for (const auto& t : c0.timeline) {
+    if (t.kind == devices::HEvent::Kind::State) {
       EXPECT_FALSE(t.at > 5 * kS && t.at < 12 * kS) << t.change;
+    }
+  }
   // After the memory reset (10 s), the STOP -> RUN at 12 s: 12 + 2 = 14 s, + 0.145 = 14.145 s.
   EXPECT_TRUE(has_row(c0, 12 * kS, "CPU 0: STOP -> LINK-UP"));
   EXPECT_TRUE(has_row(c0, 14 * kS, "CPU 0: LINK-UP -> UPDATE"));

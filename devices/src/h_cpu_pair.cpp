@@ -985,6 +985,31 @@ bool HCpuPair::one_sided_ob121(int r, bus::Ticks now) {
   return true;
 }
 
+bool HCpuPair::load_memory_error(int r, bus::Ticks now) {
+  check_rack(r);
+  run_due(now);
+  Cpu& c = m_cpu[r];
+  if (!powered(r) || c.state == CpuState::Defective) return false;
+  // The reset request first: nothing may restart the CPU (switch_to_run, power-on, the F19
+  // retry all check it) until a memory reset.
+  c.reset_request = true;
+  c.retry_at = bus::kNever;
+  c.retrying = false;
+  diag(r, now, "load-memory access error: STOP, reset request (memory reset needed)");
+  if (c.state != CpuState::Stop) {
+    // As a STOP of r (switch_to_stop), but the mode switch stays at its position.
+    const CpuState was = c.state;
+    const bool was_master = c.role == CpuRole::Master;
+    const bool lk = linked(r);
+    stop_cpu(r, now, "load-memory access error");
+    if (lk) partner_lost(r, was_master, was, false, now);
+    if (lk && was_master && m_cpu[partner(r)].role == CpuRole::Master)
+      set_role(r, CpuRole::Standby, now, "partner is master");
+  }
+  after_step(now);
+  return true;
+}
+
 void HCpuPair::inject_hardware_fault(int r, bus::Ticks now) {
   check_rack(r);
   run_due(now);

@@ -26,4 +26,36 @@ bool HSystemModel::memory_reset(int rack) {
   return ok;
 }
 
+bool HSystemModel::load_memory_error(int rack) {
+  if (!valid_rack(rack)) return false;
+  const bool ok = m_pair.load_memory_error(rack, m_sched.now());
+  after_op();
+  return ok;
+}
+
+bool HSystemModel::inject_sync_error() {
+  // The reaction of scan_execution's F18 (h_system_program.cpp), for a sync error injected by a
+  // scenario ("diverging uninitialised data", digest §7 F18, §5): the same entries, then the
+  // standby's switch_to_stop. Only a Redundant pair has two CPUs in step that can diverge.
+  const bus::Ticks now = m_sched.now();
+  m_pair.on_time(now);  // deadlines due now first, as every pair operation does
+  if (m_pair.system_mode() != SystemMode::Redundant) {
+    after_op();  // the deadlines just run may have changed a side
+    return false;
+  }
+  const int standby = 1 - m_pair.master();
+  const auto cap = m_pair.params().diag_capacity;
+  for (int r = 0; r < 2; ++r) {
+    if (m_pair.state(r) == CpuState::Off) continue;
+    auto& dg = m_io_diag[static_cast<std::size_t>(r)];
+    dg.push_back({now, m_pair.role(r), 0,
+                  "sync error (F18): diverging uninitialised data; standby rack " +
+                      std::to_string(standby) + " to STOP"});
+    if (cap > 0 && dg.size() > cap) dg.erase(dg.begin());
+  }
+  m_pair.switch_to_stop(standby, now);
+  after_op();
+  return true;
+}
+
 }  // namespace pbvbus::devices

@@ -166,6 +166,12 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
     case K::MemoryReset:
       if (!m.memory_reset(f.rack)) text += ": refused";
       break;
+    case K::LoadMemoryError:
+      if (!m.load_memory_error(f.rack)) text += ": refused (CPU off or DEFECTIVE)";
+      break;
+    case K::SyncError:
+      if (!m.inject_sync_error()) text += ": not in Redundant mode, nothing happens";
+      break;
     default: break;
   }
   m_faults.back().second = text;  // with what the pair answered ("refused", ...)

@@ -675,6 +675,9 @@ class Planner {
       case FK::kProgramChange: info = {K::ProgramChange, "program_change", false}; break;
       case FK::kParameterChange: info = {K::ParameterChange, "parameter_change", false}; break;
       case FK::kMemoryReset: info = {K::MemoryReset, "memory_reset", false}; break;
+      // F2's repair is a memory reset: a memory_reset fault of its own, not a repair_at.
+      case FK::kLoadMemoryError: info = {K::LoadMemoryError, "load_memory_error", false}; break;
+      case FK::kSyncError: info = {K::SyncError, "sync_error", false}; break;
       default: return false;
     }
     pf.kind = info.kind;
@@ -687,6 +690,8 @@ class Planner {
       case FK::kHardwareFault: cpu = &f.hardware_fault(); break;
       case FK::kCpuHold: cpu = &f.cpu_hold(); break;
       case FK::kMemoryReset: cpu = &f.memory_reset(); break;
+      case FK::kLoadMemoryError: cpu = &f.load_memory_error(); break;
+      case FK::kSyncError: h_name = f.sync_error().h_system(); break;
       case FK::kFibreCut:
         h_name = f.fibre_cut().h_system();
         if (f.fibre_cut().has_fibre()) fibre = f.fibre_cut().fibre();
@@ -709,7 +714,11 @@ class Planner {
     const std::string kind(info.field);
     bool good = true;
     if (!info.repair && !f.repair_at().empty()) {
-      error(at_field(w, fd, "repair_at"), kind + " has no repair: remove repair_at");
+      error(at_field(w, fd, "repair_at"),
+            kind + " has no repair: remove repair_at" +
+                (info.kind == K::LoadMemoryError
+                     ? std::string(" (the repair is a memory_reset fault, then a cpu_stop repair)")
+                     : std::string()));
       good = false;
     }
     // The h_system: by name, or the only simulated one.
@@ -864,6 +873,8 @@ class Planner {
         case FK::kProgramChange:
         case FK::kParameterChange:
         case FK::kMemoryReset:
+        case FK::kLoadMemoryError:
+        case FK::kSyncError:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::KIND_NOT_SET:
@@ -1019,6 +1030,8 @@ std::string h_fault_description(const PlanFault& f) {
     case K::ProgramChange: return "program change in RUN (" + std::string(to_string(f.change)) + ")";
     case K::ParameterChange: return "a parameter that may not change is changed, then a master swap";
     case K::MemoryReset: return "memory reset of " + cpu + " after its reset request";
+    case K::LoadMemoryError: return cpu + ": load-memory access error";
+    case K::SyncError: return "sync error (diverging uninitialised data)";
     default: return {};
   }
 }
@@ -1038,7 +1051,9 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::UpdateLoad:
     case K::ProgramChange:
     case K::ParameterChange:
-    case K::MemoryReset: return true;
+    case K::MemoryReset:
+    case K::LoadMemoryError:
+    case K::SyncError: return true;
     default: return false;
   }
 }

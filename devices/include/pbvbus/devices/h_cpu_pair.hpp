@@ -57,6 +57,10 @@
 // - R8: connect(r) counts S7 connections; refused on a CPU off/ERROR-SEARCH/DEFECTIVE and on
 //   both CPUs while a CPU is in LINK-UP or UPDATE; link-up breaks the standby's, keeps the
 //   master's; power-off drops a CPU's.
+// - F2 load_memory_error(r): r -> STOP + reset request (the F20 mechanism: STOP until
+//   memory_reset(), then a STOP -> RUN), entry "load-memory access error" (no event ID in the
+//   seeds: code 0); the partner's reaction is the one to a STOP of r (no new HReason: the OB 72
+//   reads MasterStop/StandbyStop, the buffer entry names the cause). Refused on off/DEFECTIVE.
 // - F22 load_change(): Allowed -> buffer entry; a structural FB-interface or global-DB change
 //   in Redundant -> both CPUs STOP (no OB 72), in Solo -> loaded; refused unless Solo or
 //   Redundant (no block load during link-up/update). F23: with set_standby_parameter_change
@@ -267,6 +271,13 @@ class HCpuPair {
   bool inject_comparison_error(bus::Ticks now);
   /// OB 121 on `rack` only (F17); false unless the system is Redundant.
   bool one_sided_ob121(int rack, bus::Ticks now);
+  /// F2: a load-memory access error on `rack`: that CPU -> STOP with a reset request (no start
+  /// until memory_reset()), a buffer entry on it; the partner reacts as to any STOP of it
+  /// (master in Redundant: the standby becomes master in Solo, OB 72 MasterStop; standby: Solo,
+  /// OB 72 StandbyStop on the master; the lone master: system STOP; during link-up/update: the
+  /// link-up is aborted). The mode switch stays where it is. A CPU already in STOP only gets the
+  /// reset request and the entry. false (nothing happens) on a CPU that is off or DEFECTIVE.
+  bool load_memory_error(int rack, bus::Ticks now);
   /// A latent hardware fault on `rack` that the next full self-test finds (-> DEFECTIVE).
   void inject_hardware_fault(int rack, bus::Ticks now);
   /// The CPU is replaced or its fault removed: clears the fault, the OB 121 history and

@@ -177,6 +177,12 @@ class HSystemModel final : public bus::EventTarget {
   HChangeResult load_change(HChange kind);   ///< F22
   void set_standby_parameter_change(bool may_not_change);  ///< F23 (then a swap: W#16#5966)
   bool memory_reset(int rack);                              ///< F20: clears a reset request
+  /// F2: HCpuPair::load_memory_error on `rack` (false: bad rack, CPU off or DEFECTIVE).
+  bool load_memory_error(int rack);
+  /// F18 without a program: exactly the reaction of the program's sync error (the standby's
+  /// switch_to_stop: standby STOP, Solo, OB 72 StandbyStop on the master; a "sync error (F18)"
+  /// entry in both buffers). false (nothing happens) unless the system is Redundant.
+  bool inject_sync_error();
   /// Every event of the pair (state, role, system mode, OB) as it happens, after the model
   /// took it in (for a runtime's capture; events() keeps only the OBs).
   void set_pair_event_handler(std::function<void(const HEvent&)> h) {

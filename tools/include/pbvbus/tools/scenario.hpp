@@ -21,12 +21,12 @@
 //    simply not reached and the report says so.
 //  - `capture { line: "A" at: 14 }` must name a station on that line by its FDL address; two
 //    entries for the same point (or two without `at` for one line) are an error.
-//  - H-system faults (cpu_failure ... memory_reset; docs/h-scenarios.md) name an h_system with
-//    a `cpu` part (the name may be left out when there is only one), a rack or fibre 0/1 where
-//    the kind needs one; repair_at only where a repair exists (power returns, RUN again,
-//    spliced, replaced, released); HOLD and the operator swap not on an S7-1500R/H pair. They
-//    are planned with line = -1 and are not applied by the Simulation until the H-system
-//    runtime exists.
+//  - H-system faults (cpu_failure ... memory_reset, load_memory_error, sync_error;
+//    docs/h-scenarios.md) name an h_system with a `cpu` part (the name may be left out when
+//    there is only one), a rack or fibre 0/1 where the kind needs one; repair_at only where a
+//    repair exists (power returns, RUN again, spliced, replaced, released); HOLD and the
+//    operator swap not on an S7-1500R/H pair. They are planned with line = -1 and are not
+//    applied by the Simulation until the H-system runtime exists.
 
 #include <cstdint>
 #include <optional>
@@ -130,6 +130,8 @@ struct PlanFault {
     ProgramChange,    ///< F22, `change`
     ParameterChange,  ///< F23: a parameter that may not change, then a master swap (W#16#5966)
     MemoryReset,      ///< F20: memory reset of `rack` after its reset request
+    LoadMemoryError,  ///< F2, `rack`: STOP + reset request; repair: a memory_reset fault
+    SyncError,        ///< F18: diverging uninitialised data, the standby STOPs
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -159,7 +161,7 @@ struct PlanFault {
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
 };
 
-/// An H-system fault kind (CpuFailure .. MemoryReset)?
+/// An H-system fault kind (CpuFailure .. SyncError)?
 bool is_h_fault(PlanFault::Kind k);
 /// "CPU 0 (rack 0) fails", "sync-link fibre 1 (lower) cut", ... (without the h_system name).
 std::string h_fault_description(const PlanFault& f);

@@ -43,19 +43,25 @@ bool HSystemModel::inject_sync_error() {
     after_op();  // the deadlines just run may have changed a side
     return false;
   }
-  const int standby = 1 - m_pair.master();
+  sync_error_reaction(1 - m_pair.master(), now, "diverging uninitialised data");
+  after_op();
+  return true;
+}
+
+void HSystemModel::sync_error_reaction(int standby, bus::Ticks now, std::string_view cause) {
+  // The pair has no sync-error operation: the standby's switch_to_stop gives exactly F18's
+  // reaction (standby STOP, Solo, OB 72 StandbyStop on the master); like every fault STOP it
+  // needs a STOP -> RUN to restart. Both CPUs log it.
   const auto cap = m_pair.params().diag_capacity;
   for (int r = 0; r < 2; ++r) {
     if (m_pair.state(r) == CpuState::Off) continue;
     auto& dg = m_io_diag[static_cast<std::size_t>(r)];
     dg.push_back({now, m_pair.role(r), 0,
-                  "sync error (F18): diverging uninitialised data; standby rack " +
+                  "sync error (F18): " + std::string(cause) + "; standby rack " +
                       std::to_string(standby) + " to STOP"});
     if (cap > 0 && dg.size() > cap) dg.erase(dg.begin());
   }
   m_pair.switch_to_stop(standby, now);
-  after_op();
-  return true;
 }
 
 }  // namespace pbvbus::devices

@@ -49,20 +49,8 @@ void HSystemModel::scan_execution(bus::Ticks now) {
     out = res.output_rack;
     // A sync error happens during the run, the comparison at its end: F18 first.
     if (res.sync_error && master >= 0) {
-      // F18: the CPUs asked for different sync points. The pair has no sync-error operation;
-      // the standby's switch_to_stop gives exactly the reaction (standby STOP, Solo, OB 72
-      // StandbyStop on the master); like every fault STOP it needs a STOP -> RUN to restart.
-      const int standby = 1 - master;
-      const auto cap = m_pair.params().diag_capacity;
-      for (int r = 0; r < 2; ++r) {
-        if (m_pair.state(r) == CpuState::Off) continue;
-        auto& dg = m_io_diag[static_cast<std::size_t>(r)];
-        dg.push_back({now, m_pair.role(r), 0,
-                      "sync error (F18): the CPUs took different paths; standby rack " +
-                          std::to_string(standby) + " to STOP"});
-        if (cap > 0 && dg.size() > cap) dg.erase(dg.begin());
-      }
-      m_pair.switch_to_stop(standby, now);
+      // F18: the CPUs asked for different sync points.
+      sync_error_reaction(1 - master, now, "the CPUs took different paths");
       after_op();
     } else if (res.comparison_error) {
       // F16 found by the comparison itself: the pair's reaction (standby ERROR-SEARCH or STOP,

@@ -245,6 +245,8 @@ class HSystemModel final : public bus::EventTarget {
   void apply(std::size_t system, int rack, SideMode to);
   void scan(bus::Ticks now);
   void scan_execution(bus::Ticks now);  // h_system_program.cpp
+  /// F18's reaction (h_system_ops.cpp): diag entries on both CPUs, the standby to STOP.
+  void sync_error_reaction(int standby, bus::Ticks now, std::string_view cause);
   void track_update(bus::Ticks now);    // h_system_update.cpp
   void on_alarm(std::size_t system, const redundancy::SystemAlarm& a);  // h_system_alarms.cpp
   void deliver_alarm(HSystemEvent h, bus::Ticks now);

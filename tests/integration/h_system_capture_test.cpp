@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -22,12 +23,26 @@ namespace {
 
 namespace ts = pbvbus::test;
 
+std::string g_written;  // the capture this process wrote, removed at the end if all passed
+
+// The capture stays for a look only when a test failed (ctest leaves one per process).
+class RemoveCapture : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    if (!g_written.empty() && ::testing::UnitTest::GetInstance()->Passed())
+      std::remove(g_written.c_str());
+  }
+};
+[[maybe_unused]] ::testing::Environment* const g_remove =
+    ::testing::AddGlobalTestEnvironment(new RemoveCapture);
+
 const std::string& capture_file() {
   static const std::string path = [] {
     // One file per process: ctest runs each test in its own process, in parallel.
     const std::string p = std::string(PBVBUS_BINARY_DIR) + "/h_system_default." +
                           std::to_string(::getpid()) + ".pcapng";
     std::ofstream f(p, std::ios::binary);
+    g_written = p;
     const auto loaded = parse_scenario(default_scenario_text(), "<default>");
     EXPECT_TRUE(loaded.ok());
     if (!loaded.ok()) return p;

@@ -993,7 +993,10 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   }
 
   // Layout.
-  int y = kHeadH + kAxisH + kEvH;
+  // The CPU rows' legend takes a second line in the header.
+  const CpuRowIndex cpu_rows(tl);
+  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16);
+  int y = head_h + kAxisH + kEvH;
   std::vector<int> lane_y;
   for (const auto& L : tl.lanes) {
     lane_y.push_back(y);
@@ -1005,7 +1008,6 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   for (std::size_t i = 0; i < tl.active_channels.size(); ++i)
     if (i == 0 || tl.active_channels[i - 1].station != tl.active_channels[i].station) ++ac_rows;
   if (ac_rows) y += ac_rows * kRowAc + kLaneGap;
-  const CpuRowIndex cpu_rows(tl);
   const int cpu_y = y;
   if (!cpu_rows.row.empty()) y += static_cast<int>(cpu_rows.row.size()) * kRowCpu + kLaneGap;
   const int lanes_end = y;
@@ -1043,7 +1045,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
          "</tspan></text>\n";
   {
     double lx = 12;
-    const int ly = 40;
+    int ly = 40;
     auto sw = [&](const std::string& colour, const std::string& text, bool line) {
       if (line)
         c.o += "<rect x=\"" + num(lx) + "\" y=\"" + std::to_string(ly - 10) + "\" width=\"3\" height=\"12\" fill=\"" + colour + "\"/>";
@@ -1071,11 +1073,16 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
       sw("url(#achatch)", "none", false);
     }
     if (!cpu_rows.row.empty()) {
+      lx = 12;
+      ly += 16;
       head("CPU state");
       std::set<int> states;
       for (const CpuStateSpan& s : tl.cpu_states) states.insert(s.state);
       for (int st : states) sw(cpu_state_colour(st), cpu_state_name(st), false);
       sw(kObColour, "OB", true);
+      c.o += "<text x=\"" + num(lx) + "\" y=\"" + std::to_string(ly) +
+             "\" font-size=\"12\" fill=\"#68717d\">(lighter: standby)</text>\n";
+      lx += 18 * 6.8 + 12;
     }
     head("events");
     sw(event_colour(EventStyle::Fault), "fault", true);
@@ -1084,7 +1091,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   }
   // Time axis.
   {
-    const int ay = kHeadH;
+    const int ay = head_h;
     const std::int64_t span = std::max<std::int64_t>(1, diff(c.from, c.to));
     const std::int64_t step = nice_step(static_cast<double>(span) / std::max(2.0, c.plot_w / 130));
     int dec = 0;
@@ -1162,7 +1169,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     c.o += "</g>\n";
   }
   c.o += "<g class=\"events\" clip-path=\"url(#plotclip)\">\n";
-  svg_events(c, tl, kHeadH + kAxisH + 2, lanes_end - kLaneGap + 4);
+  svg_events(c, tl, head_h + kAxisH + 2, lanes_end - kLaneGap + 4);
   c.o += "</g>\n";
   // Summary.
   int sy = lanes_end + 14;

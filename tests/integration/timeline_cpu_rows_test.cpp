@@ -134,8 +134,8 @@ TEST_F(TimelineCpuRows, ModelOfTheCapture) {
   EXPECT_EQ(s->state, 2);  // STARTUP
   EXPECT_EQ(s->role, 1);   // master
   EXPECT_EQ(s->end_ns, 1000 * kMs);
-  // CPU 1's link-up after F1's repair of rack 0 ... no: CPU 0 returns at 14 s as standby and
-  // links up 14 s .. 16 s (link-up 2 s), then UPDATE 16 s .. 16.145 s (W = 145 ms).
+  // CPU 0 returns at 14 s as standby and links up 14 s .. 16 s (link-up 2 s), then UPDATE
+  // 16 s .. 16.145 s (W = 145 ms).
   s = find(0, 16000 * kMs);
   ASSERT_NE(s, nullptr);
   EXPECT_EQ(s->state, 5);  // UPDATE

@@ -3,6 +3,30 @@
 
 namespace pbvbus::captures {
 
+namespace {
+std::string name_of(int v, const char* const* names, int count, const char* what) {
+  if (v >= 0 && v < count) return names[v];
+  return std::string(what) + " " + std::to_string(v);
+}
+}  // namespace
+
+std::string cpu_state_name(int state) {
+  static const char* const kNames[] = {"OFF",  "STOP", "STARTUP",      "RUN",       "LINK-UP",
+                                       "UPDATE", "HOLD", "ERROR-SEARCH", "DEFECTIVE", "SYNCUP"};
+  return name_of(state, kNames, 10, "state");
+}
+
+std::string cpu_role_name(int role) {
+  static const char* const kNames[] = {"none", "master", "standby"};
+  return name_of(role, kNames, 3, "role");
+}
+
+std::string cpu_system_mode_name(int mode) {
+  static const char* const kNames[] = {"Stop",   "Startup",   "Solo", "Link-up",
+                                       "Update", "Redundant", "Hold", "SYNCUP"};
+  return name_of(mode, kNames, 8, "mode");
+}
+
 EventRecord cpu_event_record(const CpuEventFields& f) {
   EventRecord r;
   r.category = EventCategory::Cpu;

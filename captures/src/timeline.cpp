@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "pbvbus/bus/tap.hpp"
+#include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "capture_names.hpp"
 
@@ -322,6 +323,87 @@ std::vector<ActiveChannelSpan> active_channels(const std::vector<TimelineEvent>&
   return out;
 }
 
+/// The H system's name in a Cpu record's text (timeline.hpp "CPU rows"): the part before
+/// ": CPU <who>: ", or "" when the text starts with "CPU <who>: " or names no CPU that way.
+std::string cpu_system_of(const std::string& text, int rack) {
+  const std::string who = "CPU " + (rack < 0 ? std::string("0+1") : std::to_string(rack)) + ": ";
+  if (text.compare(0, who.size(), who) == 0) return "";
+  const auto p = text.find(": " + who);
+  return p == std::string::npos ? std::string() : text.substr(0, p);
+}
+
+struct CpuRows {
+  std::vector<CpuStateSpan> spans;
+  std::vector<CpuObMark> obs;
+};
+
+/// The CPU state spans and OB marks over the whole capture (timeline.hpp); `events` in time
+/// order.
+CpuRows cpu_rows(const std::vector<TimelineEvent>& events, std::int64_t end) {
+  using Key = std::pair<std::string, int>;  // (system, rack)
+  std::map<Key, std::vector<CpuStateSpan>> rows;
+  std::map<Key, std::vector<CpuObMark>> marks;
+  std::vector<std::optional<CpuEventFields>> fields(events.size());
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    if (events[i].record.category != EventCategory::Cpu) continue;
+    fields[i] = cpu_event_fields(events[i].record);
+    const auto& f = fields[i];
+    if (f && f->kind == CpuEventKind::State && f->rack >= 0)
+      rows.try_emplace(Key{cpu_system_of(f->text, f->rack), f->rack});
+  }
+  CpuRows out;
+  if (rows.empty()) return out;
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    if (!fields[i]) continue;
+    const CpuEventFields& f = *fields[i];
+    const std::int64_t ts = events[i].ts_ns;
+    const std::string system = cpu_system_of(f.text, f.rack);
+    if (f.kind == CpuEventKind::Ob) {
+      CpuObMark m{system, f.rack, ts, f.ob, f.event_id, f.reason, f.text};
+      if (f.rack >= 0) {
+        if (rows.count(Key{system, f.rack})) marks[Key{system, f.rack}].push_back(std::move(m));
+      } else if (f.rack == -1) {  // both CPUs: a mark on each row of the system
+        for (auto it = rows.lower_bound(Key{system, 0});
+             it != rows.end() && it->first.first == system; ++it) {
+          m.rack = it->first.second;
+          marks[it->first].push_back(m);
+        }
+      }
+      continue;
+    }
+    if (f.kind != CpuEventKind::State && f.kind != CpuEventKind::Role) continue;
+    const auto it = rows.find(Key{system, f.rack});
+    if (it == rows.end()) continue;
+    std::vector<CpuStateSpan>& row = it->second;
+    int state, role;
+    if (f.kind == CpuEventKind::State) {
+      state = f.to;
+      role = f.role;
+    } else if (row.empty()) {
+      continue;  // before the first State record
+    } else {
+      state = row.back().state;
+      role = f.to;
+    }
+    if (!row.empty()) {
+      CpuStateSpan& cur = row.back();
+      if (cur.state == state && cur.role == role) continue;
+      cur.end_ns = std::max(cur.start_ns, ts);
+      if (cur.end_ns == cur.start_ns) row.pop_back();  // replaced at the same instant
+      if (!row.empty() && row.back().state == state && row.back().role == role)
+        continue;  // back to the one before
+    }
+    row.push_back({system, f.rack, state, role, ts, ts});
+  }
+  for (auto& [key, row] : rows) {
+    if (!row.empty()) row.back().end_ns = std::max(row.back().start_ns, end);
+    out.spans.insert(out.spans.end(), row.begin(), row.end());
+    const auto m = marks.find(key);
+    if (m != marks.end()) out.obs.insert(out.obs.end(), m->second.begin(), m->second.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(FrameKind k) {
@@ -457,6 +539,13 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     if (s.start_ns < to &&
         (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
       tl.active_channels.push_back(s);
+  CpuRows cpu = cpu_rows(events, tl.last_ns);
+  for (CpuStateSpan& s : cpu.spans)
+    if (s.start_ns < to &&
+        (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
+      tl.cpu_states.push_back(std::move(s));
+  for (CpuObMark& m : cpu.obs)
+    if (m.ts_ns >= tl.from_ns && m.ts_ns < to) tl.cpu_obs.push_back(std::move(m));
   for (LaneWork& w : lanes) {
     finish_lane(w, tl.from_ns, to);
     tl.lanes.push_back(std::move(w.lane));

@@ -50,6 +50,10 @@ const DX_OK = '#3f9b57', DX_MISS = '#e03131';
 // Colours of the lanes in the active-channel rows (by lane index).
 const LANE_COLOURS = ['#1c7ed6', '#f59f00', '#0ca678', '#ae3ec9', '#d6336c', '#74b816'];
 const ROW_AC = 14;
+// CPU rows (issue 8): colours by state number (cpu_event.hpp), as the SVG's.
+const CPU_STATE_COLOURS = ['#ced4da', '#e03131', '#fab005', '#2f9e44', '#74c0fc', '#1971c2', '#f76707',
+  '#9c36b5', '#5c0a0a', '#15aabf'];
+const ROW_CPU = 22, OB_COLOUR = '#212529';
 const LABEL_W = 210, AXIS_H = 34, EV_H = 46, PAD_R = 18;
 const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18;
 const MIN_SPAN = 100;  // ns: a few bit times even at 12 Mbit/s
@@ -143,6 +147,16 @@ const evTimes = Float64Array.from(events.map(e => e.t));
 const acRows = (D.ac || []).map(R => ({ a: R.a, s: R.s }));
 function laneColour(i) { return LANE_COLOURS[i % LANE_COLOURS.length]; }
 let acY = 0;
+// CPU rows: label, system, rack, spans [start, end, state, role], OB marks [t, ob, id, reason, text].
+const CPU = D.cpu || { states: [], roles: [], rows: [] };
+const cpuRows = CPU.rows;
+function cpuStateName(n) { return CPU.states[n] !== undefined ? CPU.states[n] : 'state ' + n; }
+function cpuRoleName(n) { return CPU.roles[n] !== undefined ? CPU.roles[n] : 'role ' + n; }
+function cpuStateColour(n) { return CPU_STATE_COLOURS[n] || '#868e96'; }
+// Dark text on the light colours (OFF, STARTUP, LINK-UP).
+function cpuTextColour(n) { return n === 0 || n === 2 || n === 4 ? '#1d2126' : '#fff'; }
+function cpuLabel(sp) { return cpuStateName(sp[2]) + (sp[3] === 0 ? '' : ' ' + cpuRoleName(sp[3])); }
+let cpuY = 0;
 
 // ---- view -------------------------------------------------------------------------------
 const full = [D.span[0], D.span[1]];
@@ -194,6 +208,8 @@ function layout() {
   }
   acY = y;
   if (acRows.length) y += acRows.length * ROW_AC + LANE_GAP;
+  cpuY = y;
+  if (cpuRows.length) y += cpuRows.length * ROW_CPU + LANE_GAP;
   totalH = y;
 }
 layout();
@@ -417,6 +433,45 @@ function drawActive(s) {
   s.push('</g>');
 }
 
+function cpuSpanText(R, sp) {
+  return `${R.label.toUpperCase()}   ${cpuLabel(sp)}\nfrom ${fmtAbs(sp[0], 9)}\nto   ${fmtAbs(sp[1], 9)}\nfor  ${fmtDur(sp[1] - sp[0])}`;
+}
+function obText(R, m) {
+  const id = m[2] ? ' W#16#' + m[2].toString(16).toUpperCase().padStart(4, '0') : '';
+  return `${fmtAbs(m[0], 9)}  ${R.label}: OB ${m[1]}${id}\n${m[4]}`;
+}
+let drawnCpuSpans = 0, drawnObs = 0;
+function drawCpu(s) {
+  if (!cpuRows.length) return;
+  s.push('<g class="cpu-rows">');
+  s.push(`<rect x="0" y="${cpuY - 6}" width="${LABEL_W - 8}" height="${cpuRows.length * ROW_CPU + 12}" fill="#f7f8fa"/>`);
+  cpuRows.forEach((R, j) => {
+    const y = cpuY + j * ROW_CPU;
+    s.push(`<g class="cpu-row" data-system="${esc(R.sys)}" data-rack="${R.r}">`);
+    s.push(`<text x="${LABEL_W - 12}" y="${y + 12}" text-anchor="end" font-size="11" fill="#495057">${esc(R.label)}</text>`);
+    s.push(`<g clip-path="url(#plotclip)"><rect x="${plotX}" y="${y}" width="${plotW}" height="${ROW_CPU - 1}" fill="${j % 2 ? '#fbfbfc' : '#f4f6f8'}"/>`);
+    for (const sp of R.s) {
+      if (sp[1] < v0 || sp[0] > v1) continue;
+      const xa = Math.max(plotX, X(sp[0])), xb = Math.min(plotX + plotW, X(sp[1]));
+      const w = Math.max(1, xb - xa);
+      s.push(`<rect class="cpu-span" data-state="${esc(cpuStateName(sp[2]))}" data-role="${esc(cpuRoleName(sp[3]))}" x="${xa.toFixed(2)}" y="${y + 1}" width="${w.toFixed(2)}" height="13" fill="${cpuStateColour(sp[2])}"${sp[3] === 2 ? ' fill-opacity="0.6"' : ''}/>`);
+      const label = cpuLabel(sp);
+      if (w > label.length * 6.2 + 8)
+        s.push(`<text x="${(xa + 4).toFixed(2)}" y="${y + 11}" font-size="10" fill="${cpuTextColour(sp[2])}">${esc(label)}</text>`);
+      drawnCpuSpans++;
+    }
+    for (const m of R.ob) {
+      if (m[0] < v0 || m[0] > v1) continue;
+      const x = X(m[0]).toFixed(2);
+      s.push(`<g class="cpu-ob" data-ob="${m[1]}"><line x1="${x}" y1="${y}" x2="${x}" y2="${y + ROW_CPU - 2}" stroke="${OB_COLOUR}" stroke-width="1.5"/>` +
+        `<text x="${(X(m[0]) + 2).toFixed(2)}" y="${y + ROW_CPU - 1}" font-size="8" fill="${OB_COLOUR}">${m[1]}</text></g>`);
+      drawnObs++;
+    }
+    s.push('</g></g>');
+  });
+  s.push('</g>');
+}
+
 function drawEvents(s) {
   const i0 = lowerBound(evTimes, v0), i1 = lowerBound(evTimes, v1 + 1e-9);
   // Group events closer than 4 px; stagger the labels over three rows.
@@ -460,6 +515,8 @@ function render() {
     s.push('</g></g>');
   }
   drawActive(s);
+  drawnCpuSpans = 0; drawnObs = 0;
+  drawCpu(s);
   s.push('<g class="events" clip-path="url(#plotclip)">');
   drawEvents(s);
   s.push('</g>');
@@ -473,6 +530,9 @@ function render() {
   document.body.dataset.framesDrawn = String(drawnFrames);
   document.body.dataset.lanes = String(lanes.length);
   document.body.dataset.activeRows = String(acRows.length);
+  document.body.dataset.cpuRows = String(cpuRows.length);
+  document.body.dataset.cpuSpansDrawn = String(drawnCpuSpans);
+  document.body.dataset.cpuObsDrawn = String(drawnObs);
   if (history.replaceState) history.replaceState(null, '', '#v=' + Math.round(v0) + ',' + Math.round(v1));
 }
 
@@ -530,6 +590,13 @@ function hitTest(x, y) {
   if (acRows.length && y >= acY && y < acY + acRows.length * ROW_AC) {
     const R = acRows[Math.floor((y - acY) / ROW_AC)];
     for (const sp of R.s) if (t >= sp[0] - tol && t <= sp[1] + tol) return acText(R, sp);
+    return null;
+  }
+  if (cpuRows.length && y >= cpuY && y < cpuY + cpuRows.length * ROW_CPU) {
+    const R = cpuRows[Math.floor((y - cpuY) / ROW_CPU)];
+    const near = R.ob.filter(m => Math.abs(m[0] - t) <= tol);
+    if (near.length) return near.slice(0, 20).map(m => obText(R, m)).join('\n');
+    for (const sp of R.s) if (t >= sp[0] - tol && t <= sp[1] + tol) return cpuSpanText(R, sp);
     return null;
   }
   for (const L of lanes) {
@@ -669,6 +736,14 @@ window.addEventListener('resize', schedule);
     parts.push('<span><b>active channel</b></span>');
     lanes.forEach((L, i) => parts.push(`<span><span class="sw" style="background:${laneColour(i)}"></span>${esc(L.name || '(no name)')}</span>`));
     parts.push('<span><span class="sw" style="background:repeating-linear-gradient(45deg,#adb5bd 0 2px,#f1f3f5 2px 5px)"></span>none</span>');
+  }
+  if (cpuRows.length) {
+    parts.push('<span><b>CPU state</b></span>');
+    const states = new Set();
+    cpuRows.forEach(R => R.s.forEach(sp => states.add(sp[2])));
+    Array.from(states).sort((a, b) => a - b).forEach(n => parts.push(`<span><span class="sw" style="background:${cpuStateColour(n)}"></span>${esc(cpuStateName(n))}</span>`));
+    parts.push(`<span><span class="vl" style="background:${OB_COLOUR}"></span>OB</span>`);
+    parts.push('<span>(lighter: standby)</span>');
   }
   parts.push('<span><b>events</b></span>');
   for (const k of ['fault', 'repair', 'event']) parts.push(`<span><span class="vl" style="background:${EVENT_COLOURS[k]}"></span>${k}</span>`);

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "pbvbus/captures/cpu_event.hpp"
 #include "timeline_page.hpp"
 
 namespace pbvbus::captures {
@@ -224,6 +225,47 @@ const char* const kHolderColour[] = {"#f6bd60", "#90caf9", "#b8e0a0", "#f7a8c4",
 /// Colours of the lanes in the active-channel rows (as the page's LANE_COLOURS).
 const char* const kLaneColour[] = {"#1c7ed6", "#f59f00", "#0ca678", "#ae3ec9", "#d6336c", "#74b816"};
 const char* lane_colour(int lane) { return kLaneColour[static_cast<std::size_t>(lane) % 6]; }
+/// CPU states (cpu_event.hpp numbers; as the page's CPU_STATE_COLOURS); others grey.
+const char* const kCpuStateColour[] = {"#ced4da", "#e03131", "#fab005", "#2f9e44", "#74c0fc",
+                                       "#1971c2", "#f76707", "#9c36b5", "#5c0a0a", "#15aabf"};
+const char* cpu_state_colour(int state) {
+  return state >= 0 && state < 10 ? kCpuStateColour[state] : "#868e96";
+}
+/// Dark text on the light state colours (OFF, STARTUP, LINK-UP), white on the others.
+const char* cpu_text_colour(int state) {
+  return state == 0 || state == 2 || state == 4 ? "#1d2126" : "#fff";
+}
+constexpr const char* kObColour = "#212529";
+
+/// The CPU rows of a Timeline: (system, rack) in the order of cpu_states / cpu_obs (both by
+/// system, then rack), and whether several systems share the picture (then the labels name it).
+struct CpuRowIndex {
+  std::map<std::pair<std::string, int>, int> row;
+  bool several_systems = false;
+  explicit CpuRowIndex(const Timeline& tl) {
+    std::set<std::pair<std::string, int>> keys;
+    std::set<std::string> systems;
+    for (const CpuStateSpan& s : tl.cpu_states) keys.emplace(s.system, s.rack);
+    for (const CpuObMark& m : tl.cpu_obs) keys.emplace(m.system, m.rack);
+    int i = 0;
+    for (const auto& k : keys) {
+      row.emplace(k, i++);
+      systems.insert(k.first);
+    }
+    several_systems = systems.size() > 1;
+  }
+  int of(const std::string& system, int rack) const { return row.at({system, rack}); }
+  std::string label(const std::string& system, int rack) const {
+    const std::string cpu = "CPU " + std::to_string(rack) + " (rack " + std::to_string(rack) + ")";
+    return several_systems && !system.empty() ? sanitize_utf8(system) + ": " + cpu : cpu;
+  }
+};
+
+/// "RUN master", "STOP" (no role shown for none).
+std::string cpu_span_label(const CpuStateSpan& s) {
+  return cpu_state_name(s.state) + (s.role == 0 ? std::string() : " " + cpu_role_name(s.role));
+}
+
 const char* event_colour(EventStyle s) {
   switch (s) {
     case EventStyle::Fault:
@@ -378,12 +420,45 @@ std::string page_json(const Timeline& tl, std::int64_t origin, std::int64_t view
   }
   if (!tl.active_channels.empty()) ac += "]}";
   ac += "]";
+  // CPU rows (timeline.hpp "CPU rows"): per row its label, system and rack, spans [start, end,
+  // state, role] and OB marks [time, ob, event id, reason, text] in page time; the names of the
+  // state and role numbers once.
+  std::string cpu = "{\"states\":[";
+  for (int k = 0; k < 10; ++k) cpu += std::string(k ? "," : "") + json_str(cpu_state_name(k));
+  cpu += "],\"roles\":[";
+  for (int k = 0; k < 3; ++k) cpu += std::string(k ? "," : "") + json_str(cpu_role_name(k));
+  cpu += "],\"rows\":[";
+  {
+    const CpuRowIndex rows(tl);
+    std::vector<std::string> spans(rows.row.size()), obs(rows.row.size());
+    for (const CpuStateSpan& s : tl.cpu_states) {
+      std::string& o = spans[static_cast<std::size_t>(rows.of(s.system, s.rack))];
+      o += std::string(o.empty() ? "" : ",") + "[" + std::to_string(rel(s.start_ns, origin)) + "," +
+           std::to_string(rel(s.end_ns, origin)) + "," + std::to_string(s.state) + "," +
+           std::to_string(s.role) + "]";
+    }
+    for (const CpuObMark& m : tl.cpu_obs) {
+      std::string& o = obs[static_cast<std::size_t>(rows.of(m.system, m.rack))];
+      o += std::string(o.empty() ? "" : ",") + "[" + std::to_string(rel(m.ts_ns, origin)) + "," +
+           std::to_string(m.ob) + "," + std::to_string(m.event_id) + "," +
+           std::to_string(m.reason) + "," + json_str(m.text) + "]";
+    }
+    bool first = true;
+    for (const auto& [key, i] : rows.row) {
+      const auto u = static_cast<std::size_t>(i);
+      cpu += std::string(first ? "" : ",") + "{\"label\":" + json_str(rows.label(key.first, key.second)) +
+             ",\"sys\":" + json_str(key.first) + ",\"r\":" + std::to_string(key.second) +
+             ",\"s\":[" + spans[u] + "],\"ob\":[" + obs[u] + "]}";
+      first = false;
+    }
+  }
+  cpu += "]}";
   std::string o = "{\"v\":1,\"origin\":\"" + std::to_string(origin) + "\",\"span\":[" +
                   std::to_string(rel(tl.from_ns, origin)) + "," + std::to_string(rel(tl.to_ns, origin)) +
                   "],\"view\":[" + std::to_string(rel(view_from, origin)) + "," +
                   std::to_string(rel(view_to, origin)) + "],";
   tables.write(o);
-  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + ",\"ac\":" + ac + "}";
+  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + ",\"cpu\":" + cpu + ",\"ac\":" + ac + "}";
   return o;
 }
 
@@ -397,7 +472,7 @@ std::uint64_t count_frames(const Timeline& tl) {
 
 constexpr int kLabelW = 210, kPadR = 18, kHeadH = 52, kAxisH = 34, kEvH = 46;
 constexpr int kRowFrames = 30, kRowToken = 18, kRowRuler = 20, kRowDx = 14, kLaneGap = 18;
-constexpr int kRowAc = 14;
+constexpr int kRowAc = 14, kRowCpu = 22;
 
 std::int64_t nice_step(double raw) {
   if (!(raw > 1)) return 1;
@@ -717,6 +792,58 @@ void svg_active(SvgCtx& c, const Timeline& tl, int y0) {
   if (row >= 0) c.o += "</g></g>\n";
 }
 
+/// One row per CPU from y0 (timeline.hpp "CPU rows"): spans coloured by state (a standby's
+/// lighter), labelled "RUN master"; OB marks as ticks with the OB number below.
+void svg_cpu(SvgCtx& c, const Timeline& tl, const CpuRowIndex& rows, int y0) {
+  std::vector<std::string> body(rows.row.size());
+  for (const CpuStateSpan& s : tl.cpu_states) {
+    const int row = rows.of(s.system, s.rack);
+    const int yr = y0 + row * kRowCpu;
+    std::string& o = body[static_cast<std::size_t>(row)];
+    const double xa = c.clampx(c.x(s.start_ns)), xb = c.clampx(c.x(s.end_ns));
+    const double w = std::max(1.0, xb - xa);
+    const std::string label = cpu_span_label(s);
+    const std::string title = rows.label(s.system, s.rack) + ": " + label + "\nfrom " +
+                              fmt_abs(s.start_ns, 9) + "\nto " + fmt_abs(s.end_ns, 9) + " (" +
+                              fmt_dur(diff(s.start_ns, s.end_ns)) + ")";
+    o += "<rect class=\"cpu-span\" data-state=\"" + xml(cpu_state_name(s.state)) +
+         "\" data-role=\"" + xml(cpu_role_name(s.role)) + "\" x=\"" + num(xa) + "\" y=\"" +
+         std::to_string(yr + 1) + "\" width=\"" + num(w) + "\" height=\"13\" fill=\"" +
+         cpu_state_colour(s.state) + "\"" + (s.role == 2 ? " fill-opacity=\"0.6\"" : "") +
+         "><title>" + xml(title) + "</title></rect>\n";
+    if (w > static_cast<double>(label.size()) * 6.2 + 8)
+      o += "<text x=\"" + num(xa + 4) + "\" y=\"" + std::to_string(yr + 11) +
+           "\" font-size=\"10\" fill=\"" + cpu_text_colour(s.state) + "\">" + xml(label) +
+           "</text>\n";
+  }
+  for (const CpuObMark& m : tl.cpu_obs) {
+    const int row = rows.of(m.system, m.rack);
+    const int yr = y0 + row * kRowCpu;
+    const double x = c.x(m.ts_ns);
+    const std::string title = fmt_abs(m.ts_ns, 9) + " OB " + std::to_string(m.ob) + "\n" + m.text;
+    body[static_cast<std::size_t>(row)] +=
+        "<g class=\"cpu-ob\" data-ob=\"" + std::to_string(m.ob) + "\"><line x1=\"" + num(x) +
+        "\" y1=\"" + std::to_string(yr) + "\" x2=\"" + num(x) + "\" y2=\"" +
+        std::to_string(yr + kRowCpu - 2) + "\" stroke=\"" + kObColour +
+        "\" stroke-width=\"1.5\"/><text x=\"" + num(x + 2) + "\" y=\"" +
+        std::to_string(yr + kRowCpu - 1) + "\" font-size=\"8\" fill=\"" + kObColour + "\">" +
+        std::to_string(m.ob) + "</text><title>" + xml(title) + "</title></g>\n";
+  }
+  for (const auto& [key, row] : rows.row) {
+    const int yr = y0 + row * kRowCpu;
+    c.o += "<g class=\"cpu-row\" data-system=\"" + xml(key.first) + "\" data-rack=\"" +
+           std::to_string(key.second) + "\">\n<text x=\"" + std::to_string(kLabelW - 12) +
+           "\" y=\"" + std::to_string(yr + 12) +
+           "\" text-anchor=\"end\" font-size=\"11\" fill=\"#495057\">" +
+           xml(rows.label(key.first, key.second)) + "</text>\n<g clip-path=\"url(#plotclip)\">\n";
+    c.o += "<rect x=\"" + num(c.plot_x) + "\" y=\"" + std::to_string(yr) + "\" width=\"" +
+           num(c.plot_w) + "\" height=\"" + std::to_string(kRowCpu - 1) + "\" fill=\"" +
+           (row % 2 ? "#fbfbfc" : "#f4f6f8") + "\"/>\n";
+    c.o += body[static_cast<std::size_t>(row)];
+    c.o += "</g></g>\n";
+  }
+}
+
 std::string cycle_text(const SlaveCycles& S, std::uint64_t speed) {
   std::set<int> masters;
   for (const DxPoll& p : S.polls) masters.insert(p.master);
@@ -866,7 +993,10 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   }
 
   // Layout.
-  int y = kHeadH + kAxisH + kEvH;
+  // The CPU rows' legend takes a second line in the header.
+  const CpuRowIndex cpu_rows(tl);
+  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16);
+  int y = head_h + kAxisH + kEvH;
   std::vector<int> lane_y;
   for (const auto& L : tl.lanes) {
     lane_y.push_back(y);
@@ -878,6 +1008,8 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   for (std::size_t i = 0; i < tl.active_channels.size(); ++i)
     if (i == 0 || tl.active_channels[i - 1].station != tl.active_channels[i].station) ++ac_rows;
   if (ac_rows) y += ac_rows * kRowAc + kLaneGap;
+  const int cpu_y = y;
+  if (!cpu_rows.row.empty()) y += static_cast<int>(cpu_rows.row.size()) * kRowCpu + kLaneGap;
   const int lanes_end = y;
   std::vector<std::string> summary;
   for (const auto& L : tl.lanes) {
@@ -913,7 +1045,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
          "</tspan></text>\n";
   {
     double lx = 12;
-    const int ly = 40;
+    int ly = 40;
     auto sw = [&](const std::string& colour, const std::string& text, bool line) {
       if (line)
         c.o += "<rect x=\"" + num(lx) + "\" y=\"" + std::to_string(ly - 10) + "\" width=\"3\" height=\"12\" fill=\"" + colour + "\"/>";
@@ -940,6 +1072,18 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
         sw(lane_colour(static_cast<int>(li)), tl.lanes[li].name, false);
       sw("url(#achatch)", "none", false);
     }
+    if (!cpu_rows.row.empty()) {
+      lx = 12;
+      ly += 16;
+      head("CPU state");
+      std::set<int> states;
+      for (const CpuStateSpan& s : tl.cpu_states) states.insert(s.state);
+      for (int st : states) sw(cpu_state_colour(st), cpu_state_name(st), false);
+      sw(kObColour, "OB", true);
+      c.o += "<text x=\"" + num(lx) + "\" y=\"" + std::to_string(ly) +
+             "\" font-size=\"12\" fill=\"#68717d\">(lighter: standby)</text>\n";
+      lx += 18 * 6.8 + 12;
+    }
     head("events");
     sw(event_colour(EventStyle::Fault), "fault", true);
     sw(event_colour(EventStyle::Repair), "repair", true);
@@ -947,7 +1091,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   }
   // Time axis.
   {
-    const int ay = kHeadH;
+    const int ay = head_h;
     const std::int64_t span = std::max<std::int64_t>(1, diff(c.from, c.to));
     const std::int64_t step = nice_step(static_cast<double>(span) / std::max(2.0, c.plot_w / 130));
     int dec = 0;
@@ -1019,8 +1163,13 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     svg_active(c, tl, ac_y);
     c.o += "</g>\n";
   }
+  if (!cpu_rows.row.empty()) {
+    c.o += "<g class=\"cpu-rows\">\n";
+    svg_cpu(c, tl, cpu_rows, cpu_y);
+    c.o += "</g>\n";
+  }
   c.o += "<g class=\"events\" clip-path=\"url(#plotclip)\">\n";
-  svg_events(c, tl, kHeadH + kAxisH + 2, lanes_end - kLaneGap + 4);
+  svg_events(c, tl, head_h + kAxisH + 2, lanes_end - kLaneGap + 4);
   c.o += "</g>\n";
   // Summary.
   int sy = lanes_end + 14;

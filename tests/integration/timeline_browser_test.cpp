@@ -3,7 +3,8 @@
 // zlib) and dumps the DOM after the page script ran (body data-rendered="1", the lane group, the
 // DP cycle table, the fault marker); opened at a window of 150 µs through the URL fragment, the
 // page shows a bit-time axis, which it does not at the wide first view. The page of a
-// switched-io run (10 s) draws one active-channel row per switched station (issue 7).
+// switched-io run (10 s) draws one active-channel row per switched station (issue 7), and the
+// page of the built-in default scenario (an H system) one row per CPU (issue 8).
 //
 // Skipped, with the reason, when no Chromium is installed (Debian: apt-get install chromium);
 // PBVBUS_CHROMIUM may name the browser binary.
@@ -264,6 +265,50 @@ TEST_F(TimelineBrowserSwitched, ScriptDrawsTheActiveChannelRows) {
   EXPECT_EQ(count(svg, "fill=\"#1c7ed6\"><title>STATION "), a);  // DP_A's colour
   // The legend names the lanes' colours.
   EXPECT_NE(dom.find("<b>active channel</b>"), std::string::npos);
+}
+
+/// The page of a run of the built-in default scenario (examples/h-system.textproto, 18 s).
+class TimelineBrowserH : public TimelineBrowser {
+ protected:
+  void SetUp() override {
+    if (!start()) GTEST_SKIP() << kNoChromium;
+    const std::string capture = (m_dir / "h.pcapng").string();
+    std::ostringstream out, err;
+    ASSERT_EQ(cmd_run({"--capture", capture, "--quiet"}, out, err), 0) << err.str();
+    m_html = (m_dir / "h.html").string();
+    ASSERT_EQ(cmd_timeline({capture, "-o", m_html}, out, err), 0) << err.str();
+  }
+};
+
+TEST_F(TimelineBrowserH, ScriptDrawsTheCpuRows) {
+  const auto [rc, dom] = chromium("--dump-dom", "file://" + m_html);
+  ASSERT_EQ(rc, 0);
+  EXPECT_NE(dom.find("data-rendered=\"1\""), std::string::npos) << "the page script did not run";
+  EXPECT_NE(dom.find("data-cpu-rows=\"2\""), std::string::npos);
+  const std::string svg = svg_of(dom);
+  ASSERT_NE(svg, "");
+  EXPECT_EQ(count(svg, "<g class=\"cpu-row\" data-system="), 2u);
+  for (const char* rack : {"0", "1"}) {
+    EXPECT_NE(svg.find(std::string("<g class=\"cpu-row\" data-system=\"H-CPU\" data-rack=\"") + rack +
+                       "\">"),
+              std::string::npos)
+        << rack;
+    EXPECT_NE(svg.find(std::string(">CPU ") + rack + " (rack " + rack + ")</text>"), std::string::npos)
+        << rack;
+  }
+  // The first view is the whole run: every span and OB mark is drawn, and the page counts them.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(dom, m, std::regex("data-cpu-spans-drawn=\"(\\d+)\"")));
+  const std::size_t spans = std::stoul(m[1].str());
+  EXPECT_GE(spans, 10u);  // each CPU: at least STARTUP/STOP, LINK-UP, UPDATE, RUN
+  EXPECT_EQ(count(svg, "class=\"cpu-span\""), spans);
+  // Both CPUs are RUN master at some time (CPU 0 until 12 s, CPU 1 after F1).
+  EXPECT_GE(count(svg, "class=\"cpu-span\" data-state=\"RUN\" data-role=\"master\""), 2u);
+  ASSERT_TRUE(std::regex_search(dom, m, std::regex("data-cpu-obs-drawn=\"(\\d+)\"")));
+  EXPECT_EQ(count(svg, "<g class=\"cpu-ob\""), std::stoul(m[1].str()));
+  // OB 72 at F5 (CPU 0) and F1 (CPU 1).
+  EXPECT_EQ(count(svg, "<g class=\"cpu-ob\" data-ob=\"72\">"), 2u);
+  EXPECT_NE(dom.find("<b>CPU state</b>"), std::string::npos);
 }
 
 }  // namespace

@@ -48,6 +48,14 @@ struct CpuEventFields {
   std::string text;
 };
 
+/// Names of the numbers in the records (devices' to_string, S7-400H profile: the S7-1500R/H's
+/// primary/backup are the same numbers as master/standby): "OFF", "STOP", ..., "LINK-UP",
+/// "SYNCUP"; "none", "master", "standby"; "Stop", ..., "Redundant", "SYNCUP". A number outside
+/// the enum gives "state N" / "role N" / "mode N".
+std::string cpu_state_name(int state);
+std::string cpu_role_name(int role);
+std::string cpu_system_mode_name(int mode);
+
 /// The record for `f` (category Cpu, line -1).
 EventRecord cpu_event_record(const CpuEventFields& f);
 /// The fields of a Cpu record; nullopt for another category or an unknown kind.

@@ -2,7 +2,8 @@
 // The model behind `pbvbus timeline CAPTURE` (issue 6, "a picture of the bus"): a capture read
 // into lanes of frames with their times on the wire, who held the token when, the DP cycle of
 // every slave, the events, and (issue 7) the active channel of every switched station.
-// timeline_render.hpp draws it as HTML or SVG.
+// and (issue 8) the states, roles and OBs of the CPUs of an H system. timeline_render.hpp
+// draws it as HTML or SVG.
 //
 // Decisions:
 //  - One lane per interface with link type USER0 (147) or PROFIBUS_DL (257), in interface
@@ -62,11 +63,29 @@
 //    before '@' in interface order (pbvbus declares each line's interfaces together, in line
 //    index order) and the Nth group's first lane is line N's. A line index with no such lane
 //    keeps its index with line_lane = -1. Worked out on the whole capture like the token spans.
-//  - Window [from_ns, to_ns): frames, token spans and active-channel spans that overlap it,
-//    polls and events that start in it. Without a window: from the earliest record to 1 ns
+//  - CPU rows of an H system (issue 8, "a timeline of states, roles and events per CPU"): from
+//    the Cpu event records (category 5, cpu_event.hpp). A CPU gets a row if it has at least one
+//    State record (kind 0); a row is (system, rack): `system` is the name before ": CPU <rack>:"
+//    in the record's text (pbvbus writes "H-CPU: CPU 0: STOP -> STARTUP"; "" when the text does
+//    not start that way), so that two simulated pairs' rack 0 are two rows. The row starts at
+//    the CPU's first State record: a State record sets (state = "to", role = b, the role after
+//    the event), a Role record (kind 1) sets role = "to" and keeps the state; Role records
+//    before the first State record are passed over (that State record carries the role).
+//    System-mode records (kind 2) change no span: RUN in Solo or in Redundant mode is one state
+//    (the report's table has the mode column). A span is a (state, role) period, with the same
+//    rules as the active channels: consecutive records with the same (state, role) make one
+//    span, a span that another record at the same instant replaces (zero length, not the last)
+//    is dropped, and the last span lasts to last_ns. Numbers outside the known enums are kept
+//    as they are (cpu_state_name() says "state 12").
+//  - OB marks: every Cpu record of kind Ob (3) of a CPU that has a row, at its time, with the OB
+//    number, event ID and reason from the value and the record's text; a record for both CPUs
+//    (a = -1, "CPU 0+1: ...") gives one mark on each row of its system. OB records of CPUs
+//    without a row are not marked (they are still events). By system, rack, then time.
+//  - Window [from_ns, to_ns): frames, token spans, active-channel spans and CPU state spans that
+//    overlap it, polls, events and OB marks that start in it. Without a window: from the earliest record to 1 ns
 //    after the end of the latest frame or event (so that what happens last is inside; to_ns
 //    saturates at the int64 limit, and a window ending there includes it). Token spans, active
-//    channels and cycle times are worked out on the whole capture first, so a window does not
+//    channels, CPU states and cycle times are worked out on the whole capture first, so a window does not
 //    change them; the per-slave summary covers the polls in the window. Times are the capture's own (virtual time since the start
 //    of the run for pbvbus captures).
 //  - Errors: anything the reader rejects (not pcapng, truncated or malformed block) fails the
@@ -175,6 +194,28 @@ struct ActiveChannelSpan {
   std::int64_t end_ns = 0;
 };
 
+/// A time in which one CPU of an H system was in one state with one role (numbers as in
+/// cpu_event.hpp: state devices::CpuState, role devices::CpuRole).
+struct CpuStateSpan {
+  std::string system;  ///< the H system's name from the record texts ("" if none)
+  int rack = 0;
+  int state = 0;  ///< 0 OFF, 1 STOP, 2 STARTUP, 3 RUN, 4 LINK-UP, ... (cpu_state_name())
+  int role = 0;   ///< 0 none, 1 master, 2 standby (cpu_role_name())
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+};
+
+/// An OB that ran on a CPU (a Cpu record of kind Ob), drawn as a tick on the CPU's row.
+struct CpuObMark {
+  std::string system;
+  int rack = 0;
+  std::int64_t ts_ns = 0;
+  int ob = 0;                 ///< OB number (72, 121, 85, ...)
+  std::uint16_t event_id = 0;  ///< W#16#.... (0 = none given)
+  int reason = 0;             ///< devices::HReason (0 none)
+  std::string text;           ///< the record's text
+};
+
 struct Timeline {
   std::int64_t from_ns = 0;  ///< the window
   std::int64_t to_ns = 0;
@@ -184,6 +225,10 @@ struct Timeline {
   std::vector<TimelineEvent> events;  ///< in the window, by time
   /// In the window, by station, then by start time (one row per switched station).
   std::vector<ActiveChannelSpan> active_channels;
+  /// In the window, by system, rack, then start time (one row per CPU with a State record).
+  std::vector<CpuStateSpan> cpu_states;
+  /// In the window, by system, rack, then time.
+  std::vector<CpuObMark> cpu_obs;
   std::uint64_t records = 0;
   std::uint64_t bad_event_records = 0;
   std::uint64_t skipped_interfaces = 0;

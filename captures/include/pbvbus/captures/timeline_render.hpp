@@ -16,6 +16,11 @@
 //             times (differences), "c0" cycle of the first poll (-1 none), "m" masters, "un"
 //             indices of unanswered polls
 //   "ev"      events: [time, style, category, text]
+//   "cpu"     CPU rows (issue 8): "states" and "roles" the names of the numbers; "rows" per CPU
+//             "label" ("CPU 0 (rack 0)", with the system's name when several H systems are in
+//             the capture), "sys", "r" rack, spans "s" [start, end, state, role] and OB marks
+//             "ob" [time, OB number, event ID, reason, text]
+//   "ac"      active channels: per switched station "a" and spans "s" [start, end, lane, line]
 // A frame's end is worked out in the page from its octet count and the lane's speed exactly as
 // frame_duration_ns() does. The script draws only the visible window: frames wider than a
 // pixel one by one (labelled when wide enough), denser ones aggregated per pixel (colour of
@@ -26,10 +31,17 @@
 // (decoded telegram, hex, time since the previous frame in µs and bit times), token spans, DP
 // polls and events, and a table of DP cycle times for the polls in view. After each drawing the
 // page sets data-rendered="1" on <body>; each lane is a <g class="lane" data-lane="NAME">.
+// Below the lanes come the active-channel rows (one per switched station) and the CPU rows (one
+// per CPU of an H system, <g class="cpu-row" data-rack="N">): spans coloured by state (a
+// standby's lighter), labelled "RUN master" when wide enough, OB marks as ticks with the OB
+// number (<g class="cpu-ob" data-ob="72">); <body> gets data-cpu-rows, data-cpu-spans-drawn and
+// data-cpu-obs-drawn. RUN-Solo and RUN-Redundant are one state: the system mode is not a span.
+// The CPU spans and OB marks have tooltips as the frames do.
 //
 // SVG (to_svg): the window of the Timeline as a static picture of `width` pixels, the same
 // rows as the page, frames aggregated per pixel when denser than a pixel, <title> tooltips on
-// frames drawn one by one, a legend and a DP cycle summary below the lanes.
+// frames drawn one by one, the active-channel and CPU rows with <title> tooltips on their spans
+// and OB marks, a legend and a DP cycle summary below the lanes.
 //
 // Text from the capture (interface names, comments, event texts) is escaped for its context and
 // invalid UTF-8 is replaced, so any capture gives well-formed XML and JSON.

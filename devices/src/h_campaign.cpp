@@ -90,7 +90,8 @@ std::string HCampaignResult::summary() const {
     o << buf << n;
   }
   o << " OB72=" << ob72 << " OB121=" << ob121 << " (observed " << observed_events << ", expected "
-    << expected_events << "); samples " << output_samples << " pulses " << pulses << "; DX "
+    << expected_events << "); samples " << output_samples << " pulses " << pulses << " cleared "
+    << cleared_samples << "; DX "
     << dx_requests << " stray " << stray_dx << "; split frames " << split_frames
     << " second-master frames " << second_master_frames << "; mismatches " << mismatches.size()
     << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
@@ -499,6 +500,7 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     const bool none = (!m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end)) ||
                       m_obs.no_program(f.end);
     if (none) s.exempt = true;
+    if (v == 0 && m_obs.no_program(f.end)) ++m_r.cleared_samples;
     std::string bad;
     if (v == 0) {
       if (!s.exempt) bad = "outputs 0";

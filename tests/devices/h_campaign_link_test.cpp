@@ -91,7 +91,8 @@ TEST(HCampaignLink, MasterHoldRefusesTheLinkUpUntilReleased) {
   expect_ob72(ev[0], t0, 0, HReason::StandbyStop);
   expect_io(ev[1], t0, 0x39C3, 1, 0);
   expect_io(ev[2], t5 + 2000 * kMs, 0x38C3, 1, 0);
-  EXPECT_EQ(r.refusals, 2);     // HOLD in Redundant, RUN while the master is in HOLD
+  EXPECT_GT(r.cleared_samples, 0u);  // HOLD: the master's DP master in Clear, outputs 0
+  EXPECT_EQ(r.refusals, 2);          // HOLD in Redundant, RUN while the master is in HOLD
   EXPECT_EQ(r.diag_checks, 1);  // the refusal in the master's buffer
   EXPECT_EQ(r.role_swaps, 0);
 }
@@ -164,6 +165,7 @@ TEST(HCampaignLink, StructuralChangeStopsBothAndBothRestart) {
   ASSERT_EQ(r.log.size(), 3u);
   const bus::Ticks t0 = r.log[1].at, t1 = r.log[2].at;
   EXPECT_EQ(r.log[1].expected, 0);  // no OB 72 (nobody runs), the 39C3 only a diag entry
+  EXPECT_GT(r.cleared_samples, 0u);   // both in STOP: the master's DP master Clear, outputs 0
   const auto ev = obs_from(r, t0);
   ASSERT_EQ(ev.size(), 1u);
   // RUN at t1: the master's STARTUP 1 000 ms, then the standby's LINK-UP 2 000 ms.

@@ -215,6 +215,9 @@ struct HCampaignResult {
   int observed_events = 0;
   std::uint64_t output_samples = 0;
   std::uint64_t pulses = 0;
+  /// Samples with outputs 0 while the observer says no CPU runs the program (HOLD, F22's
+  /// double STOP): the DP master's Clear, allowed (not a pulse).
+  std::uint64_t cleared_samples = 0;
   std::vector<std::string> pulse_reports;  ///< the first few
   std::uint64_t dx_requests = 0;           ///< Data_Exchange requests to switched stations seen
   std::uint64_t split_frames = 0;          ///< frames while two masters drove (F6 only)
@@ -234,8 +237,11 @@ struct HCampaignResult {
 };
 
 /// Runs the campaign. Throws std::invalid_argument for unusable options (a negative weight, all
-/// weights 0, min > max, a scan time or settle limit <= 0) and std::runtime_error when the
-/// system cannot be built (GSD missing, a baud rate a station does not support).
+/// weights 0, min > max, a scan time or settle limit <= 0, H parameters with a
+/// check_h_parameters Error or under which the normal update exceeds T_P15, an
+/// update_timeout_kb whose update fits (with UpdateTimeout drawn), update_timeout_failures_max
+/// outside 1..10) and std::runtime_error when the system cannot be built (GSD missing, a baud
+/// rate a station does not support).
 HCampaignResult run_h_campaign(const HCampaignOptions& o);
 
 }  // namespace pbvbus::devices

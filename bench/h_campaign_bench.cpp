@@ -1,14 +1,17 @@
 // The full seeded H-system fault campaign (issue 8 "Must show"; devices/h_campaign.hpp): >= 1000
 // injections of CPU (power, STOP, comparison error, one-sided OB 121, operator swap), sync-link
-// (one fibre, both fibres at once), IM, line (short circuit) and DP master module faults and
-// their repairs, on two lines with the CPU pair, two switched stations (PBVB0A10, PBVB0A11) and
-// one one-sided slave per line, checked by the campaign's independent observer.
+// (one fibre, both fibres at once), IM, line (short circuit) and DP master module faults, the
+// link-up/update faults (master HOLD, load-memory error, sync error, update timeout, standby
+// lost in LINK-UP, structural change, swap with a changed parameter) and their repairs, on two
+// lines with the CPU pair, two switched stations (PBVB0A10, PBVB0A11) and one one-sided slave
+// per line, checked by the campaign's independent observer.
 //
 //   BM_HCampaign/<seed>/<steps>/<baud>   baud 0 = 1.5 Mbit/s, 1 = 12 Mbit/s (PBVB0A11's GSD has
 //     no 12M_supp: the station model refuses it and the run is skipped). Counters: faults,
 //     repairs, pulses, mismatches, events (observed) and expected_events, samples, dx,
 //     split_frames, second_master_frames, stray_dx, role_swaps, defective, comparison_stops,
-//     virt_s, virt_s_per_wall_s, virt_s_per_cpu_s (std::clock), max_settle_ms.
+//     update_timeouts, refusals, diag_checks, virt_s, virt_s_per_wall_s, virt_s_per_cpu_s
+//     (std::clock), max_settle_ms.
 //   One iteration (the campaign is one long run); mismatches and pulses are printed to stderr.
 //
 // PBVBUS_HCAMPAIGN_SEED and PBVBUS_HCAMPAIGN_STEPS override the seed and the number of
@@ -97,6 +100,9 @@ void BM_HCampaign(benchmark::State& state) {
   state.counters["role_swaps"] = r.role_swaps;
   state.counters["defective"] = r.defective;
   state.counters["comparison_stops"] = r.comparison_stops;
+  state.counters["update_timeouts"] = r.update_timeouts;
+  state.counters["refusals"] = r.refusals;
+  state.counters["diag_checks"] = r.diag_checks;
   state.counters["virt_s"] = virt;
   state.counters["virt_s_per_wall_s"] = r.wall_seconds > 0 ? virt / r.wall_seconds : 0;
   state.counters["virt_s_per_cpu_s"] = cpu_s > 0 ? virt / cpu_s : 0;

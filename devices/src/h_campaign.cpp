@@ -52,6 +52,20 @@ std::string_view to_string(HFault f) {
       return "one-sided OB 121 (F17)";
     case HFault::MasterSwap:
       return "operator master swap";
+    case HFault::MasterHold:
+      return "master HOLD, link-up refused (F21)";
+    case HFault::LoadMemoryError:
+      return "load-memory access error (F2)";
+    case HFault::SyncError:
+      return "sync error (F18)";
+    case HFault::UpdateTimeout:
+      return "update timeout (F19)";
+    case HFault::StandbyLostDuringLinkUp:
+      return "standby lost in LINK-UP (F20)";
+    case HFault::LoadChange:
+      return "structural change in Redundant (F22)";
+    case HFault::ParameterChangeSwap:
+      return "master swap with a changed parameter (F23)";
   }
   return "?";
 }
@@ -68,14 +82,16 @@ std::string HCampaignResult::summary() const {
   for (int k = 0; k < kHFaultKinds; ++k)
     o << ' ' << to_string(static_cast<HFault>(k)) << '=' << drawn[k];
   o << ") defective " << defective << " comparison-stops " << comparison_stops << " role swaps "
-    << role_swaps << "; events";
+    << role_swaps << " update-timeouts " << update_timeouts << " refusals " << refusals
+    << " diag-checks " << diag_checks << "; events";
   for (const auto& [c, n] : io_events) {
     char buf[16];
     std::snprintf(buf, sizeof buf, " %04X=", c);
     o << buf << n;
   }
   o << " OB72=" << ob72 << " OB121=" << ob121 << " (observed " << observed_events << ", expected "
-    << expected_events << "); samples " << output_samples << " pulses " << pulses << "; DX "
+    << expected_events << "); samples " << output_samples << " pulses " << pulses << " cleared "
+    << cleared_samples << "; DX "
     << dx_requests << " stray " << stray_dx << "; split frames " << split_frames
     << " second-master frames " << second_master_frames << "; mismatches " << mismatches.size()
     << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
@@ -173,7 +189,10 @@ struct Observer {
   int act[2] = {0, 0};
   std::optional<bus::Ticks> last121[2];
   bus::Ticks swap_at = bus::kNever;  ///< the last automatic swap after ERROR-SEARCH
+  std::uint32_t kb = 100;            ///< KB of changed DBs the next update copies
 
+  /// No CPU runs the program (HOLD, both STOP): no OB runs, the outputs may be 0 (Clear).
+  bool no_program(bus::Ticks t) const { return !prog(0, t) && !prog(1, t); }
   bool side_runs(int r, bus::Ticks t) const { return run_from[r] <= t && t < run_until[r]; }
   bool prog(int r, bus::Ticks t) const { return prog_from[r] <= t && t < prog_until[r]; }
   /// The rack an I/O OB runs on at t: -1 when both CPUs run the program.
@@ -209,6 +228,21 @@ class HCampaignRun {
     if (o.scan_time <= 0 || o.self_test_time < 0 || o.settle_limit <= 0 || o.recognition < 0 ||
         o.startup < 0)
       throw std::invalid_argument("h campaign: times must not be negative (scan, settle > 0)");
+    const HCheckResult hc = check_h_parameters(o.h_parameters);
+    if (!hc.ok()) {
+      std::string m = "h campaign: H parameters:";
+      for (const auto& v : hc.violations)
+        if (v.severity == Severity::Error) m += " " + v.message + ";";
+      throw std::invalid_argument(m);
+    }
+    if (update_abort_after(m_obs.kb) != bus::kNever)
+      throw std::invalid_argument("h campaign: the normal update (100 KB) exceeds T_P15");
+    if (o.update_timeout_failures_max < 1 || o.update_timeout_failures_max > kUpdateMaxTries)
+      throw std::invalid_argument("h campaign: update_timeout_failures_max must be 1..10");
+    if (o.weights[static_cast<int>(HFault::UpdateTimeout)] > 0 &&
+        update_abort_after(o.update_timeout_kb) == bus::kNever)
+      throw std::invalid_argument(
+          "h campaign: update_timeout_kb gives an update that fits in T_P15 (no timeout)");
     build();
   }
   HCampaignResult run();
@@ -229,7 +263,23 @@ class HCampaignRun {
     return std::uniform_int_distribution<bus::Ticks>(lo, hi)(m_rng);
   }
   int draw_int(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(m_rng); }
-  bus::Ticks update_w() const { return default_update_time(m_params.update_db_kb); }
+  /// The observer's W (digest §3.1): MAX(75 ms + 0.7 ms per changed KB, 50 ms + T_PH).
+  bus::Ticks update_w(std::uint32_t kb) const {
+    const bus::Ticks tph = to_ticks(m_o.h_parameters.t_ph.value_or(0));
+    return std::max(default_update_time(kb), tph > 0 ? 50 * kMs + tph : bus::Ticks{0});
+  }
+  bus::Ticks update_w() const { return update_w(m_obs.kb); }
+  /// F19/R6: the update is aborted this long after t3 (= the start of UPDATE here) when the
+  /// first monitored limit (T_P15, then communication delay, cycle extension; 0 = not
+  /// monitored) is shorter than W; kNever when it fits.
+  bus::Ticks update_abort_after(std::uint32_t kb) const {
+    const bus::Ticks w = update_w(kb);
+    bus::Ticks best = bus::kNever;
+    for (const auto& v : {m_o.h_parameters.t_p15, m_o.h_parameters.max_comm_delay,
+                          m_o.h_parameters.max_cycle_extension})
+      if (v && *v > 0 && to_ticks(*v) < w) best = std::min(best, to_ticks(*v));
+    return best;
+  }
 
   // Expectations.
   Expect cpu_ob(int ob, int rack, CpuRole role, HReason why, bus::Ticks at) const {
@@ -249,7 +299,7 @@ class HCampaignRun {
     x.code = code;
     x.line = line;
     x.station = station;
-    x.rack = m_obs.io_rack(from);
+    x.rack = m_obs.io_rack(from);  // -2: no CPU runs a program, no OB (dropped at begin_step)
     x.earliest = from;
     x.latest = to;
     return x;
@@ -275,6 +325,18 @@ class HCampaignRun {
   void match_all();
 
   void cycle(HFault f);
+  /// The new kinds (link-up/update reactions); each returns when its last repair is injected
+  /// and gives the time the settle counts from.
+  bus::Ticks cycle_link(HFault f);
+  /// The standby to STOP by its mode switch: OB 72 StandbyStop on the master, its side lost.
+  void stop_standby(const std::string& what);
+  void mismatch(const std::string& m) {
+    m_r.mismatches.push_back(fmt_time(now()) + ": " + m_steps.back().what + ": " + m);
+  }
+  /// A diagnostic entry on `rack` at exactly `at` with `code` and a text starting with
+  /// `text` (empty: any); a mismatch when there is none.
+  void expect_diag(int rack, bus::Ticks at, std::uint16_t code, std::string_view text);
+  void pause() { run_to(now() + draw(100 * kMs, 300 * kMs)); }
   void hidden_cycle();
   void dwell() { run_to(now() + draw(m_o.fault_min, m_o.fault_max)); }
   std::string rack_name(int r) const { return "rack " + std::to_string(r); }
@@ -353,6 +415,7 @@ void HCampaignRun::build() {
     m_bus[l]->add_tap(m_tap);
     m_bus[l]->start();
   }
+  m_params.h_parameters = m_o.h_parameters;  // checked in the constructor
   m_params.self_test_time = m_o.self_test_time;
   m_params.cyclic_self_test_period = m_o.cyclic_self_test_period;
   m_h = std::make_unique<HSystemModel>(m_sched, m_params,
@@ -431,8 +494,13 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
       continue;
     }
     ++m_r.output_samples;
-    const bool none = !m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end);
+    // Outputs 0 are allowed while no channel reaches the station or no CPU runs the program
+    // (HOLD, both STOP: the DP master in Clear drives the safe state), until the first new
+    // value after it.
+    const bool none = (!m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end)) ||
+                      m_obs.no_program(f.end);
     if (none) s.exempt = true;
+    if (v == 0 && m_obs.no_program(f.end)) ++m_r.cleared_samples;
     std::string bad;
     if (v == 0) {
       if (!s.exempt) bad = "outputs 0";
@@ -486,7 +554,10 @@ void HCampaignRun::begin_step(std::string what, bool repair, std::vector<Expect>
   s.at = now();
   s.repair = repair;
   s.what = std::move(what);
-  s.expect = std::move(ex);
+  // An I/O event while no CPU runs a program is only a diagnostic entry (no OB, not in
+  // events()): the observer expects nothing then.
+  for (auto& x : ex)
+    if (x.src != Src::Io || x.rack != -2) s.expect.push_back(std::move(x));
   m_r.expected_events += static_cast<int>(s.expect.size());
   m_steps.push_back(std::move(s));
   if (repair)
@@ -850,6 +921,15 @@ void HCampaignRun::cycle(HFault f) {
       }
       break;
     }
+    case HFault::MasterHold:
+    case HFault::LoadMemoryError:
+    case HFault::SyncError:
+    case HFault::UpdateTimeout:
+    case HFault::StandbyLostDuringLinkUp:
+    case HFault::LoadChange:
+    case HFault::ParameterChangeSwap:
+      since = cycle_link(f);
+      break;
     case HFault::MasterSwap: {
       // The operator: the standby's switch to STOP, the swap request (the standby links up and
       // becomes master at the end of the update, the old master STOPs), then RUN again.
@@ -892,6 +972,228 @@ void HCampaignRun::cycle(HFault f) {
   settle_step();
   wait_recovered(since);
   check_roles();
+}
+
+// ---- the link-up/update faults -------------------------------------------------------------
+
+void HCampaignRun::stop_standby(const std::string& what) {
+  const int S = 1 - m_obs.master;
+  const bus::Ticks t = now();
+  std::vector<Expect> ex;
+  m_obs.prog_until[S] = t;
+  ex.push_back(cpu_ob(72, m_obs.master, CpuRole::Master, HReason::StandbyStop, t));
+  lose_side(S, t, ex);
+  m_h->switch_to_stop(S);
+  begin_step(what + ": STOP " + rack_name(S), false, std::move(ex));
+  settle_step();
+}
+
+void HCampaignRun::expect_diag(int rack, bus::Ticks at, std::uint16_t code, std::string_view text) {
+  ++m_r.diag_checks;
+  for (const auto& d : m_h->diag_buffer(rack))
+    if (d.at == at && d.code == code && d.text.compare(0, text.size(), text) == 0) return;
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%04X", code);
+  mismatch("no diagnostic entry W#16#" + std::string(buf) + " '" + std::string(text) + "' on " +
+           rack_name(rack) + " at " + fmt_time(at));
+}
+
+bus::Ticks HCampaignRun::cycle_link(HFault f) {
+  const std::string name(to_string(f));
+  const int M = m_obs.master, S = 1 - M;
+  std::vector<Expect> ex;
+  bus::Ticks since = now();
+  switch (f) {
+    case HFault::MasterHold: {
+      // HOLD is reachable only for the master in STARTUP or Solo RUN (digest §4): refused now.
+      ++m_r.refusals;
+      if (m_h->hold(M)) mismatch("HOLD of the master accepted in Redundant mode");
+      stop_standby(name);
+      pause();
+      // HOLD: no OB 1 from now on; the master's DP master goes Clear (outputs 0 allowed).
+      m_obs.prog_until[M] = now();
+      if (!m_h->hold(M)) mismatch("HOLD of the master refused in Solo RUN");
+      begin_step("HOLD " + rack_name(M), false, {});
+      pause();
+      // R4: no link-up while the master is in HOLD: the standby stays in STOP, no event; the
+      // refusal is in the master's buffer.
+      const bus::Ticks tr = now();
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S) + " (refused: master in HOLD)", true, {});
+      ++m_r.refusals;
+      expect_diag(M, tr, 0, "link-up request of the standby CPU refused: HOLD");
+      dwell();
+      m_obs.prog_from[M] = now();
+      m_obs.prog_until[M] = bus::kNever;
+      if (!m_h->release_hold(M)) mismatch("release of HOLD refused");
+      begin_step("release HOLD " + rack_name(M), true, {});
+      pause();
+      // The refused start is not remembered: a new STOP -> RUN links up.
+      since = now();
+      restart_side(S, since, ex);
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S), true, std::move(ex));
+      break;
+    }
+    case HFault::LoadMemoryError: {
+      // F2 on rack r: as a STOP of r (the partner's OB 72), plus a reset request.
+      const int r = draw_int(0, 1);
+      const bool of_master = r == M;
+      const bus::Ticks t = now();
+      m_obs.prog_until[r] = t;
+      ex.push_back(cpu_ob(72, 1 - r, CpuRole::Master,
+                          of_master ? HReason::MasterStop : HReason::StandbyStop, t));
+      lose_side(r, t, ex);
+      if (of_master) set_master(1 - r);
+      if (!m_h->load_memory_error(r)) mismatch("load-memory error refused");
+      begin_step(name + ": " + rack_name(r), false, std::move(ex));
+      settle_step();
+      dwell();
+      // The reset request: no start before a memory reset (no link-up, no 38C3).
+      m_h->switch_to_run(r);
+      begin_step("RUN " + rack_name(r) + " (refused: reset request)", true, {});
+      ++m_r.refusals;
+      pause();
+      since = now();
+      ex.clear();
+      if (!m_h->memory_reset(r)) mismatch("memory reset refused");
+      restart_side(r, since, ex);
+      m_h->switch_to_run(r);
+      begin_step("MRES + RUN " + rack_name(r), true, std::move(ex));
+      break;
+    }
+    case HFault::SyncError: {
+      const bus::Ticks t = now();
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::StandbyStop, t));
+      lose_side(S, t, ex);
+      if (!m_h->inject_sync_error()) mismatch("sync error refused in Redundant mode");
+      begin_step(name, false, std::move(ex));
+      for (int r = 0; r < 2; ++r) expect_diag(r, t, 0, "sync error (F18)");
+      settle_step();
+      dwell();
+      since = now();
+      ex.clear();
+      restart_side(S, since, ex);
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S), true, std::move(ex));
+      break;
+    }
+    case HFault::UpdateTimeout: {
+      // The program changed many DBs: W > T_P15. Each update aborts at t3 + T_P15 (t3 = the
+      // start of UPDATE), the standby retries exactly 60 s after the abort (R6).
+      m_obs.kb = m_o.update_timeout_kb;
+      m_h->set_changed_db_kb(m_obs.kb);
+      stop_standby(name + ": " + std::to_string(m_obs.kb) + " KB changed");
+      dwell();
+      const int fails = draw_int(1, m_o.update_timeout_failures_max);
+      const bus::Ticks abort_after = update_abort_after(m_obs.kb);
+      bus::Ticks link = now();
+      for (int i = 0; i < fails; ++i) {
+        restart_side(S, link, ex);  // 38C3 at the start of UPDATE
+        const bus::Ticks t_abort = link + m_params.link_up_time + abort_after;
+        ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::UpdateTimeout, t_abort));
+        lose_side(S, t_abort, ex);  // the standby STOPs: 39C3 of its line
+        ++m_r.update_timeouts;
+        link = t_abort + to_ticks(kUpdateRetryDelay);
+      }
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S) + " (" + std::to_string(fails) + " update(s) time out)",
+                 true, std::move(ex));
+      settle_step();
+      pause();
+      ex.clear();
+      m_obs.kb = m_params.update_db_kb;
+      m_h->set_changed_db_kb(m_obs.kb);
+      if (fails < kUpdateMaxTries) {
+        // The repair: the changed DBs back to normal before the automatic retry at `link`.
+        since = link;
+        restart_side(S, link, ex);
+        begin_step("changed DBs back to " + std::to_string(m_obs.kb) + " KB, retry at " +
+                       fmt_time(link),
+                   true, std::move(ex));
+      } else {
+        // kUpdateMaxTries failed: no retry left, the link-up must be restarted by hand.
+        since = now();
+        restart_side(S, since, ex);
+        m_h->switch_to_run(S);
+        begin_step("changed DBs back to " + std::to_string(m_obs.kb) + " KB, RUN " +
+                       rack_name(S),
+                   true, std::move(ex));
+      }
+      break;
+    }
+    case HFault::StandbyLostDuringLinkUp: {
+      stop_standby(name);
+      pause();
+      // LINK-UP starts: the standby's side does not run yet (no event before its UPDATE).
+      const bus::Ticks t1 = now();
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S) + " (LINK-UP)", true, {});
+      // Power off inside the load-memory copy (the first half of LINK-UP, T8): no OB 72 (the
+      // system is Solo), no 39C3 (its side never ran), the reset request W#16#6523.
+      const bus::Ticks copy = m_params.link_up_time / 2;
+      run_to(t1 + draw(10 * kMs, copy - 10 * kMs));
+      const bus::Ticks t2 = now();
+      m_h->power_off(S);
+      begin_step("power off " + rack_name(S) + " in LINK-UP at +" + fmt_time(t2 - t1), false,
+                 {});
+      expect_diag(S, t2, 0x6523, "reset request");
+      dwell();
+      since = now();
+      m_h->power_on(S);
+      if (!m_h->memory_reset(S)) mismatch("memory reset refused");
+      restart_side(S, since, ex);
+      m_h->switch_to_run(S);
+      begin_step("power on + MRES + RUN " + rack_name(S), true, std::move(ex));
+      break;
+    }
+    case HFault::LoadChange: {
+      // F22: both CPUs STOP, no OB 72 (nobody runs). The standby's side stops; its 39C3 is no
+      // OB (no program runs). The master's DP master stays (a master in STOP accesses the
+      // switched I/O) in Clear: the outputs go to the safe state.
+      const HChange kind = draw_int(0, 1) ? HChange::GlobalDb : HChange::StructuralFbInterface;
+      const bus::Ticks t = now();
+      m_obs.prog_until[M] = t;
+      m_obs.prog_until[S] = t;
+      lose_side(S, t, ex);
+      if (m_h->load_change(kind) != HChangeResult::BothStopped)
+        mismatch("structural change in Redundant mode did not stop both CPUs");
+      begin_step(name + ": " + std::string(to_string(kind)), false, std::move(ex));
+      settle_step();
+      dwell();
+      // Both switches STOP -> RUN at once: the master's STARTUP, then the standby's link-up.
+      since = now();
+      ex.clear();
+      m_obs.prog_from[M] = since + m_params.startup_time;
+      m_obs.prog_until[M] = bus::kNever;
+      restart_side(S, since + m_params.startup_time, ex);
+      m_h->switch_to_run(M);
+      m_h->switch_to_run(S);
+      begin_step("RUN both racks", true, std::move(ex));
+      break;
+    }
+    case HFault::ParameterChangeSwap: {
+      stop_standby(name);
+      pause();
+      const bus::Ticks t1 = now();
+      m_h->set_standby_parameter_change(true);
+      ++m_r.refusals;
+      if (m_h->request_master_swap()) mismatch("master swap accepted with a changed parameter");
+      begin_step("master swap request (refused)", false, {});
+      for (int r = 0; r < 2; ++r) expect_diag(r, t1, 0x5966, "master swap refused");
+      dwell();
+      since = now();
+      m_h->set_standby_parameter_change(false);
+      restart_side(S, since, ex);
+      m_h->switch_to_run(S);
+      begin_step("parameter change undone, RUN " + rack_name(S), true, std::move(ex));
+      break;
+    }
+    default:
+      break;
+  }
+  return since;
 }
 
 void HCampaignRun::hidden_cycle() {
@@ -952,8 +1254,11 @@ HCampaignResult HCampaignRun::run() {
       settle_step();
       wait_recovered(now());
     } else {
+      const bool hidden_kb = index == m_o.tamper.hidden_update_timeout_at;
+      if (hidden_kb) m_h->set_changed_db_kb(m_o.update_timeout_kb);  // the observer not told
       ++m_r.drawn[static_cast<int>(f)];
       cycle(f);
+      if (hidden_kb) m_h->set_changed_db_kb(m_obs.kb);
     }
     ++index;
   }
@@ -966,6 +1271,11 @@ HCampaignResult HCampaignRun::run() {
     if (e.ob == 121) ++m_r.ob121;
     for (auto& [c, n] : m_r.io_events)
       if (e.source == Src::Io && e.code == c) ++n;
+  }
+  if (m_o.keep_log) {
+    for (const auto& st : m_steps)
+      m_r.log.push_back({st.at, st.repair, st.what, static_cast<int>(st.expect.size())});
+    m_r.events = m_h->events();
   }
   m_r.simulated = now();
   m_r.frames = m_bus[0]->stats().frames + m_bus[1]->stats().frames;

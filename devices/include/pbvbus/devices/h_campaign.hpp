@@ -29,6 +29,44 @@
 //                                      repair_cpu + switch_to_run (history cleared)
 //   MasterSwap                         the operator's swap: standby switch STOP, request, the
 //                                      old master STOPs at the end of the update; switch_to_run
+// The link-up/update reactions (the pair runs with the manual's four H parameters, checked with
+// check_h_parameters: T_P15 194 ms, T_PH 90 ms, so W = MAX(75 ms + 0.7 ms/KB, 50 ms + T_PH)):
+//   MasterHold (F21/R4)                hold(master) in Redundant must be refused; then standby
+//                                      STOP, hold(master) (Solo: accepted; no OB 1, the master's
+//                                      DP master Clear -> outputs to the safe state 0, allowed),
+//                                      switch_to_run(standby): refused (stays STOP, no event, the
+//                                      entry on the master); release_hold; the refused request
+//                                      is not remembered (HCpuPair), so switch_to_run again ->
+//                                      link-up and update at the predicted times
+//   LoadMemoryError (F2)               load_memory_error(r), r random: as a STOP of r (OB 72
+//                                      MasterStop/StandbyStop on the partner); switch_to_run is
+//                                      refused (reset request); repair memory_reset + RUN
+//   SyncError (F18)                    inject_sync_error: standby STOP, OB 72 StandbyStop, the
+//                                      "sync error (F18)" entry on both; repair switch_to_run
+//   UpdateTimeout (F19/R6)             set_changed_db_kb(update_timeout_kb) (W > T_P15) and
+//                                      standby STOP; RUN: each update aborts at t3 + T_P15 (OB 72
+//                                      UpdateTimeout on the master, 39C3 of the standby's line),
+//                                      the standby retries exactly 60 s later; n in 1..
+//                                      update_timeout_failures_max updates fail, then the KB are
+//                                      reset (the repair) and the retry succeeds (n = 10: no
+//                                      retry left, the repair is KB + switch_to_run)
+//   StandbyLostDuringLinkUp (F20/R9)   standby STOP, RUN (LINK-UP), power_off inside the
+//                                      load-memory copy (half of link_up_time): no event, the
+//                                      W#16#6523 entry on it; repair power_on + memory_reset + RUN
+//   LoadChange (F22)                   load_change(structural FB interface | global DB, drawn)
+//                                      in Redundant: both STOP, no OB 72; the standby's 39C3 is
+//                                      no OB (no CPU runs a program: a diagnostic entry only);
+//                                      the master (STOP, still accessing the switched I/O) keeps
+//                                      its side in Clear: the outputs go to 0 - the safe state
+//                                      by command, not a pulse, and no Output_Hold_Time applies
+//                                      (no switchover). Repair: switch_to_run of both at once ->
+//                                      master STARTUP, the standby links up at its end
+//   ParameterChangeSwap (F23)          standby STOP, set_standby_parameter_change(true), swap
+//                                      request: refused, W#16#5966 on both, no role change;
+//                                      repair: the change undone, switch_to_run(standby)
+// The observer allows outputs 0 on the switched stations only while no channel reaches them or
+// while, in its model, no CPU runs the program (HOLD, F22); the window ends with the first new
+// counter value. I/O events while no CPU runs a program are no OBs: not expected in events().
 // Each injection is one step (faults + repairs; automatic recoveries are no injection).
 //
 // The observer is independent of HSystemModel's reconciliation: it keeps its own model of the
@@ -61,7 +99,7 @@
 //
 // Tamper options (the observer's own tests): a fault it is not told about, a doctored event
 // list, a program glitch writing 0, a forced second master outside F6 (both fibres cut while
-// the observer is told one fibre).
+// the observer is told one fibre), an update timeout (changed DBs set large without telling it).
 
 #include <array>
 #include <cstdint>
@@ -89,8 +127,16 @@ enum class HFault : std::uint8_t {
   ComparisonError,
   OneSidedOb121,
   MasterSwap,
+  // The link-up/update reactions (seeds-digest.md §4, §7 F2, F18-F23, §11 R6, R9):
+  MasterHold,               ///< F21/R4: link-up refused while the master is in HOLD
+  LoadMemoryError,          ///< F2: STOP + reset request; repair memory_reset + RUN
+  SyncError,                ///< F18: standby STOP, OB 72 StandbyStop
+  UpdateTimeout,            ///< F19/R6: W > T_P15 -> abort at t3 + T_P15, retry 60 s later
+  StandbyLostDuringLinkUp,  ///< F20/R9: standby off in the load-memory copy -> W#16#6523
+  LoadChange,               ///< F22: a structural change in Redundant -> both CPUs STOP
+  ParameterChangeSwap,      ///< F23: master swap with a changed parameter -> W#16#5966
 };
-inline constexpr int kHFaultKinds = 13;
+inline constexpr int kHFaultKinds = 20;
 std::string_view to_string(HFault f);
 
 struct HCampaignTamper {
@@ -104,6 +150,9 @@ struct HCampaignTamper {
   /// At this cycle: both fibres are cut while the observer is told one fibre (F5) - a second
   /// master outside its F6 model (-1: never).
   int second_master_at = -1;
+  /// At this cycle (0-based): the changed DBs are set to update_timeout_kb before the drawn
+  /// cycle and back after it, the observer not told: its restart's update times out (-1: never).
+  int hidden_update_timeout_at = -1;
 };
 
 struct HCampaignOptions {
@@ -112,7 +161,8 @@ struct HCampaignOptions {
   bus::Baud baud = bus::Baud::k1_5M;
   std::string gsd_dir;  ///< where PBVB0A10/0A11/0A01.gsd are (e.g. <source>/examples/gsd)
   /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out.
-  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
+                                       1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;
   bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;             ///< ERROR-SEARCH (90 s default)
   bus::Ticks cyclic_self_test_period = 30 * bus::kTicksPerSecond;  ///< 90 min default
@@ -121,7 +171,29 @@ struct HCampaignOptions {
   bus::Ticks recognition = 50 * bus::kTicksPerMs;       ///< window for a bus fault's events
   bus::Ticks startup = 2000 * bus::kTicksPerMs;         ///< window for a bus repair's events
   bus::Ticks settle_limit = 15 * bus::kTicksPerSecond;  ///< back to Redundant + data exchange
+  /// The four H parameters of the pair (the manual's worked example, seeds-digest.md §3.1:
+  /// max cycle extension 1940 ms, max communication delay 776 ms, T_P15 194 ms, T_PH 90 ms).
+  /// Must pass check_h_parameters (no Error) and let the normal update (100 KB: W = 145 ms)
+  /// fit in T_P15, else std::invalid_argument.
+  HParameters h_parameters{ms(1940), ms(776), ms(194), ms(90)};
+  /// UpdateTimeout (F19): the changed DBs of the failing updates; W(kb) must exceed the first
+  /// monitored limit (T_P15). 1024 KB: W = 75 + 0.7 x 1024 = 791.8 ms > 194 ms.
+  std::uint32_t update_timeout_kb = 1024;
+  /// UpdateTimeout: updates that time out per cycle, drawn in 1..this (<= kUpdateMaxTries = 10;
+  /// 10: the standby gives up and the repair is a manual RUN). Each failure costs 60 s + 2.2 s
+  /// of virtual time (the retry delay), hence the small default.
+  int update_timeout_failures_max = 2;
+  /// Keep the step log and a copy of HSystemModel::events() in the result (tests).
+  bool keep_log = false;
   HCampaignTamper tamper;
+};
+
+/// One injection (or the start-up) as the observer recorded it (HCampaignOptions::keep_log).
+struct HCampaignStep {
+  bus::Ticks at = 0;
+  bool repair = false;
+  std::string what;
+  int expected = 0;  ///< events the observer expects in this step
 };
 
 struct HCampaignResult {
@@ -131,6 +203,10 @@ struct HCampaignResult {
   int defective = 0;                      ///< F17 cycles that made a CPU DEFECTIVE
   int comparison_stops = 0;               ///< F16 cycles that stopped the standby (repeat)
   int role_swaps = 0;                     ///< master changes the observer expected
+  int update_timeouts = 0;                ///< F19 aborts the observer expected
+  int refusals = 0;  ///< refused requests checked (HOLD in Redundant, RUN in HOLD/with reset
+                     ///< request, F23 swap)
+  int diag_checks = 0;  ///< diagnostic entries checked (6523, 5966, F18's, HOLD's refusal)
   /// Events of HSystemModel::events() by code (I/O) or OB (72, 121).
   std::array<std::pair<std::uint16_t, int>, 6> io_events{};
   int ob72 = 0, ob121 = 0;
@@ -139,6 +215,9 @@ struct HCampaignResult {
   int observed_events = 0;
   std::uint64_t output_samples = 0;
   std::uint64_t pulses = 0;
+  /// Samples with outputs 0 while the observer says no CPU runs the program (HOLD, F22's
+  /// double STOP): the DP master's Clear, allowed (not a pulse).
+  std::uint64_t cleared_samples = 0;
   std::vector<std::string> pulse_reports;  ///< the first few
   std::uint64_t dx_requests = 0;           ///< Data_Exchange requests to switched stations seen
   std::uint64_t split_frames = 0;          ///< frames while two masters drove (F6 only)
@@ -149,6 +228,8 @@ struct HCampaignResult {
   bus::Ticks simulated = 0;
   double wall_seconds = 0;
   std::uint64_t frames = 0;
+  std::vector<HCampaignStep> log;     ///< keep_log only
+  std::vector<HSystemEvent> events;  ///< keep_log only: HSystemModel::events() at the end
 
   int injections() const { return faults + repairs; }
   int events_with(std::uint16_t code) const;
@@ -156,8 +237,11 @@ struct HCampaignResult {
 };
 
 /// Runs the campaign. Throws std::invalid_argument for unusable options (a negative weight, all
-/// weights 0, min > max, a scan time or settle limit <= 0) and std::runtime_error when the
-/// system cannot be built (GSD missing, a baud rate a station does not support).
+/// weights 0, min > max, a scan time or settle limit <= 0, H parameters with a
+/// check_h_parameters Error or under which the normal update exceeds T_P15, an
+/// update_timeout_kb whose update fits (with UpdateTimeout drawn), update_timeout_failures_max
+/// outside 1..10) and std::runtime_error when the system cannot be built (GSD missing, a baud
+/// rate a station does not support).
 HCampaignResult run_h_campaign(const HCampaignOptions& o);
 
 }  // namespace pbvbus::devices

@@ -295,6 +295,10 @@ class HCpuPair {
   /// R8: open an S7 connection to `rack`; false on a CPU that is off, in ERROR-SEARCH or
   /// DEFECTIVE, and on both CPUs from the start of a link-up to the end of the update (400H).
   bool connect(int rack, bus::Ticks now);
+  /// R8's admission rule, the one truth for connect() and HConnections (h_connections.hpp): a
+  /// new S7 connection to `rack` is accepted now (powered, not ERROR-SEARCH/DEFECTIVE, and no
+  /// CPU in LINK-UP or UPDATE). Does not run deadlines: call after on_time()/an operation.
+  bool accepts_connections(int rack) const;
   /// F22: load a program change (into the master; in Redundant mode into both).
   HChangeResult load_change(HChange kind, bus::Ticks now);
   /// F23: the standby's configuration has a changed parameter that may not change; a

@@ -78,6 +78,11 @@
 //   otherwise, also when the line is lost only because its CPU/master stopped.
 // - The lines must be started (bus::Line::start powers every attachment) before the model is
 //   constructed: the construction unpowers the masters of the CPUs that are off.
+// - F4 connections, SSL (block at the end of the class, h_system_comms.cpp): an HConnections
+//   follows the pair at every reconcile(); its events go into both powered CPUs' buffers;
+//   repair_cp() re-establishes the standard connections the CP lost (000 §9.1.4 step 3).
+//   read_ssl(id, index) answers SFC 51 byte-exact for xy71, 0F71, 0C75, 0019, 0174, 0222 and
+//   0232 index 4 (h_ssl.hpp: layouts, RET_VAL 8082/8083/8085 and every decision).
 
 #include <array>
 #include <cstdint>

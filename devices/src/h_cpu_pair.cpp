@@ -1069,13 +1069,19 @@ bool HCpuPair::memory_reset(int r, bus::Ticks now) {
 bool HCpuPair::connect(int r, bus::Ticks now) {
   check_rack(r);
   run_due(now);
-  Cpu& c = m_cpu[r];
+  if (!accepts_connections(r)) return false;
+  ++m_cpu[r].connections;
+  return true;
+}
+
+bool HCpuPair::accepts_connections(int r) const {
+  if (r != 0 && r != 1) return false;
+  const Cpu& c = m_cpu[r];
   if (!powered(r) || c.state == CpuState::ErrorSearch || c.state == CpuState::Defective)
     return false;
   // R8: no new connections on either CPU from the start of link-up to the end of the update.
   for (const Cpu& x : m_cpu)
     if (x.state == CpuState::LinkUp || x.state == CpuState::Update) return false;
-  ++c.connections;
   return true;
 }
 

@@ -164,6 +164,7 @@ void HSystemModel::reconcile() {
   deliver_held(m_sched.now());
   if (has_program() && !m_scan_armed && program_runs() && !m_pair.io_frozen())
     arm_scan(m_sched.now());
+  comms_update(m_sched.now());  // F4 connections, SSL: h_system_comms.cpp
 }
 
 void HSystemModel::apply(std::size_t s, int r, SideMode to) {

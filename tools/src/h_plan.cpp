@@ -1,6 +1,7 @@
 // A scenario's h_system entries (h_plan.hpp).
 #include "pbvbus/tools/h_plan.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <map>
 
@@ -123,6 +124,10 @@ class HPlanner {
     } else if (h.has_program()) {
       error(i, "program", "h_system \"" + hp.name + "\": a program needs a cpu part (the simulated pair)");
     }
+    // ---- F4 connections, SSL ----
+    if (!h.has_cpu() && (h.cp_size() > 0 || h.connection_size() > 0))
+      error(i, h.cp_size() > 0 ? "cp" : "connection",
+            "h_system \"" + hp.name + "\": cp and connection entries need a cpu part (the simulated pair)");
     m_plan.h_systems.push_back(std::move(hp));
   }
 
@@ -181,6 +186,7 @@ class HPlanner {
       rt.systems.push_back(s);
     }
     if (h.has_program()) plan_program(i, h.program(), rt.program);
+    plan_comms(i, rt);  // F4 connections
 
     // A simulated pair must not run on a bad set of H parameters.
     try {
@@ -196,6 +202,60 @@ class HPlanner {
     // The pair monitors its updates with the configured set (T_P15, T_PH: HCpuPair rules 18-20).
     rt.pair.h_parameters = hp.params;
     hp.runtime = std::move(rt);
+  }
+
+  // ---- F4 connections: the h_system's cp and connection entries (devices::HConnections checks
+  // them; its message is reported at the entry's field) ----
+  void plan_comms(int i, HRuntimePlan& rt) {
+    const auto& h = m_plan.proto.h_system(i);
+    devices::HConnections check;
+    for (int k = 0; k < h.cp_size(); ++k) {
+      const auto& c = h.cp(k);
+      if (!c.has_rack()) {
+        error_at(i, {{"cp", k}}, "cp needs a rack: rack: 0 or rack: 1");
+        continue;
+      }
+      const devices::CpConfig cfg{static_cast<int>(std::min<std::uint32_t>(c.rack(), 2)),
+                                  static_cast<int>(std::min<std::uint32_t>(c.index(), 1000)),
+                                  c.kind() == scenario::HCp::CP_443_5 ? devices::CpKind::Cp443_5
+                                                                      : devices::CpKind::Cp443_1};
+      if (c.index() > 1000) {
+        error_at(i, {{"cp", k}, {"index"}}, "cp: index " + std::to_string(c.index()) + " is above 1000");
+        continue;
+      }
+      if (std::string e = check.add_cp(cfg); !e.empty()) {
+        error_at(i, {{"cp", k}, {c.rack() > 1 ? "rack" : "index"}}, e);
+        continue;
+      }
+      rt.cps.push_back(cfg);
+    }
+    for (int k = 0; k < h.connection_size(); ++k) {
+      const auto& c = h.connection(k);
+      devices::ConnectionConfig cfg;
+      cfg.name = c.name();
+      cfg.kind = c.kind() == scenario::HConnection::FAULT_TOLERANT ? devices::ConnectionKind::FaultTolerant
+                                                                   : devices::ConnectionKind::Standard;
+      cfg.cp = static_cast<int>(std::min<std::uint32_t>(c.cp(), 1001));
+      if (cfg.kind == devices::ConnectionKind::Standard) {
+        if (!c.has_rack()) {
+          error_at(i, {{"connection", k}}, "connection \"" + c.name() + "\": a standard connection needs a rack");
+          continue;
+        }
+        cfg.rack = static_cast<int>(std::min<std::uint32_t>(c.rack(), 2));
+      } else if (c.has_rack()) {
+        error_at(i, {{"connection", k}, {"rack"}},
+                 "connection \"" + c.name() + "\": a fault-tolerant connection has no rack (it uses both CPUs)");
+        continue;
+      }
+      if (std::string e = check.add_connection(cfg); !e.empty()) {
+        const char* field = c.name().empty() || e.find("duplicate") != std::string::npos ? "name"
+                            : e.find("rack must") != std::string::npos                    ? "rack"
+                                                                                          : "cp";
+        error_at(i, {{"connection", k}, {field}}, e);
+        continue;
+      }
+      rt.connections.push_back(std::move(cfg));
+    }
   }
 
   void plan_program(int i, const scenario::HProgram& pr, devices::ProgramSpec& spec) {

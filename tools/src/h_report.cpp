@@ -306,6 +306,15 @@ void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os) {
       os << "  H faults:\n";
       for (const auto& [at, text] : s.faults) os << "    " << pad(format_s_ms(at), 10) << text << "\n";
     }
+    if (!s.connections.empty()) {  // F4 connections
+      os << "  connections:\n";
+      for (const HConnectionRow& c : s.connections) {
+        os << "    " << c.name << " (" << c.kind << "): " << c.state;
+        if (!c.active.empty()) os << ", active path " << c.active;
+        os << "\n";
+        for (const auto& [at, text] : c.events) os << "      " << pad(format_s_ms(at), 10) << text << "\n";
+      }
+    }
     if (s.io_events.empty()) {
       os << "  I/O events: none\n";
     } else {
@@ -439,6 +448,18 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
       os << ",";
       json_opt_time(os, "first_io_after", w.first_io_after);
       os << "}";
+    }
+    os << "],\"connections\":[";  // F4 connections (last: the keys before keep their order)
+    for (std::size_t k = 0; k < s.connections.size(); ++k) {
+      const HConnectionRow& c = s.connections[k];
+      os << (k ? "," : "") << "{\"name\":" << json_quote(c.name) << ",\"kind\":" << json_quote(c.kind)
+         << ",\"state\":" << json_quote(c.state) << ",\"active\":" << json_quote(c.active) << ",\"events\":[";
+      for (std::size_t x = 0; x < c.events.size(); ++x) {
+        os << (x ? "," : "") << "{";
+        json_time(os, "time", c.events[x].first);
+        os << ",\"text\":" << json_quote(c.events[x].second) << "}";
+      }
+      os << "]}";
     }
     os << "]}";
   }

@@ -73,6 +73,11 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   try {
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models));
     if (has_networks(rt.program)) m_model->set_program(rt.program);
+    // F4 connections: checked by the planner already; an error here is a planner bug.
+    for (const devices::CpConfig& c : rt.cps)
+      if (std::string e = m_model->add_cp(c); !e.empty()) throw std::invalid_argument(e);
+    for (const devices::ConnectionConfig& c : rt.connections)
+      if (std::string e = m_model->add_connection(c); !e.empty()) throw std::invalid_argument(e);
   } catch (const std::exception& e) {
     throw std::runtime_error("h_system \"" + hp.name + "\": " + e.what());
   }
@@ -172,6 +177,9 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
     case K::SyncError:
       if (!m.inject_sync_error()) text += ": not in Redundant mode, nothing happens";
       break;
+    case K::CpFailure:  // F4; the repair re-establishes the standard connections over the CP
+      if (on ? !m.cp_failure(f.rack, f.cp) : !m.repair_cp(f.rack, f.cp)) text += ": nothing to do";
+      break;
     default: break;
   }
   m_faults.back().second = text;  // with what the pair answered ("refused", ...)
@@ -241,6 +249,24 @@ HSystemReport HSystemNode::report() const {
         if (u.first_scan_after != bus::kNever) w.first_io_after = u.first_scan_after;
         w.scan_time = plan().runtime->program.scan_time;
       }
+  // F4 connections: state, active path and their events.
+  const devices::HConnections& comms = m_model->comms();
+  for (std::size_t i = 0; i < comms.connections().size(); ++i) {
+    const devices::Connection& c = comms.connections()[i];
+    HConnectionRow row;
+    row.name = c.config.name;
+    row.kind = std::string(devices::to_string(c.config.kind));
+    row.state = std::string(devices::to_string(c.state));
+    if (c.active >= 0) {
+      const devices::ConnectionPath& p = c.paths[static_cast<std::size_t>(c.active)];
+      for (const devices::CpConfig& cp : comms.cps())
+        if (cp.rack == p.rack && cp.index == p.cp) row.active = std::string(devices::to_string(cp.kind)) + " ";
+      row.active += "rack " + std::to_string(p.rack) + " CP " + std::to_string(p.cp);
+    }
+    for (const devices::CommEvent& e : comms.events())
+      if (e.connection == static_cast<int>(i)) row.events.emplace_back(e.at, e.text);
+    r.connections.push_back(std::move(row));
+  }
   for (const devices::HIoEntry& e : m_model->io_map().entries()) {
     HIoMapRow row;
     row.address = e.address;

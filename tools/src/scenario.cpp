@@ -678,6 +678,7 @@ class Planner {
       // F2's repair is a memory reset: a memory_reset fault of its own, not a repair_at.
       case FK::kLoadMemoryError: info = {K::LoadMemoryError, "load_memory_error", false}; break;
       case FK::kSyncError: info = {K::SyncError, "sync_error", false}; break;
+      case FK::kCpFailure: info = {K::CpFailure, "cp_failure", true}; break;  // F4
       default: return false;
     }
     pf.kind = info.kind;
@@ -692,6 +693,11 @@ class Planner {
       case FK::kMemoryReset: cpu = &f.memory_reset(); break;
       case FK::kLoadMemoryError: cpu = &f.load_memory_error(); break;
       case FK::kSyncError: h_name = f.sync_error().h_system(); break;
+      case FK::kCpFailure:  // F4: rack as for a CPU fault, cp checked below
+        h_name = f.cp_failure().h_system();
+        needs_rack = true;
+        if (f.cp_failure().has_rack()) rack = f.cp_failure().rack();
+        break;
       case FK::kFibreCut:
         h_name = f.fibre_cut().h_system();
         if (f.fibre_cut().has_fibre()) fibre = f.fibre_cut().fibre();
@@ -782,6 +788,22 @@ class Planner {
         return false;
       }
       pf.fibre = static_cast<int>(*fibre);
+    }
+    if (pf.kind == K::CpFailure) {  // F4: an h_system cp entry of that rack
+      if (!f.cp_failure().has_cp()) {
+        error(kw, "cp_failure needs a cp: the CP's index in the rack (an h_system cp entry)");
+        return false;
+      }
+      const int cp = static_cast<int>(f.cp_failure().cp());
+      const bool known = std::any_of(rt.cps.begin(), rt.cps.end(), [&](const devices::CpConfig& c) {
+        return c.rack == pf.rack && c.index == cp;
+      });
+      if (!known) {
+        error(at_field(kw, kd, "cp"), "cp_failure: rack " + std::to_string(pf.rack) + " has no CP " +
+                                          std::to_string(cp) + " (h_system cp entries)");
+        return false;
+      }
+      pf.cp = cp;
     }
     if (pf.kind == K::UpdateLoad) {
       if (f.update_load().kb() == 0) {
@@ -875,6 +897,7 @@ class Planner {
         case FK::kMemoryReset:
         case FK::kLoadMemoryError:
         case FK::kSyncError:
+        case FK::kCpFailure:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::KIND_NOT_SET:
@@ -1032,6 +1055,7 @@ std::string h_fault_description(const PlanFault& f) {
     case K::MemoryReset: return "memory reset of " + cpu + " after its reset request";
     case K::LoadMemoryError: return cpu + ": load-memory access error";
     case K::SyncError: return "sync error (diverging uninitialised data)";
+    case K::CpFailure: return "CP " + std::to_string(f.cp) + " in rack " + std::to_string(f.rack) + " fails (F4)";
     default: return {};
   }
 }
@@ -1053,7 +1077,8 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::ParameterChange:
     case K::MemoryReset:
     case K::LoadMemoryError:
-    case K::SyncError: return true;
+    case K::SyncError:
+    case K::CpFailure: return true;
     default: return false;
   }
 }

@@ -56,7 +56,9 @@
 //   does not start it. Aborts caused by the partner or the link set no reset request.
 // - R8: connect(r) counts S7 connections; refused on a CPU off/ERROR-SEARCH/DEFECTIVE and on
 //   both CPUs while a CPU is in LINK-UP or UPDATE; link-up breaks the standby's, keeps the
-//   master's; power-off drops a CPU's.
+//   master's; power-off drops a CPU's. accepts_connections(r) is that admission rule, shared
+//   with HConnections (h_connections.hpp: the configured connections over the CPs, F4); the
+//   counter here is the ad-hoc connections only.
 // - F2 load_memory_error(r): r -> STOP + reset request (the F20 mechanism: STOP until
 //   memory_reset(), then a STOP -> RUN), entry "load-memory access error" (no event ID in the
 //   seeds: code 0); the partner's reaction is the one to a STOP of r (no new HReason: the OB 72
@@ -295,6 +297,10 @@ class HCpuPair {
   /// R8: open an S7 connection to `rack`; false on a CPU that is off, in ERROR-SEARCH or
   /// DEFECTIVE, and on both CPUs from the start of a link-up to the end of the update (400H).
   bool connect(int rack, bus::Ticks now);
+  /// R8's admission rule, the one truth for connect() and HConnections (h_connections.hpp): a
+  /// new S7 connection to `rack` is accepted now (powered, not ERROR-SEARCH/DEFECTIVE, and no
+  /// CPU in LINK-UP or UPDATE). Does not run deadlines: call after on_time()/an operation.
+  bool accepts_connections(int rack) const;
   /// F22: load a program change (into the master; in Redundant mode into both).
   HChangeResult load_change(HChange kind, bus::Ticks now);
   /// F23: the standby's configuration has a changed parameter that may not change; a

@@ -78,6 +78,11 @@
 //   otherwise, also when the line is lost only because its CPU/master stopped.
 // - The lines must be started (bus::Line::start powers every attachment) before the model is
 //   constructed: the construction unpowers the masters of the CPUs that are off.
+// - F4 connections, SSL (block at the end of the class, h_system_comms.cpp): an HConnections
+//   follows the pair at every reconcile(); its events go into both powered CPUs' buffers;
+//   repair_cp() re-establishes the standard connections the CP lost (000 §9.1.4 step 3).
+//   read_ssl(id, index) answers SFC 51 byte-exact for xy71, 0F71, 0C75, 0019, 0174, 0222 and
+//   0232 index 4 (h_ssl.hpp: layouts, RET_VAL 8082/8083/8085 and every decision).
 
 #include <array>
 #include <cstdint>
@@ -90,10 +95,12 @@
 
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
+#include "pbvbus/devices/h_connections.hpp"
 #include "pbvbus/devices/h_cpu_pair.hpp"
 #include "pbvbus/devices/h_io_map.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/devices/h_ssl.hpp"
 #include "pbvbus/devices/h_system_records.hpp"
 #include "pbvbus/devices/h_update_measure.hpp"
 #include "pbvbus/devices/redundant_master_system.hpp"
@@ -290,6 +297,37 @@ class HSystemModel final : public bus::EventTarget {
   std::function<void(const HSystemEvent&)> m_handler;
   std::function<void(const HEvent&)> m_pair_handler;
   std::array<std::vector<DiagEntry>, 2> m_io_diag;
+
+  // ---- F4 connections, SSL ----
+  // (devices/src/h_system_comms.cpp; rules in h_connections.hpp and h_ssl.hpp). The
+  // connections follow the pair at every reconcile(); their events go into both powered CPUs'
+  // diagnostic buffers (000 §9.1.4: "both CPUs report the event").
+ public:
+  /// Configuration before the run ("" or the error text; h_connections.hpp).
+  std::string add_cp(const CpConfig& cp) { return m_comms.add_cp(cp); }
+  std::string add_connection(const ConnectionConfig& c);
+  /// F4: the CP fails now. false: no such CP or already failed.
+  bool cp_failure(int rack, int cp);
+  /// The CP is replaced now: fault-tolerant connections regain the path as a reserve, and the
+  /// partner re-establishes the standard connections over it that were lost (000 §9.1.4 step
+  /// 3, "the system establishes the connection automatically"). false: not failed / no CP.
+  bool repair_cp(int rack, int cp);
+  /// The partner re-establishes a lost connection now (false: unknown, not lost, refused).
+  bool reestablish(std::string_view name);
+  const HConnections& comms() const { return m_comms; }
+  /// SFC 51 RDSYSST: the SSL partial list `id`/`index`, answered by the master (h_ssl.hpp).
+  SslResult read_ssl(std::uint16_t id, std::uint16_t index);
+
+ private:
+  void comms_update(bus::Ticks now);
+  void comms_log(bus::Ticks now);
+  SslResult ssl_h_state(int cpu) const;
+  SslResult ssl_switched_slave(std::uint16_t index) const;
+  SslResult ssl_leds(int cpu, std::uint16_t id, std::uint16_t index) const;
+  SslResult ssl_interrupt(std::uint16_t index) const;
+  SslResult ssl_protection(int cpu, std::uint16_t index) const;
+  HConnections m_comms;
+  std::size_t m_comms_logged = 0;  ///< comms events already in the diagnostic buffers
 };
 
 }  // namespace pbvbus::devices

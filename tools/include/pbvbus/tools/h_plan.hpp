@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "pbvbus/devices/h_connections.hpp"
 #include "pbvbus/devices/h_cpu_pair.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_update_timing.hpp"
@@ -51,6 +52,9 @@ struct HRuntimePlan {
   bool fibres_connected_at_power_on = true;
   devices::ProgramSpec program;
   std::vector<int> systems;  ///< indices into ScenarioPlan::redundant_systems (driven systems)
+  // ---- F4 connections (h_system cp/connection; devices/h_connections.hpp) ----
+  std::vector<devices::CpConfig> cps;
+  std::vector<devices::ConnectionConfig> connections;
 };
 
 struct HSystemPlan {

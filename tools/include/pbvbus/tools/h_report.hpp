@@ -99,6 +99,15 @@ struct HIoMapRow {
   std::size_t out_addr = 0, out_len = 0;
 };
 
+// ---- F4 connections: one configured S7 connection at the end of the run ----
+struct HConnectionRow {
+  std::string name;
+  std::string kind;    ///< "standard" / "fault-tolerant"
+  std::string state;   ///< "configured" / "established" / "lost"
+  std::string active;  ///< "CP 443-1 rack 0 CP 0", "" unless established
+  std::vector<std::pair<bus::Ticks, std::string>> events;  ///< established, switched, lost ...
+};
+
 struct HSystemReport {
   std::string name;
   devices::HProfile profile = devices::HProfile::S7_400H;
@@ -112,6 +121,8 @@ struct HSystemReport {
   std::vector<std::pair<bus::Ticks, std::string>> faults;
   /// The process-image map of the driven DP master systems, filled by the runtime.
   std::vector<HIoMapRow> io_map;
+  /// F4 connections: the configured S7 connections (h_system cp/connection), by the runtime.
+  std::vector<HConnectionRow> connections;
 };
 
 /// Everything the pair knows: final states, LEDs, buffers, the timeline from its events and

@@ -21,7 +21,8 @@
 //    simply not reached and the report says so.
 //  - `capture { line: "A" at: 14 }` must name a station on that line by its FDL address; two
 //    entries for the same point (or two without `at` for one line) are an error.
-//  - H-system faults (cpu_failure ... memory_reset, load_memory_error, sync_error;
+//  - H-system faults (cpu_failure ... memory_reset, load_memory_error, sync_error, cp_failure (F4: an h_system
+//    cp entry of that rack);
 //    docs/h-scenarios.md) name an h_system with a `cpu` part (the name may be left out when
 //    there is only one), a rack or fibre 0/1 where the kind needs one; repair_at only where a
 //    repair exists (power returns, RUN again, spliced, replaced, released); HOLD and the
@@ -132,6 +133,7 @@ struct PlanFault {
     MemoryReset,      ///< F20: memory reset of `rack` after its reset request
     LoadMemoryError,  ///< F2, `rack`: STOP + reset request; repair: a memory_reset fault
     SyncError,        ///< F18: diverging uninitialised data, the standby STOPs
+    CpFailure,        ///< F4, `rack`, `cp`; repair: CP replaced
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -157,6 +159,7 @@ struct PlanFault {
   int h_system = -1;   ///< H faults: index into ScenarioPlan::h_systems (one with a runtime)
   int rack = -1;       ///< H faults: 0 or 1 where the kind names a CPU
   int fibre = -1;      ///< fibre_cut: 0 = upper, 1 = lower
+  int cp = -1;         ///< cp_failure: the CP's index in `rack`
   std::uint32_t kb = 0;  ///< update_load: KB the next update copies
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
 };

@@ -46,8 +46,8 @@ std::vector<std::string> split_lines(const std::string& s) {
 // Fragments spliced into a line: values at and past the limits, module references, and whole
 // fields that are known to be checked late (after the protobuf parse).
 const char* const kTokens[] = {
-    " modules: [\"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", "
-    "\"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\"] ",
+    (" modules: [\"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", "
+     "\"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\", \"8DI DC24V\"] "),  // one token (nine modules)
     " modules: \"16DI/16DO DC24V\" ", " modules: \"16DI/16DO DC24V\" modules: \"8DI DC24V\" ",
     " modules: \"no such module\" ", " modules: [] ", " gsd: \"gsd/PBVB0A01.gsd\" ",
     " gsd: \"gsd/PBVB0A02.gsd\" ", " gsd: \"gsd/PBVB0A03.gsd\" ", " gsd: \"/nonexistent.gsd\" ",

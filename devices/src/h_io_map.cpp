@@ -30,9 +30,32 @@ HIoMap::HIoMap(std::span<RedundantMasterSystemModel* const> systems) {
   }
 }
 
+const HIoEntry& HIoMap::add_central(int rack, std::size_t module, std::size_t in_len,
+                                    std::size_t out_len) {
+  HIoEntry e;
+  e.system = -1;
+  e.module = module;
+  e.in_addr = m_pii;
+  e.in_len = in_len;
+  e.out_addr = m_piq;
+  e.out_len = out_len;
+  e.central = true;
+  e.rack = rack;
+  m_pii += in_len;
+  m_piq += out_len;
+  m_entries.push_back(e);
+  return m_entries.back();
+}
+
+const HIoEntry* HIoMap::find_central(int rack, std::size_t module) const {
+  for (const auto& e : m_entries)
+    if (e.central && e.rack == rack && e.module == module) return &e;
+  return nullptr;
+}
+
 const HIoEntry* HIoMap::find(int system, std::uint8_t address, std::size_t module) const {
   for (const auto& e : m_entries)
-    if (e.system == system && e.address == address && e.module == module) return &e;
+    if (!e.central && e.system == system && e.address == address && e.module == module) return &e;
   return nullptr;
 }
 
@@ -40,7 +63,7 @@ void HIoMap::read_inputs(std::span<RedundantMasterSystemModel* const> systems,
                          std::span<std::uint8_t> pii) const {
   if (pii.size() != m_pii) return;
   for (const auto& e : m_entries) {
-    if (e.in_len == 0 || static_cast<std::size_t>(e.system) >= systems.size()) continue;
+    if (e.central || e.in_len == 0 || static_cast<std::size_t>(e.system) >= systems.size()) continue;
     const dp::MasterImage* img = systems[static_cast<std::size_t>(e.system)]->system().active_image(e.address);
     if (img == nullptr) continue;  // no active channel: keep the last values
     (void)img->read_inputs(e.module, pii.subspan(e.in_addr, e.in_len));
@@ -51,7 +74,7 @@ void HIoMap::write_outputs(std::span<RedundantMasterSystemModel* const> systems,
                            std::span<const std::uint8_t> piq) const {
   if (piq.size() != m_piq) return;
   for (const auto& e : m_entries) {
-    if (e.out_len == 0 || static_cast<std::size_t>(e.system) >= systems.size()) continue;
+    if (e.central || e.out_len == 0 || static_cast<std::size_t>(e.system) >= systems.size()) continue;
     systems[static_cast<std::size_t>(e.system)]->system().write_outputs(
         e.address, e.module, piq.subspan(e.out_addr, e.out_len));
   }

@@ -258,7 +258,7 @@ void HSystemModel::on_event(bus::Ticks now, std::uint64_t tag) {
       return;
     }
     scan(now);
-    m_sched.schedule(now + m_scan_time, *this, kTagScan);
+    m_sched.schedule(end_cycle(now), *this, kTagScan);  // OB 80 monitoring, cycle_overload
     return;
   }
   if ((tag >> 1) != m_gen) return;  // stale deadline
@@ -275,14 +275,17 @@ void HSystemModel::scan(bus::Ticks now) {
     m_measures.back().first_scan_after = now;
   m_last_scan = now;
   check_process_image(now);
+  read_racks(now);  // F8: the expansion racks' OB 85 and inputs (h_system_racks.cpp)
   if (m_exec) {
     scan_execution(now);
+    write_racks();
     return;
   }
   ++m_scans;
   m_map.read_inputs(m_systems, m_pii);
   m_program(m_pii, m_piq, now);
   m_map.write_outputs(m_systems, m_piq);
+  write_racks();
 }
 
 // ---- events, diagnostics, LEDs -----------------------------------------------------------

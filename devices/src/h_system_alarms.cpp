@@ -139,6 +139,7 @@ void HSystemModel::check_process_image(bus::Ticks now) {
   std::uint8_t last = 0xFF;
   int last_sys = -1;
   for (const HIoEntry& e : m_map.entries()) {
+    if (e.central) continue;  // expansion racks: read_racks (h_system_racks.cpp)
     if (e.system == last_sys && e.address == last) continue;  // once per station
     last_sys = e.system;
     last = e.address;

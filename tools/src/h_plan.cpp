@@ -128,6 +128,9 @@ class HPlanner {
     if (!h.has_cpu() && (h.cp_size() > 0 || h.connection_size() > 0))
       error(i, h.cp_size() > 0 ? "cp" : "connection",
             "h_system \"" + hp.name + "\": cp and connection entries need a cpu part (the simulated pair)");
+    if (!h.has_cpu() && h.expansion_rack_size() > 0)
+      error(i, "expansion_rack",
+            "h_system \"" + hp.name + "\": expansion racks need a cpu part (the simulated pair)");
     m_plan.h_systems.push_back(std::move(hp));
   }
 
@@ -187,6 +190,10 @@ class HPlanner {
     }
     if (h.has_program()) plan_program(i, h.program(), rt.program);
     plan_comms(i, rt);  // F4 connections
+    for (int k = 0; k < h.expansion_rack_size(); ++k) plan_rack(i, k, rt.racks);
+    if (!c.max_cycle_time().empty())
+      if (auto t = ticks(i, {{"cpu"}, {"max_cycle_time"}}, c.max_cycle_time(), true))
+        rt.max_cycle_time = *t;
 
     // A simulated pair must not run on a bad set of H parameters.
     try {
@@ -256,6 +263,124 @@ class HPlanner {
       }
       rt.connections.push_back(std::move(cfg));
     }
+  }
+
+  // ---- F8 expansion racks ----
+  /// h_system[i].expansion_rack[k] -> racks (nothing on an error; h_plan.hpp has the rules).
+  void plan_rack(int i, int k, std::vector<devices::HExpansionRack>& racks) {
+    const auto& x = m_plan.proto.h_system(i).expansion_rack(k);
+    const HPathStep at{"expansion_rack", k};
+    devices::HExpansionRack r;
+    bool good = true;
+    if (!x.has_number()) {
+      error_at(i, {at}, "expansion rack needs a number: number: 1..21");
+      good = false;
+    } else if (x.number() < 1 || x.number() > static_cast<std::uint32_t>(devices::kMaxExpansionRack)) {
+      error_at(i, {at, {"number"}}, "expansion rack number " + std::to_string(x.number()) + " is not 1..21");
+      good = false;
+    } else {
+      r.number = static_cast<int>(x.number());
+      for (const auto& o : racks)
+        if (o.number == r.number) {
+          error_at(i, {at, {"number"}}, "expansion rack " + std::to_string(r.number) + " is defined twice");
+          good = false;
+        }
+    }
+    const std::string who = "expansion rack " + (x.has_number() ? std::to_string(x.number()) : std::string("?"));
+    if (!x.has_side()) {
+      error_at(i, {at}, who + " needs a side: side: 0 or side: 1 (the CPU it hangs on)");
+      good = false;
+    } else if (x.side() > 1) {
+      error_at(i, {at, {"side"}}, who + ": side " + std::to_string(x.side()) + " is not 0 or 1");
+      good = false;
+    } else {
+      r.side = static_cast<int>(x.side());
+    }
+    if (x.module_size() == 0) {
+      error_at(i, {at}, who + " has no module");
+      good = false;
+    }
+    for (int m = 0; m < x.module_size(); ++m) {
+      const auto& mod = x.module(m);
+      const std::vector<HPathStep> mp{at, {"module", m}};
+      devices::HRackModule out;
+      out.name = mod.name().empty() ? "module " + std::to_string(m) : mod.name();
+      out.in_len = mod.in_len();
+      out.out_len = mod.out_len();
+      const std::string mw = who + " module \"" + out.name + "\"";
+      if (out.in_len == 0 && out.out_len == 0) {
+        error_at(i, mp, mw + ": in_len and out_len are both 0");
+        good = false;
+      }
+      for (auto [len, field] : {std::pair{out.in_len, "in_len"}, std::pair{out.out_len, "out_len"}})
+        if (len > devices::kMaxRackModuleOctets) {
+          error_at(i, {at, {"module", m}, {field}},
+                   mw + ": " + field + " " + std::to_string(len) + " is more than 244 octets");
+          good = false;
+        }
+      using BC = scenario::HRackModule::BehaviourCase;
+      switch (mod.behaviour_case()) {
+        case BC::kConstant: {
+          std::vector<std::uint8_t> v(out.in_len, 0);
+          devices::put_big_endian(static_cast<std::int64_t>(mod.constant().value()), v.begin(), v.size());
+          out.inputs = devices::IoBehaviour::constant_value(std::move(v));
+          break;
+        }
+        case BC::kCounter: {
+          const auto& c = mod.counter();
+          bus::Ticks period = 0;
+          if (!c.period().empty()) {
+            auto t = ticks(i, {at, {"module", m}, {"counter"}}, c.period(), true);
+            if (!t) good = false;
+            period = t.value_or(0);
+          }
+          out.inputs = devices::IoBehaviour::counter_every(period, c.has_step() ? c.step() : 1, c.start());
+          break;
+        }
+        case BC::kRamp: {
+          const auto& rp = mod.ramp();
+          auto t = rp.period().empty() ? std::nullopt
+                                       : ticks(i, {at, {"module", m}, {"ramp"}}, rp.period(), true);
+          if (rp.period().empty()) error_at(i, {at, {"module", m}, {"ramp"}}, mw + ": ramp needs a period");
+          if (!t || rp.max() < rp.min()) {
+            if (t) error_at(i, {at, {"module", m}, {"ramp"}}, mw + ": ramp max is below min");
+            good = false;
+          }
+          out.inputs = devices::IoBehaviour::ramp(rp.min(), rp.max(), t.value_or(1));
+          break;
+        }
+        case BC::kEcho: {
+          const auto& e = mod.echo();
+          std::optional<std::size_t> src;
+          if (e.has_from_module_index()) {
+            src = e.from_module_index();
+          } else if (e.has_from_module()) {
+            for (int q = 0; q < x.module_size() && !src; ++q)
+              if (x.module(q).name() == e.from_module()) src = static_cast<std::size_t>(q);
+            if (!src) {
+              error_at(i, {at, {"module", m}, {"echo"}}, mw + ": echo from_module \"" + e.from_module() +
+                                                             "\" is not a module of this rack");
+              good = false;
+            }
+          }
+          const std::size_t from = src.value_or(static_cast<std::size_t>(m));
+          if (from >= static_cast<std::size_t>(x.module_size())) {
+            error_at(i, {at, {"module", m}, {"echo"}},
+                     mw + ": echo from_module_index " + std::to_string(from) + " is not a module of this rack");
+            good = false;
+          } else if (x.module(static_cast<int>(from)).out_len() == 0 && out.in_len > 0) {
+            error_at(i, {at, {"module", m}, {"echo"}},
+                     mw + ": echo source module " + std::to_string(from) + " has no outputs");
+            good = false;
+          }
+          out.inputs = devices::IoBehaviour::echo(from);
+          break;
+        }
+        case BC::BEHAVIOUR_NOT_SET: out.inputs = devices::IoBehaviour::constant_value({}); break;
+      }
+      r.modules.push_back(std::move(out));
+    }
+    if (good) racks.push_back(std::move(r));
   }
 
   void plan_program(int i, const scenario::HProgram& pr, devices::ProgramSpec& spec) {

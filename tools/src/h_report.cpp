@@ -11,6 +11,11 @@ namespace pbvbus::tools {
 
 namespace {
 
+std::string hex_byte(std::uint8_t b) {
+  static const char* d = "0123456789ABCDEF";
+  return {d[b >> 4], d[b & 0xF]};
+}
+
 using devices::CpuRole;
 using devices::CpuState;
 using devices::HEvent;
@@ -294,13 +299,28 @@ void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os) {
     if (!s.io_map.empty()) {
       os << "  process images (IB = inputs, QB = outputs):\n";
       for (const HIoMapRow& m : s.io_map) {
-        os << "    station " << static_cast<int>(m.address) << " module " << m.module << ":";
+        if (m.rack != 0) os << "    expansion rack " << m.rack << " module " << m.module << ":";
+        else os << "    station " << static_cast<int>(m.address) << " module " << m.module << ":";
         if (m.in_len != 0)
           os << " IB " << m.in_addr << ".." << (m.in_addr + m.in_len - 1);
         if (m.out_len != 0)
           os << " QB " << m.out_addr << ".." << (m.out_addr + m.out_len - 1);
         os << "\n";
       }
+    }
+    if (!s.racks.empty()) {
+      os << "  expansion racks:\n";
+      for (const HRackReport& r : s.racks) {
+        os << "    rack " << r.number << " on CPU " << r.side << ": " << (r.on ? "on" : "OFF") << ", "
+           << (r.reachable ? "reachable" : "not reachable") << (r.ob85 ? ", OB 85 episode open" : "");
+        for (const auto& m : r.modules) {
+          if (m.outputs.empty()) continue;
+          os << "; " << m.name << " outputs";
+          for (std::uint8_t b : m.outputs) os << " " << hex_byte(b);
+        }
+        os << "\n";
+      }
+      os << "  OB 80 calls: " << s.ob80 << "\n";
     }
     if (!s.faults.empty()) {
       os << "  H faults:\n";
@@ -410,7 +430,25 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
       const HIoMapRow& m = s.io_map[k];
       os << (k ? "," : "") << "{\"station\":" << static_cast<int>(m.address) << ",\"module\":" << m.module
          << ",\"in_addr\":" << m.in_addr << ",\"in_len\":" << m.in_len << ",\"out_addr\":" << m.out_addr
-         << ",\"out_len\":" << m.out_len << "}";
+         << ",\"out_len\":" << m.out_len;
+      if (m.rack != 0) os << ",\"rack\":" << m.rack;  // central (F8) rows only
+      os << "}";
+    }
+    if (!s.racks.empty()) {
+      os << "],\"ob80\":" << s.ob80 << ",\"expansion_racks\":[";
+      for (std::size_t k = 0; k < s.racks.size(); ++k) {
+        const HRackReport& r = s.racks[k];
+        os << (k ? "," : "") << "{\"number\":" << r.number << ",\"side\":" << r.side
+           << ",\"on\":" << (r.on ? "true" : "false") << ",\"reachable\":" << (r.reachable ? "true" : "false")
+           << ",\"ob85\":" << (r.ob85 ? "true" : "false") << ",\"modules\":[";
+        for (std::size_t m = 0; m < r.modules.size(); ++m) {
+          os << (m ? "," : "") << "{\"name\":" << json_quote(r.modules[m].name) << ",\"outputs\":[";
+          for (std::size_t o = 0; o < r.modules[m].outputs.size(); ++o)
+            os << (o ? "," : "") << static_cast<int>(r.modules[m].outputs[o]);
+          os << "]}";
+        }
+        os << "]}";
+      }
     }
     os << "],\"io_events\":[";
     for (std::size_t k = 0; k < s.io_events.size(); ++k) {

@@ -32,6 +32,7 @@ devices::HChange to_change(HProgramChangeKind k) {
 std::string HSystemNode::io_event_text(const devices::HSystemEvent& e) const {
   if (e.source != devices::HSystemEvent::Source::Io && e.source != devices::HSystemEvent::Source::Image)
     return e.text;
+  if (e.system < 0) return e.text;  // an expansion rack's OB 85/86: the model's text names it
   std::string kind;
   switch (e.code) {
     case 0x39B1: kind = "process-image transfer error incoming"; break;
@@ -71,7 +72,8 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     models.push_back(&node->model());
   }
   try {
-    m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models));
+    m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
+    m_model->set_max_cycle_time(rt.max_cycle_time);
     if (has_networks(rt.program)) m_model->set_program(rt.program);
     // F4 connections: checked by the planner already; an error here is a planner bug.
     for (const devices::CpConfig& c : rt.cps)
@@ -180,6 +182,11 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
     case K::CpFailure:  // F4; the repair re-establishes the standard connections over the CP
       if (on ? !m.cp_failure(f.rack, f.cp) : !m.repair_cp(f.rack, f.cp)) text += ": nothing to do";
       break;
+    case K::ExpansionRackFailure:
+      if (on ? !m.expansion_rack_off(f.rack_number) : !m.expansion_rack_on(f.rack_number))
+        text += on ? ": off already, nothing happens" : ": on already, nothing happens";
+      break;
+    case K::CycleOverload: m.cycle_overload(f.extra); break;
     default: break;
   }
   m_faults.back().second = text;  // with what the pair answered ("refused", ...)
@@ -199,7 +206,7 @@ void HSystemNode::on_model_event(const devices::HSystemEvent& e) {
   // OB 72/121 come with the pair's events, OB 70/86 with the redundancy records: the rest
   // (OB 85, the alarms' OB 40/82/83..., the program's 7960) as Cpu records of kind Ob.
   if (m_capture == nullptr || e.source == devices::HSystemEvent::Source::Cpu ||
-      e.source == devices::HSystemEvent::Source::Io)
+      (e.source == devices::HSystemEvent::Source::Io && e.system >= 0))  // racks' OB 86: here
     return;
   captures::CpuEventFields f;
   f.kind = captures::CpuEventKind::Ob;
@@ -275,8 +282,23 @@ HSystemReport HSystemNode::report() const {
     row.in_len = e.in_len;
     row.out_addr = e.out_addr;
     row.out_len = e.out_len;
+    if (e.central) row.rack = e.rack;
     r.io_map.push_back(row);
   }
+  for (const devices::HExpansionRack& x : m_model->expansion_racks()) {
+    HRackReport rr;
+    rr.number = x.number;
+    rr.side = x.side;
+    rr.on = m_model->expansion_rack_is_on(x.number);
+    rr.reachable = m_model->expansion_rack_reachable(x.number);
+    rr.ob85 = m_model->expansion_rack_ob85(x.number);
+    for (std::size_t m = 0; m < x.modules.size(); ++m) {
+      const auto out = m_model->rack_outputs(x.number, m);
+      rr.modules.push_back({x.modules[m].name, {out.begin(), out.end()}});
+    }
+    r.racks.push_back(std::move(rr));
+  }
+  r.ob80 = m_model->ob80_count();
   return r;
 }
 

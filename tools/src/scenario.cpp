@@ -679,6 +679,10 @@ class Planner {
       case FK::kLoadMemoryError: info = {K::LoadMemoryError, "load_memory_error", false}; break;
       case FK::kSyncError: info = {K::SyncError, "sync_error", false}; break;
       case FK::kCpFailure: info = {K::CpFailure, "cp_failure", true}; break;  // F4
+      case FK::kExpansionRackFailure:
+        info = {K::ExpansionRackFailure, "expansion_rack_failure", true};
+        break;
+      case FK::kCycleOverload: info = {K::CycleOverload, "cycle_overload", false}; break;
       default: return false;
     }
     pf.kind = info.kind;
@@ -698,6 +702,8 @@ class Planner {
         needs_rack = true;
         if (f.cp_failure().has_rack()) rack = f.cp_failure().rack();
         break;
+      case FK::kExpansionRackFailure: h_name = f.expansion_rack_failure().h_system(); break;
+      case FK::kCycleOverload: h_name = f.cycle_overload().h_system(); break;
       case FK::kFibreCut:
         h_name = f.fibre_cut().h_system();
         if (f.fibre_cut().has_fibre()) fibre = f.fibre_cut().fibre();
@@ -805,6 +811,41 @@ class Planner {
       }
       pf.cp = cp;
     }
+    if (pf.kind == K::ExpansionRackFailure) {
+      // The rack by number among the h_system's expansion_rack entries; `rack` = its CPU.
+      const auto& x = f.expansion_rack_failure();
+      if (!x.has_number()) {
+        error(kw, "expansion_rack_failure needs a number: number: 1..21 (an expansion_rack of " +
+                      quoted(plan.h_systems[static_cast<std::size_t>(found)].name) + ")");
+        return false;
+      }
+      const devices::HExpansionRack* r = nullptr;
+      for (const auto& q : rt.racks)
+        if (q.number == static_cast<int>(x.number())) r = &q;
+      if (r == nullptr) {
+        error(at_field(kw, kd, "number"),
+              "expansion_rack_failure: h_system " +
+                  quoted(plan.h_systems[static_cast<std::size_t>(found)].name) +
+                  " has no expansion_rack " + std::to_string(x.number()));
+        return false;
+      }
+      pf.rack_number = r->number;
+      pf.rack = r->side;
+    }
+    if (pf.kind == K::CycleOverload) {
+      const auto& x = f.cycle_overload();
+      if (x.extra().empty()) {
+        error(kw, "cycle_overload needs extra: how much longer the next OB 1 lasts, e.g. \"200ms\"");
+        return false;
+      }
+      auto t = duration(at_field(kw, kd, "extra"), x.extra());
+      if (!t) return false;
+      if (*t <= 0) {
+        error(at_field(kw, kd, "extra"), "cycle_overload: extra must be longer than 0");
+        return false;
+      }
+      pf.extra = *t;
+    }
     if (pf.kind == K::UpdateLoad) {
       if (f.update_load().kb() == 0) {
         error(kw, "update_load needs kb > 0 (the KB of DBs the next update copies)");
@@ -898,6 +939,8 @@ class Planner {
         case FK::kLoadMemoryError:
         case FK::kSyncError:
         case FK::kCpFailure:
+        case FK::kExpansionRackFailure:
+        case FK::kCycleOverload:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::KIND_NOT_SET:
@@ -1056,6 +1099,15 @@ std::string h_fault_description(const PlanFault& f) {
     case K::LoadMemoryError: return cpu + ": load-memory access error";
     case K::SyncError: return "sync error (diverging uninitialised data)";
     case K::CpFailure: return "CP " + std::to_string(f.cp) + " in rack " + std::to_string(f.rack) + " fails (F4)";
+    case K::ExpansionRackFailure:
+      return "expansion rack " + std::to_string(f.rack_number) + " of CPU " + std::to_string(f.rack) +
+             " off (IM 460/461)";
+    case K::CycleOverload: {
+      const bus::Ticks us = f.extra / bus::kTicksPerUs;
+      return "OB 1 overload: the next OB 1 lasts " +
+             (us % 1000 == 0 ? std::to_string(us / 1000) + " ms" : std::to_string(us) + " us") +
+             " longer";
+    }
     default: return {};
   }
 }
@@ -1079,6 +1131,8 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::LoadMemoryError:
     case K::SyncError:
     case K::CpFailure: return true;
+    case K::ExpansionRackFailure:
+    case K::CycleOverload: return true;
     default: return false;
   }
 }

@@ -14,6 +14,12 @@
 // without an active channel (failed, or no line runs) keeps its last PII bytes, as an S7
 // process image keeps the last values of a failed station (the program learns of it from
 // OB 86). Outputs go out through MasterSystem::write_outputs: both lines' images alike.
+//
+// Central I/O (F8 expansion racks, h_expansion_rack.hpp): HSystemModel appends the modules of
+// its expansion racks after every DP entry (add_central: racks in the order given, modules in
+// rack order), so the DP entries and their addresses never move. A central entry has
+// central = true, rack = the expansion rack number, system = -1, address = 0, module = the
+// module's index in its rack; read_inputs/write_outputs skip it (HSystemModel serves it).
 
 #include <cstddef>
 #include <cstdint>
@@ -32,6 +38,8 @@ struct HIoEntry {
   std::size_t in_len = 0;
   std::size_t out_addr = 0;   ///< first PIQ byte
   std::size_t out_len = 0;
+  bool central = false;  ///< a module of an expansion rack (F8), not DP
+  int rack = 0;          ///< central: the expansion rack number (1..21)
   bool operator==(const HIoEntry&) const = default;
 };
 
@@ -47,6 +55,12 @@ class HIoMap {
   std::size_t piq_size() const { return m_piq; }
   /// The entry of (system, address, module), or nullptr.
   const HIoEntry* find(int system, std::uint8_t address, std::size_t module) const;
+
+  /// Appends a central module of expansion rack `rack` after the entries so far.
+  const HIoEntry& add_central(int rack, std::size_t module, std::size_t in_len,
+                              std::size_t out_len);
+  /// The central entry of (rack, module), or nullptr.
+  const HIoEntry* find_central(int rack, std::size_t module) const;
 
   /// PII from the active images; bytes of slaves without an active channel are left as they are.
   /// Nothing happens if pii is not pii_size() long.

@@ -97,6 +97,7 @@
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/h_connections.hpp"
 #include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/devices/h_expansion_rack.hpp"
 #include "pbvbus/devices/h_io_map.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_redundant_execution.hpp"
@@ -236,6 +237,99 @@ class HSystemModel final : public bus::EventTarget {
   HSystemLeds leds(int rack) const;
 
   void on_event(bus::Ticks now, std::uint64_t tag) override;
+
+  // ---- F8 expansion racks, OB 80 ----
+  // Decisions (docs/h-system.md "Expansion racks (F8) and OB 80"; h_expansion_rack.hpp has the
+  // configuration rules and the event IDs; code in h_system_racks.cpp, h_system_cycle.cpp):
+  // - The racks' modules are one-sided central I/O of CPU `side`, appended to the I/O map after
+  //   every DP module (h_io_map.hpp: central entries, rack number). A rack is reachable while it
+  //   is on and its CPU runs the program (dp_master_operate(side)). At each OB 1 a reachable
+  //   rack's inputs go into the PII (in Redundant the PII is shared: the one-sided inputs reach
+  //   the partner over the sync link, digest §2, so both CPUs see the same bytes); an
+  //   unreachable one keeps its last PII bytes. After OB 1 a reachable rack's modules take
+  //   their PIQ bytes (rack_outputs). Counter inputs without a period count the rack's reads.
+  // - OB 85 (as for DP, same codes W#16#39B1/38B1, source Image, system -1, station = the rack
+  //   number, line = its side): at an OB 1, a rack that was reachable once and is not now
+  //   (off, or its CPU not running the program: the partner's Solo, a failed CPU) opens an
+  //   episode; the first OB 1 that reaches it again closes it. A rack whose CPU never ran the
+  //   program (the standby before its first link-up) is idle: no OB 85.
+  // - expansion_rack_off/on (F8): OB 86 W#16#39C1 incoming / W#16#38C1 outgoing at once (source
+  //   Io, system -1, station = rack number, line = side), an entry in every powered CPU's
+  //   diagnostic buffer; the OB runs on the CPUs running the program (rack -1 in Redundant:
+  //   "OB 86 on both") when the rack's own CPU runs it, else only the entries (no running CPU
+  //   sees the rack). Nobody notices a change while the rack's CPU is off. No CPU changes state.
+  // - OB 80 (time error W#16#3501, source Program: the program's cycle; ob 80): each OB 1 start
+  //   arms the cycle monitoring at start + max_cycle_time; if no OB 1 started since, none is due
+  //   at that instant (a cycle of exactly the maximum is no overrun) and the program still runs, OB 80 runs on the CPUs running the program (-1 in Redundant) and both
+  //   powered CPUs log it, once per overrun cycle. cycle_overload(extra): the next OB 1 lasts
+  //   scan_time + extra. A cycle that an update falls into ([t1, t5) began after its start or
+  //   is running) is monitored with max_cycle_time + the "max scan-cycle extension" H parameter
+  //   (digest §3.1: normal cycle monitoring is suspended during the update); with no extension
+  //   configured (0 or unset) such a cycle is not monitored. Not modelled: the STOP when OB 80
+  //   is called twice in one cycle (a cycle > 2 x max gives one OB 80).
+
+  /// The model with expansion racks: as set_expansion_racks (a bad configuration throws before
+  /// anything is scheduled).
+  HSystemModel(bus::Scheduler& sched, HCpuPairParams params,
+               std::vector<RedundantMasterSystemModel*> systems, std::vector<HExpansionRack> racks);
+  /// The expansion racks (before the run): appended to the I/O map, the images grow. Throws
+  /// std::invalid_argument("expansion racks: " + the first problem) for a bad configuration
+  /// (check_expansion_racks), after set_program(ProgramSpec) or once an OB 1 ran (the images'
+  /// sizes are fixed then); the model is then unchanged. Replaces racks set before.
+  void set_expansion_racks(std::vector<HExpansionRack> racks);
+  const std::vector<HExpansionRack>& expansion_racks() const { return m_rack_cfg; }
+  /// F8: rack `number` loses power / its IM 460-461 link; false (nothing happens) if there is no
+  /// such rack or it is off already.
+  bool expansion_rack_off(int number);
+  /// F8 repair: power back; false if there is no such rack or it is on.
+  bool expansion_rack_on(int number);
+  /// false also for an unknown rack.
+  bool expansion_rack_is_on(int number) const;
+  /// On and its CPU runs the program.
+  bool expansion_rack_reachable(int number) const;
+  /// An OB 85 episode is open for the rack.
+  bool expansion_rack_ob85(int number) const;
+  /// The octets a module's outputs got at the last OB 1 that reached the rack (zeros before);
+  /// empty for an unknown rack/module.
+  std::span<const std::uint8_t> rack_outputs(int number, std::size_t module) const;
+  /// The module's inputs as last read into the PII; empty for an unknown rack/module.
+  std::span<const std::uint8_t> rack_inputs(int number, std::size_t module) const;
+
+  /// OB 80's maximum cycle time (S7 default 150 ms). <= 0: std::invalid_argument.
+  void set_max_cycle_time(bus::Ticks t);
+  bus::Ticks max_cycle_time() const { return m_max_cycle; }
+  /// cycle_overload: the next OB 1 to start lasts scan_time + extra (the one after starts that
+  /// much later); several before one OB 1 add up. false (nothing) if extra <= 0.
+  bool cycle_overload(bus::Ticks extra);
+  /// OB 80 calls so far.
+  std::uint64_t ob80_count() const { return m_ob80; }
+
+ private:
+  struct RackState {
+    bool on = true;
+    bool ran = false;   ///< its CPU ran the program once (before: idle, no OB 85)
+    bool ob85 = false;  ///< OB 85 episode open
+    std::uint64_t reads = 0;
+    std::vector<std::vector<std::uint8_t>> in, out;  ///< per module
+  };
+  static std::vector<RedundantMasterSystemModel*> racks_checked(
+      std::vector<RedundantMasterSystemModel*> systems, const std::vector<HExpansionRack>& racks);
+  int rack_index(int number) const;
+  bool rack_reachable(std::size_t k) const;
+  void rack_event(std::size_t k, bool failed);
+  void read_racks(bus::Ticks now);  ///< at each OB 1: OB 85, the reachable racks' inputs
+  void write_racks();               ///< after OB 1: the PIQ into the reachable racks' modules
+  bus::Ticks end_cycle(bus::Ticks start);  ///< the next OB 1's start; arms the monitoring
+  void cycle_check(bus::Ticks start, bool extended);
+  void log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text);
+  std::vector<HExpansionRack> m_rack_cfg;
+  std::vector<RackState> m_racks;
+  bus::Ticks m_max_cycle = 150 * bus::kTicksPerMs;
+  bus::Ticks m_pending_extra = 0;
+  bus::Ticks m_cycle_start = bus::kNever;  ///< start of the last OB 1 (also a gated one)
+  bus::Ticks m_cycle_next = bus::kNever;   ///< when the next OB 1 is planned
+  std::uint64_t m_ob80 = 0;
+  // ---- end F8 expansion racks, OB 80 ----
 
  private:
   struct Side {

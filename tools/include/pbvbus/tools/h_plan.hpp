@@ -20,6 +20,10 @@
 //   to HCpuPairParams' 100 KB when that is 0.
 // - power_on "off" = not powered during the run; unset = "0s". Equal times for both racks are
 //   the simultaneous POWER ON (HCpuPair::power_on_both).
+// - expansion_rack entries (F8, needs `cpu`): number 1..21 unique and side 0/1 required, at
+//   least one module, each with in_len/out_len not both 0 and <= 244, a behaviour (constant,
+//   counter, ramp, echo of a module of the same rack that has outputs; default constant 0).
+//   max_cycle_time > 0 (OB 80).
 // - Program networks are checked as devices::ProgramSpec requires: width 1/2/4, period > 0,
 //   length > 0, discrepancy_time > 0, pulse_high < period, pulse_bit 0..7, scan_time > 0.
 #include <array>
@@ -30,6 +34,7 @@
 
 #include "pbvbus/devices/h_connections.hpp"
 #include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/devices/h_expansion_rack.hpp"
 #include "pbvbus/devices/h_program_spec.hpp"
 #include "pbvbus/devices/h_update_timing.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
@@ -55,6 +60,10 @@ struct HRuntimePlan {
   // ---- F4 connections (h_system cp/connection; devices/h_connections.hpp) ----
   std::vector<devices::CpConfig> cps;
   std::vector<devices::ConnectionConfig> connections;
+  // F8 expansion racks, OB 80 (HPlanner::plan_racks): the racks as HSystemModel takes them, and
+  // OB 80's maximum cycle time (HCpuPair.max_cycle_time, default 150 ms).
+  std::vector<devices::HExpansionRack> racks;
+  bus::Ticks max_cycle_time = 150 * bus::kTicksPerMs;
 };
 
 struct HSystemPlan {

@@ -97,6 +97,20 @@ struct HIoMapRow {
   std::size_t module = 0;
   std::size_t in_addr = 0, in_len = 0;
   std::size_t out_addr = 0, out_len = 0;
+  int rack = 0;  ///< a central module (F8): its expansion rack number; 0 = a DP slave's module
+};
+/// An expansion rack (F8) at the end of the run: its state and its modules' outputs.
+struct HRackReport {
+  int number = 0;
+  int side = 0;  ///< the CPU it hangs on
+  bool on = true;
+  bool reachable = false;  ///< on and its CPU runs the program
+  bool ob85 = false;       ///< an OB 85 episode is open
+  struct Module {
+    std::string name;
+    std::vector<std::uint8_t> outputs;  ///< as the last OB 1 that reached the rack wrote them
+  };
+  std::vector<Module> modules;
 };
 
 // ---- F4 connections: one configured S7 connection at the end of the run ----
@@ -123,6 +137,9 @@ struct HSystemReport {
   std::vector<HIoMapRow> io_map;
   /// F4 connections: the configured S7 connections (h_system cp/connection), by the runtime.
   std::vector<HConnectionRow> connections;
+  /// F8 expansion racks, OB 80 (filled by the runtime; JSON keys only when there are racks).
+  std::vector<HRackReport> racks;
+  std::uint64_t ob80 = 0;  ///< OB 80 calls (the events are in io_events)
 };
 
 /// Everything the pair knows: final states, LEDs, buffers, the timeline from its events and

@@ -134,6 +134,9 @@ struct PlanFault {
     LoadMemoryError,  ///< F2, `rack`: STOP + reset request; repair: a memory_reset fault
     SyncError,        ///< F18: diverging uninitialised data, the standby STOPs
     CpFailure,        ///< F4, `rack`, `cp`; repair: CP replaced
+    // F8 expansion racks, OB 80
+    ExpansionRackFailure,  ///< F8, `rack_number` (`rack` = its CPU); repair: power back
+    CycleOverload,         ///< the next OB 1 lasts scan_time + `extra` (OB 80)
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -162,9 +165,11 @@ struct PlanFault {
   int cp = -1;         ///< cp_failure: the CP's index in `rack`
   std::uint32_t kb = 0;  ///< update_load: KB the next update copies
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
+  int rack_number = 0;   ///< expansion_rack_failure: the expansion rack (1..21)
+  bus::Ticks extra = 0;  ///< cycle_overload: how much longer the next OB 1 lasts
 };
 
-/// An H-system fault kind (CpuFailure .. SyncError)?
+/// An H-system fault kind (CpuFailure .. SyncError, ExpansionRackFailure, CycleOverload)?
 bool is_h_fault(PlanFault::Kind k);
 /// "CPU 0 (rack 0) fails", "sync-link fibre 1 (lower) cut", ... (without the h_system name).
 std::string h_fault_description(const PlanFault& f);

@@ -109,6 +109,7 @@ struct PlanFault {
     ChannelDiag,
     ModulePull,
     ProcessAlarm,
+    SlaveStop,  ///< F15: the slave's CPU to STOP; repair: back to RUN
     // Switched I/O: applied through the redundant system's models.
     InterfaceFailure,  ///< `switched`, `side`
     StationPowerLoss,  ///< `switched`

@@ -36,6 +36,7 @@ struct DiagView {
   std::vector<std::size_t> faulty_ids;      ///< identifier numbers of channel blocks
   std::vector<std::size_t> faulty_modules;  ///< identifier-related block bits (module index)
   std::vector<std::uint8_t> alarm_slots;    ///< slots of Diagnostic/Pull/Plug alarm PDUs
+  std::vector<std::size_t> no_module;       ///< DP-V1 Module_Status "no module" (pulled)
   bool stop = false;                        ///< S7 record 0 with MDL_STOP
 };
 
@@ -57,6 +58,12 @@ DiagView view(std::span<const std::uint8_t> diag, bool dpv1) {
         if (bytes.size() < 4) continue;
         const std::uint8_t type = bytes[1];
         if (type == 1 || type == 3 || type == 4) v.alarm_slots.push_back(bytes[2]);
+        // Module_Status (0x82, slot 0): 2 bits per module from bit 0 of the first data octet.
+        if (type == dp::kModuleStatus && bytes[2] == 0)
+          for (std::size_t i = 4; i < bytes.size(); ++i)
+            for (std::size_t k = 0; k < 4; ++k)
+              if (((bytes[i] >> (2 * k)) & 0x03) == static_cast<std::uint8_t>(dp::ModuleState::NoModule))
+                v.no_module.push_back((i - 4) * 4 + k);
         // Status_Message, slot 0, data = record 0: octet 2 of the data is the 7th of the PDU.
         if (type == kStatusMessage && bytes[2] == 0 && bytes.size() >= 8 &&
             (bytes[4 + kS7Rec0MdlStopOctet] & kS7Rec0MdlStop) != 0)
@@ -140,12 +147,13 @@ void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis
   const dp::Master& m = ms.master(l);
   const DiagView v = view(d.diag, m.slave_params(d.station).dpv1());
   const dp::MasterImage& img = m.image(d.station);
-  auto event = [&](int module, bool incoming, bool stop) {
+  auto event = [&](int module, bool incoming, bool stop, int ob = 82) {
     HSystemEvent h;
     h.time = d.time;
     h.original_time = d.time;
-    h.ob = 82;
-    h.code = incoming ? kOb82Incoming : kOb82Outgoing;
+    h.ob = ob;
+    h.code = ob == 83 ? (incoming ? kOb83Removed : kOb83Inserted)
+                      : (incoming ? kOb82Incoming : kOb82Outgoing);
     h.incoming = incoming;
     h.source = HSystemEvent::Source::Diagnosis;
     h.system = sys;
@@ -156,9 +164,9 @@ void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis
     h.mdl_stop = stop;
     char buf[192];
     std::snprintf(buf, sizeof buf,
-                  "OB 82 W#16#%04X diagnosis %s, DP master system %zu, station %u, %s, MDL_ADDR "
+                  "OB %d W#16#%04X %s %s, DP master system %zu, station %u, %s, MDL_ADDR "
                   "%u, MDL_STOP %d",
-                  static_cast<unsigned>(h.code), incoming ? "incoming" : "outgoing", s + 1,
+                  ob, static_cast<unsigned>(h.code), ob == 83 ? "module" : "diagnosis", incoming ? "incoming" : "outgoing", s + 1,
                   static_cast<unsigned>(d.station),
                   module < 0 ? "station" : ("module " + std::to_string(module)).c_str(),
                   static_cast<unsigned>(h.mdl_addr), stop ? 1 : 0);
@@ -173,20 +181,26 @@ void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis
   }
   for (std::size_t mod = 0; mod < img.modules(); ++mod) {
     const dp::ModuleLayout& ml = img.module(mod);
+    const auto key = module_key(sys, d.station, mod);
+    const auto slot = static_cast<std::uint8_t>(mod + 1);
+    const bool alarm = std::find(v.alarm_slots.begin(), v.alarm_slots.end(), slot) !=
+                       v.alarm_slots.end();  // the alarm in this diagnosis is the module's OB
+    // Pulled / plugged (DP-V1 Module_Status): OB 83 unless the pull/plug alarm is its OB.
+    const bool pulled =
+        std::find(v.no_module.begin(), v.no_module.end(), mod) != v.no_module.end();
+    if (pulled != contains(m_pulled, key)) {
+      set(m_pulled, key, pulled);
+      if (!alarm) event(static_cast<int>(mod), pulled, false, 83);
+    }
+    if (pulled) continue;  // a pulled module's identifier bit is OB 83's, not a fault
     bool faulty = std::find(v.faulty_modules.begin(), v.faulty_modules.end(), mod) !=
                   v.faulty_modules.end();
     for (std::size_t id : v.faulty_ids)
       if (id >= ml.first_id && id < ml.first_id + std::max<std::size_t>(ml.id_count, 1))
         faulty = true;
-    const auto key = module_key(sys, d.station, mod);
-    if (contains(m_pulled, key)) faulty = true;  // a pulled module's bit is OB 83's
     if (faulty == contains(m_faulty, key)) continue;
     set(m_faulty, key, faulty);
-    const auto slot = static_cast<std::uint8_t>(mod + 1);
-    if (std::find(v.alarm_slots.begin(), v.alarm_slots.end(), slot) != v.alarm_slots.end())
-      continue;  // the alarm in this diagnosis is the module's OB
-    if (contains(m_pulled, key)) continue;
-    event(static_cast<int>(mod), faulty, false);
+    if (!alarm) event(static_cast<int>(mod), faulty, false);
   }
 }
 

@@ -23,6 +23,7 @@
 #include "pbvbus/devices/h_system.hpp"
 #include "pbvbus/devices/slave_model.hpp"
 #include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::devices {
 namespace {
@@ -54,6 +55,12 @@ struct DiagTap final : bus::Tap {
   std::vector<Resp> seen;
   void on_frame(const bus::TapFrame& f) override {
     const auto b = f.bytes;
+    // SD2 (68 LE LEr 68 DA SA FC DSAP SSAP DU FCS 16), or SD3 for exactly 8 data octets
+    // (A2 DA SA FC DSAP SSAP DU[6] FCS 16): a 6-octet diagnosis comes as SD3.
+    if (b.size() == 14 && b[0] == 0xA2 && (b[2] & 0x80) != 0 && b[5] == 60) {
+      seen.push_back({f.end, static_cast<std::uint8_t>(b[2] & 0x7F), Bytes(b.begin() + 6, b.end() - 2)});
+      return;
+    }
     if (b.size() < 11 || b[0] != 0x68 || (b[5] & 0x80) == 0 || b[8] != 60) return;
     seen.push_back({f.end, static_cast<std::uint8_t>(b[5] & 0x7F),
                     Bytes(b.begin() + 9, b.end() - 2)});
@@ -98,12 +105,17 @@ struct Fix {
       EXPECT_TRUE(sp.ok());
       dp::SlaveParams q = *sp.value;
       q.prm_cmd.assign(8, 0);
+      q.user_prm[1] |= dp::kEnablePullPlugAlarm;  // DPV1_Status_2: pull/plug alarms too
       cfg[l].push_back(q);
     }
     for (auto [g, m, a] : {std::tuple{&g0, &m0, kV0}, std::tuple{&g1, &m1, kV1}}) {
       auto sp = master_slave_params(*g, *m, a);
       EXPECT_TRUE(sp.ok()) << int(a);
-      cfg[0].push_back(*sp.value);
+      dp::SlaveParams q = *sp.value;
+      // 21: DPV1_Status_2 enables the diagnostic and pull/plug alarms its GSD supports (the
+      // GSD's constant leaves them off).
+      if (a == kV1) q.user_prm[1] |= dp::kEnableDiagnosticAlarm | dp::kEnablePullPlugAlarm;
+      cfg[0].push_back(q);
     }
     RedundantMasterSystemOptions o;
     o.bus_params = bp;
@@ -177,10 +189,10 @@ TEST(HF3Model, DpV0ChannelDiagnosisIsOb82OnBothCpus) {
   f.bring_up();
   const bus::Ticks t1 = kUp + 5 * kMs;
   f.at(t1);
-  // Module 0 (identifier 0), channel 3, input, bit, line break (6): 88 43 26.
+  // Module 0 (identifier 0), channel 3, input, bit, line break (6): 80 43 26.
   ASSERT_EQ(f.v0->apply(SlaveFault::channel_diag(0, 3, dp::ChannelError::LineBreak)), "");
   f.at(t1 + 100 * kMs);
-  const auto* r = f.tap.first(kV0, t1, [](const Bytes& du) { return has(du, {0x88, 0x43, 0x26}); });
+  const auto* r = f.tap.first(kV0, t1, [](const Bytes& du) { return has(du, {0x80, 0x43, 0x26}); });
   ASSERT_NE(r, nullptr);
   EXPECT_EQ(r->du[0] & 0x08, 0x08);  // Ext_Diag
   auto ob = f.obs(82);
@@ -226,7 +238,7 @@ TEST(HF3Model, DpV1DiagnosticAlarmIsOneOb82NotTwo) {
   ASSERT_EQ(f.v1->apply(c), "");
   f.at(t1 + 100 * kMs);
   // The diagnosis with the alarm PDU (type 1, slot 1) and the channel block 88 41 21.
-  const auto* r = f.tap.first(kV1, t1, [](const Bytes& du) { return has(du, {0x88, 0x41, 0x21}); });
+  const auto* r = f.tap.first(kV1, t1, [](const Bytes& du) { return has(du, {0x80, 0x41, 0x21}); });
   ASSERT_NE(r, nullptr);
   auto ob = f.obs(82);
   ASSERT_EQ(ob.size(), 1u);  // the alarm's; the diagnosis change adds none

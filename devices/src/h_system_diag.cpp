@@ -89,8 +89,9 @@ std::uint16_t HSystemModel::module_address(int system, std::uint8_t station, int
 
 bool HSystemModel::module_reachable(const HIoEntry& e) const {
   const redundancy::MasterSystem& ms = m_systems[static_cast<std::size_t>(e.system)]->system();
-  return ms.active_image(e.address) != nullptr &&
-         !contains(m_pulled, module_key(e.system, e.address, e.module));
+  const auto key = module_key(e.system, e.address, e.module);
+  return ms.active_image(e.address) != nullptr && !contains(m_pulled, key) &&
+         !contains(m_pulled_alarm, key);
 }
 
 void HSystemModel::io_ob(HSystemEvent h) {
@@ -116,14 +117,16 @@ void HSystemModel::alarm_start_info(std::size_t s, const redundancy::SystemAlarm
   h.mdl_addr = module_address(sys, a.station, module);
   if (module < 0) return;
   const auto key = module_key(sys, a.station, static_cast<std::size_t>(module));
+  // The alarm's own state is kept apart from the diagnosis-derived one (m_faulty, m_pulled):
+  // an alarm's PDU leaving the diagnosis at its acknowledgement must not look like a change.
   if (h.ob == 82) {
     h.code = h.incoming ? kOb82Incoming : kOb82Outgoing;
-    set(m_faulty, key, h.incoming);
   } else if (h.ob == 83) {
     const bool pulled = a.type == 3;
     h.code = pulled ? kOb83Removed : kOb83Inserted;
     h.incoming = pulled;
-    set(m_pulled, key, pulled);
+    set(m_pulled_alarm, key, pulled);
+    if (!pulled) reparameterise(sys, a.station, static_cast<std::size_t>(module));
   }
   char buf[64];
   std::snprintf(buf, sizeof buf, ", W#16#%04X, MDL_ADDR %u", static_cast<unsigned>(h.code),
@@ -190,7 +193,10 @@ void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis
         std::find(v.no_module.begin(), v.no_module.end(), mod) != v.no_module.end();
     if (pulled != contains(m_pulled, key)) {
       set(m_pulled, key, pulled);
-      if (!alarm) event(static_cast<int>(mod), pulled, false, 83);
+      if (!alarm) {
+        event(static_cast<int>(mod), pulled, false, 83);
+        if (!pulled) reparameterise(sys, d.station, mod);
+      }
     }
     if (pulled) continue;  // a pulled module's identifier bit is OB 83's, not a fault
     bool faulty = std::find(v.faulty_modules.begin(), v.faulty_modules.end(), mod) !=
@@ -201,6 +207,30 @@ void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis
     if (faulty == contains(m_faulty, key)) continue;
     set(m_faulty, key, faulty);
     if (!alarm) event(static_cast<int>(mod), faulty, false);
+  }
+}
+
+bool HSystemModel::set_module_parameters(std::size_t system, std::uint8_t station,
+                                         std::size_t module, std::uint8_t index,
+                                         std::vector<std::uint8_t> record) {
+  if (system >= m_systems.size() || record.empty() || record.size() > 240 ||
+      m_map.find(static_cast<int>(system), station, module) == nullptr)
+    return false;
+  const auto key = module_key(static_cast<int>(system), station, module);
+  std::erase_if(m_module_prm, [&](const ModulePrm& p) { return p.key == key; });
+  m_module_prm.push_back({key, index, std::move(record)});
+  return true;
+}
+
+void HSystemModel::reparameterise(int system, std::uint8_t station, std::size_t module) {
+  const auto key = module_key(system, station, module);
+  for (const ModulePrm& p : m_module_prm) {
+    if (p.key != key) continue;
+    redundancy::MasterSystem& ms = m_systems[static_cast<std::size_t>(system)]->system();
+    const auto slot = static_cast<std::uint8_t>(module + 1);
+    if (ms.write(station, slot, p.index, p.record, [](const dp::AcyclicResult&) {},
+                 m_sched.now()) != 0)
+      ++m_reparams;
   }
 }
 

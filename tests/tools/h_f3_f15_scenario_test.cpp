@@ -82,14 +82,14 @@ TEST(HF3F15Scenario, SlaveStopAndDirectArePlanned) {
 // 13 more -> its fields at 31.
 TEST(HF3F15Scenario, SlaveStopRefusalsCarryTheirPositions) {
   EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" address: 20 module_index: 0 } }\n"),
-            (std::vector<std::string>{"test.textproto:17:18: slave_stop takes no module"}));
+            (std::vector<std::string>{kFile + ":17:18: slave_stop takes no module"}));
   EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" address: 22 } }\n"),
             (std::vector<std::string>{
                 // `line: "DP_A" ` is 14 more -> address at 45.
-                "test.textproto:17:45: slave_stop: no dp_slave 22 on line \"DP_A\""}));
+                kFile + ":17:45: slave_stop: no dp_slave 22 on line \"DP_A\""}));
   EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" } }\n"),
             (std::vector<std::string>{
-                "test.textproto:17:18: slave_stop needs the address of a dp_slave"}));
+                kFile + ":17:18: slave_stop needs the address of a dp_slave"}));
 }
 
 TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
@@ -151,8 +151,11 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
   EXPECT_EQ(rd->mdl_addr, std::optional<std::uint16_t>(2));
   EXPECT_EQ(rd->racks, both);
   // Nothing before 11 s (the slave stopped at 5 s stays reachable), nothing after the return.
-  for (const auto& e : io)
-    if (e.ob == 122) EXPECT_TRUE(e.at >= failure->at && e.at < 12500 * kMs) << e.at;
+  for (const auto& e : io) {
+    if (e.ob == 122) {
+      EXPECT_TRUE(e.at >= failure->at && e.at < 12500 * kMs) << e.at;
+    }
+  }
   // No OB 82 twice: exactly the four above.
   int n82 = 0;
   for (const auto& e : io) n82 += e.ob == 82;

@@ -321,7 +321,19 @@ class HSystemModel final : public bus::EventTarget {
   //   write goes nowhere (the station is not there).
   // - Every one of these events is logged in both powered CPUs' diagnostic buffers (F3: "both
   //   CPUs log"); the OB runs on the CPUs running the program (rack -1 = both, synchronously).
+  // - Automatic re-parameterisation (F3): after a plug (OB 83 W#16#3861, from the alarm or the
+  //   Module_Status) the master writes the module's parameter data record, as the S7 CPU sends
+  //   a plugged module its parameter records: MSAC_C1 Write (MasterSystem::write over the
+  //   active channel) to slot = module + 1 with the index and octets the configuration gave
+  //   (set_module_parameters; the GSD's module parameters). A module without a registered
+  //   record gets none (the model knows no parameters for it). The result is not an OB.
  public:
+  /// Registers module `module`'s parameter data record (index, octets <= 240) written after
+  /// each plug. False: bad system/station/module or record length.
+  bool set_module_parameters(std::size_t system, std::uint8_t station, std::size_t module,
+                             std::uint8_t index, std::vector<std::uint8_t> record);
+  /// Parameter records written after plugs so far (the jobs started).
+  std::uint64_t reparameterisations() const { return m_reparams; }
   /// OB 122 episodes so far (one per network, direction and scan).
   std::uint64_t access_errors() const { return m_access_errors; }
 
@@ -340,12 +352,21 @@ class HSystemModel final : public bus::EventTarget {
     return (static_cast<std::uint32_t>(system) << 24) | (std::uint32_t{station} << 16) |
            static_cast<std::uint32_t>(module & 0xFFFF);
   }
-  std::vector<std::uint32_t> m_faulty;   ///< module_key: OB 82 incoming reported
-  std::vector<std::uint32_t> m_pulled;   ///< module_key: pull alarm, no plug yet
+  std::vector<std::uint32_t> m_faulty;   ///< module_key: faulty in the last diagnosis
+  std::vector<std::uint32_t> m_pulled;   ///< module_key: "no module" in the last diagnosis
+  std::vector<std::uint32_t> m_pulled_alarm;  ///< module_key: pull alarm, no plug alarm yet
   std::vector<std::uint32_t> m_stopped;  ///< module_key(system, station, 0xFFFF): MDL_STOP
   std::vector<CopyNetwork> m_direct;     ///< the spec's copy networks (those with `direct` count)
   std::vector<std::uint8_t> m_direct_pii;
   std::uint64_t m_access_errors = 0;
+  struct ModulePrm {
+    std::uint32_t key = 0;
+    std::uint8_t index = 0;
+    std::vector<std::uint8_t> record;
+  };
+  std::vector<ModulePrm> m_module_prm;
+  std::uint64_t m_reparams = 0;
+  void reparameterise(int system, std::uint8_t station, std::size_t module);
   // ---- end F3/F15/OB 122 ----
 };
 

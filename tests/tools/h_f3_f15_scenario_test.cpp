@@ -43,7 +43,7 @@ dp_slave { address: 20 line: "DP_A" gsd: "gsd/PBVB0A02.gsd" master: 1 modules: [
 dp_slave { address: 21 line: "DP_A" gsd: "gsd/PBVB0A03.gsd" master: 1 modules: ["8DI with process alarm", "8DO DC24V/0.5A"] }
 h_system {
   name: "H"
-  dp_system { system: "S" }
+  dp_system { system: "S" t_pto: "1250ms" }
   cpu { cpu0 { power_on: "0s" } cpu1 { power_on: "0s" } startup_time: "1s" link_up_time: "2s" }
   program { scan_time: "10ms" copy { from_input: 2 to_output: 2 direct: true } }
 }
@@ -85,8 +85,8 @@ TEST(HF3F15Scenario, SlaveStopRefusalsCarryTheirPositions) {
             (std::vector<std::string>{kFile + ":17:18: slave_stop takes no module"}));
   EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" address: 22 } }\n"),
             (std::vector<std::string>{
-                // `line: "DP_A" ` is 14 more -> address at 45.
-                kFile + ":17:45: slave_stop: no dp_slave 22 on line \"DP_A\""}));
+                // `line: "DP_A" ` is 13 more -> address at 44.
+                kFile + ":17:44: slave_stop: no dp_slave 22 on line \"DP_A\""}));
   EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" } }\n"),
             (std::vector<std::string>{
                 kFile + ":17:18: slave_stop needs the address of a dp_slave"}));

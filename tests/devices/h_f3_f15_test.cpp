@@ -378,8 +378,9 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   f.at(t2 + 1000 * kMs);
   // Re-parameterisation after the plug: the MSAC_C1 Write job (slot 2, index 1, 12 34) was
   // started on the active channel, once (after the plug, not after the pull). Its octets on the
-  // wire are NOT asserted yet: in this run the job did not appear on either line within 1 s
-  // (left open, see docs/h-system.md "Not done yet").
+  // wire are NOT asserted yet: the job completes (negatively: the station model keeps no
+  // parameter records), but this tap did not find its request frame (left open, see
+  // docs/h-system.md "Not done yet").
   EXPECT_EQ(f.h->reparameterisations(), 1u);
 
   EXPECT_EQ(f.obs(82).size(), 1u);

@@ -47,6 +47,8 @@ HSystemModel::HSystemModel(bus::Scheduler& sched, HCpuPairParams params,
         [this, s](const redundancy::SystemEvent& e) { on_io_event(s, e); });
     m_systems[s]->system().on_alarm(
         [this, s](const redundancy::SystemAlarm& a) { on_alarm(s, a); });
+    m_systems[s]->system().on_diagnosis(
+        [this, s](const redundancy::SystemDiagnosis& d) { on_diagnosis(s, d); });
   }
   reconcile();
   arm_deadline();

@@ -39,8 +39,9 @@ void HSystemModel::on_alarm(std::size_t s, const redundancy::SystemAlarm& a) {
   h.system = static_cast<int>(s);
   h.line = a.line;
   h.station = a.station;
-  h.code = a.type;  // the DP-V1 Alarm_Type (no S7 event ID for these in the seeds)
+  h.code = a.type;  // the DP-V1 Alarm_Type (OB 82/83: the S7 event ID, alarm_start_info)
   h.incoming = (a.specifier & 0x03) != 2;  // Alarm_Specifier 2 = disappears
+  alarm_start_info(s, a, h);  // OB 82/83: S7 event ID, MDL_ADDR, both CPUs log (F3)
   if (m_pair.interrupts_held()) {
     m_held_alarms.push_back(std::move(h));  // digest §4: DP modules store them, delivered after
     return;

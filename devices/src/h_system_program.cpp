@@ -15,6 +15,7 @@ void HSystemModel::set_program(const ProgramSpec& spec) {
   m_exec = std::make_unique<RedundantExecution>(spec, m_map.pii_size(), m_map.piq_size());
   m_program = nullptr;
   m_scan_time = spec.scan_time;  // > 0: validate() checked it
+  m_direct = spec.copies;        // OB 122 checks those with `direct` (h_system_diag.cpp)
   if (!m_scan_armed && program_runs() && !m_pair.io_frozen()) arm_scan(m_sched.now());
 }
 
@@ -26,8 +27,15 @@ bool HSystemModel::inject_divergence(int rack, Area area, std::uint32_t offset,
 void HSystemModel::scan_execution(bus::Ticks now) {
   // The sync point: the master's reading of the I/O goes into both PIIs.
   m_map.read_inputs(m_systems, m_pii);
-  m_exec->set_inputs(m_pii);
   const std::array<bool, 2> running{m_pair.dp_master_operate(0), m_pair.dp_master_operate(1)};
+  if (running[0] || running[1]) {
+    // Direct access (L PIB / T PQB): OB 122 for unreachable modules, their bytes read 0.
+    m_direct_pii = m_pii;
+    direct_access(now, m_direct_pii);
+    m_exec->set_inputs(m_direct_pii);
+  } else {
+    m_exec->set_inputs(m_pii);
+  }
   if (!running[0] && !running[1]) return;
   ++m_scans;
   std::optional<int> out;

@@ -12,6 +12,8 @@ std::string_view to_string(SlaveFault::Kind k) {
     case SlaveFault::Kind::ModulePulled: return "module pulled";
     case SlaveFault::Kind::ModulePlugged: return "module plugged";
     case SlaveFault::Kind::ProcessAlarm: return "process alarm";
+    case SlaveFault::Kind::SlaveStop: return "slave STOP";
+    case SlaveFault::Kind::SlaveRun: return "slave RUN";
   }
   return "?";
 }

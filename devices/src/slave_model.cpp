@@ -2,6 +2,7 @@
 #include "pbvbus/devices/slave_model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <stdexcept>
 
@@ -408,9 +409,9 @@ void SlaveModel::refresh_inputs(bus::Ticks now) {
   for (std::size_t m = 0; m < m_modules.size(); ++m) {
     Module& mod = m_modules[m];
     const std::size_t len = app.module(m).in_len;
-    if (len == 0 || (mod.channels.empty() && !mod.pulled)) continue;
+    if (len == 0 || (mod.channels.empty() && !mod.pulled && !m_stopped)) continue;
     std::span<std::uint8_t> buf(m_scratch.data(), len);
-    if (mod.pulled) {
+    if (mod.pulled || m_stopped) {
       std::fill(buf.begin(), buf.end(), std::uint8_t{0});
     } else {
       app.image().inputs(m).read(buf);
@@ -428,7 +429,8 @@ void SlaveModel::refresh_inputs(bus::Ticks now) {
 
 std::string SlaveModel::check_fault(const SlaveFault& f) const {
   using K = SlaveFault::Kind;
-  if (f.kind == K::Mute || f.kind == K::Unmute) return {};
+  if (f.kind == K::Mute || f.kind == K::Unmute || f.kind == K::SlaveStop || f.kind == K::SlaveRun)
+    return {};
   if (f.module >= m_modules.size())
     return std::string(to_string(f.kind)) + ": module " + std::to_string(f.module) +
            " does not exist (" + std::to_string(m_modules.size()) + " modules)";
@@ -500,6 +502,26 @@ void SlaveModel::do_apply(const SlaveFault& f) {
       if (m_dpv1_pull_plug)
         app.raise_alarm(static_cast<std::uint8_t>(pulled ? dp::AlarmType::Pull : dp::AlarmType::Plug), slot,
                         pulled ? dp::AlarmSpec::Appears : dp::AlarmSpec::Disappears, false);
+      break;
+    }
+    case K::SlaveStop:
+    case K::SlaveRun: {
+      const bool stop = f.kind == K::SlaveStop;
+      if (m_stopped == stop) break;
+      m_stopped = stop;
+      const std::array<std::uint8_t, 4> rec0{kS7Rec0ModuleFault, 0x00, kS7Rec0MdlStop, 0x00};
+      if (m_dpv1) {
+        if (stop)
+          app.set_status(kStatusMessage, 0, static_cast<std::uint8_t>(dp::AlarmSpec::Appears),
+                         rec0);
+        else
+          app.clear_status(kStatusMessage, 0);
+      } else {
+        app.set_device_diag(stop ? std::span<const std::uint8_t>(rec0)
+                                 : std::span<const std::uint8_t>{});
+      }
+      app.set_ext_diag(stop);
+      if (bound()) refresh_inputs(port().now());  // zero now, not at the next request
       break;
     }
     case K::ProcessAlarm:

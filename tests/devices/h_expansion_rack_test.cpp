@@ -297,3 +297,44 @@ TEST(HExpansionRack, SoloRackFailureOnTheMasterAndEchoInputs) {
 
 }  // namespace
 }  // namespace pbvbus::devices
+
+namespace pbvbus::devices {
+namespace {
+
+// OB 122 for a direct access to a central module (digest D1 applied to an expansion rack): a
+// copy network with `direct` from PIB 2 (rack 9's DIO8, CPU 1's side) to PQB 0 (rack 3's DO16).
+// In Solo (1000 .. 2990 ms, CPU 1 in LINK-UP) rack 9 is not reachable: every OB 1 raises one
+// OB 122 W#16#2942 (read) on CPU 0 alone and copies 0; the write goes to rack 3, which is there
+// (no 2943). From Redundant (3145 ms) rack 9 answers: A5 lands in rack 3's DO16, no OB 122.
+TEST(HExpansionRack, DirectAccessToAnUnreachableRackIsOb122) {
+  Pair p(two_racks());
+  ProgramSpec spec;
+  spec.copies.push_back(CopyNetwork{2, 0, 1, true});
+  p.h->set_program(spec);
+  p.sched.run_until(ms(2995));
+  auto ob122 = [&] {
+    std::vector<HSystemEvent> out;
+    for (const auto& e : p.h->events())
+      if (e.ob == 122) out.push_back(e);
+    return out;
+  };
+  const auto solo = ob122();
+  ASSERT_EQ(solo.size(), 200U);  // OB 1 at 1000, 1010, ..., 2990 ms
+  EXPECT_EQ(solo[0].time, ms(1000));
+  EXPECT_EQ(solo[199].time, ms(2990));
+  EXPECT_EQ(solo[0].code, 0x2942);
+  EXPECT_EQ(solo[0].rack, 0);
+  EXPECT_EQ(solo[0].system, -1);
+  EXPECT_EQ(solo[0].station, 9);
+  EXPECT_EQ(solo[0].mdl_addr, 2);
+  EXPECT_EQ(solo[0].text,
+            "OB 122 W#16#2942 I/O access error reading, copy 0, PIB 2, expansion rack 9, module 0");
+  EXPECT_EQ(bytes(p.h->rack_outputs(3, 1)), (Bytes{0x00, 0x00}));
+  p.sched.run_until(ms(3300));
+  EXPECT_EQ(ob122().size(), 200U);
+  EXPECT_EQ(bytes(p.h->rack_outputs(3, 1)), (Bytes{0xA5, 0x00}));
+  EXPECT_EQ(p.h->access_errors(), 200U);
+}
+
+}  // namespace
+}  // namespace pbvbus::devices

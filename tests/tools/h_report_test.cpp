@@ -200,7 +200,8 @@ TEST(HReport, JsonKeysAndTimes) {
 
 TEST(HReport, IoEventsArePrinted) {
   HSystemReport r = make_h_report("H-CPU", driven_pair());
-  r.io_events.push_back({10 * kTicksPerSecond, {0, 1}, 70, 0x73A3, "switched station 3: redundancy loss"});
+  r.io_events.push_back(
+      {10 * kTicksPerSecond, {0, 1}, 70, 0x73A3, "switched station 3: redundancy loss", {}, false});
   std::ostringstream os;
   write_h_text({r}, os);
   EXPECT_TRUE(has_line(lines_of(os.str()),

@@ -391,6 +391,7 @@ class HPlanner {
       devices::CopyNetwork c;
       c.from_input = n.from_input();
       c.to_output = n.to_output();
+      c.direct = n.direct();
       if (n.has_length()) {
         if (n.length() == 0)
           error_at(i, {{"program"}, {"copy", k}, {"length"}}, "copy network: length must be at least 1");

@@ -457,7 +457,9 @@ void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os) {
       json_time(os, "time", e.at);
       os << ",\"racks\":[";
       for (std::size_t x = 0; x < e.racks.size(); ++x) os << (x ? "," : "") << e.racks[x];
-      os << "],\"ob\":" << e.ob << ",\"code\":" << e.code << ",\"text\":" << json_quote(e.text) << "}";
+      os << "],\"ob\":" << e.ob << ",\"code\":" << e.code;
+      if (e.mdl_addr) os << ",\"mdl_addr\":" << *e.mdl_addr << ",\"mdl_stop\":" << (e.mdl_stop ? "true" : "false");
+      os << ",\"text\":" << json_quote(e.text) << "}";
     }
     os << "],\"updates\":[";
     for (std::size_t k = 0; k < s.updates.size(); ++k) {

@@ -244,6 +244,10 @@ HSystemReport HSystemNode::report() const {
     x.ob = e.ob;
     x.code = e.code;
     x.text = io_event_text(e);
+    if (e.ob == 82 || e.ob == 83 || e.ob == 122) {
+      x.mdl_addr = e.mdl_addr;
+      x.mdl_stop = e.mdl_stop;
+    }
     r.io_events.push_back(std::move(x));
   }
   // The phases of each update as the model measured them (t1 matches the pair's).

@@ -500,6 +500,7 @@ class Planner {
                         const pb::Descriptor* kd, const char* kind_field, int li, PlanFault& pf) {
     using K = PlanFault::Kind;
     const scenario::DpSlaveFault& s = pf.kind == K::SlaveMute     ? f.slave_mute()
+                                      : pf.kind == K::SlaveStop   ? f.slave_stop()
                                       : pf.kind == K::ChannelDiag ? f.channel_diag()
                                       : pf.kind == K::ModulePull  ? f.module_pull()
                                                                   : f.process_alarm();
@@ -525,6 +526,15 @@ class Planner {
         return false;
       }
       pf.description = "mute " + who;
+      return true;
+    }
+    if (pf.kind == K::SlaveStop) {
+      // F15: the slave's own CPU; the whole station, so no module.
+      if (s.module_ref_case() != scenario::DpSlaveFault::MODULE_REF_NOT_SET) {
+        error(kw, "slave_stop takes no module");
+        return false;
+      }
+      pf.description = "CPU of " + who + " to STOP";
       return true;
     }
     if (pf.kind == K::ProcessAlarm && !sp->config.features.dpv1) {
@@ -919,6 +929,7 @@ class Planner {
         case FK::kChannelDiag: pf.kind = K::ChannelDiag; line_name = f.channel_diag().line(); kind_field = "channel_diag"; break;
         case FK::kModulePull: pf.kind = K::ModulePull; line_name = f.module_pull().line(); kind_field = "module_pull"; break;
         case FK::kProcessAlarm: pf.kind = K::ProcessAlarm; line_name = f.process_alarm().line(); kind_field = "process_alarm"; break;
+        case FK::kSlaveStop: pf.kind = K::SlaveStop; line_name = f.slave_stop().line(); kind_field = "slave_stop"; break;
         case FK::kInterfaceFailure: pf.kind = K::InterfaceFailure; line_name = f.interface_failure().line(); kind_field = "interface_failure"; break;
         case FK::kStationPowerLoss: pf.kind = K::StationPowerLoss; line_name = f.station_power_loss().line(); kind_field = "station_power_loss"; break;
         case FK::kMasterFailure: pf.kind = K::MasterFailure; line_name = f.master_failure().line(); kind_field = "master_failure"; break;
@@ -1012,6 +1023,7 @@ class Planner {
           break;
         }
         case K::SlaveMute:
+        case K::SlaveStop:
         case K::ChannelDiag:
         case K::ModulePull:
         case K::ProcessAlarm:

@@ -348,6 +348,7 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
     case K::TransceiverFailure: l.set_transceiver_ok(f.a, !on); break;
     case K::Babble: l.set_babbling(f.a, on); break;
     case K::SlaveMute:
+    case K::SlaveStop:
     case K::ChannelDiag:
     case K::ModulePull:
     case K::ProcessAlarm: apply_slave_fault(f, on); break;
@@ -394,6 +395,11 @@ void Simulation::apply_slave_fault(const PlanFault& f, bool on) {
                                              : dp::ChannelDirection::Input,
                             on);
       text = f.description + (on ? " appears" : " disappears");
+      break;
+    case K::SlaveStop:
+      sf = on ? SF::slave_stop() : SF::slave_run();
+      text = on ? f.description : "CPU of" + f.description.substr(6, f.description.size() - 6 - 8) +
+                                      " back to RUN";  // "CPU of <who> to STOP"
       break;
     case K::ModulePull:
       sf = on ? SF::pulled(f.module) : SF::plugged(f.module);

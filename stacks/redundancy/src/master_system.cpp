@@ -210,6 +210,7 @@ void MasterSystem::on_master_event(int line, const dp::MasterEvent& e) {
     case K::DataExchangeEntered: channel_up(*s, line, e.time, e.diag); break;
     case K::Diagnosis:
       if (s->switched) observe_red_status(*s, line, e.diag, e.time);
+      on_diagnosis_event(*s, line, e);
       break;
     case K::Alarm: on_alarm_event(*s, line, e); break;
     case K::AlarmAcknowledged: on_alarm_ack(*s, line, e); break;
@@ -253,6 +254,39 @@ void MasterSystem::on_alarm_event(Station& s, int line, const dp::MasterEvent& e
   a.data.assign(e.alarm_data.begin(), e.alarm_data.end());
   m_alarms.push_back(a);
   if (m_alarm_cb) m_alarm_cb(m_alarms.back());
+}
+
+std::vector<std::uint8_t> diagnosis_content(std::span<const std::uint8_t> diag) {
+  std::vector<std::uint8_t> out;
+  std::vector<dp::ExtDiagBlock> blocks;
+  if (diag.size() <= dp::kStdDiagLen ||
+      !dp::split_ext_diag(diag.subspan(dp::kStdDiagLen), blocks))
+    return out;
+  for (const auto& b : blocks) {
+    // Prm_Cmd_Ack (0x9E) and Red_Status (0x9F): the redundancy's own state, per line.
+    if (b.kind == dp::kBlockDevice && b.bytes.size() >= 2 &&
+        (b.bytes[1] == 0x9E || b.bytes[1] == 0x9F))
+      continue;
+    out.insert(out.end(), b.bytes.begin(), b.bytes.end());
+  }
+  return out;
+}
+
+void MasterSystem::on_diagnosis_event(Station& s, int line, const dp::MasterEvent& e) {
+  const int act = s.switched ? s.active : s.home;
+  if (line != act) return;  // the passive channel's diagnosis is not the program's
+  auto content = diagnosis_content(e.diag);
+  if (content == s.diag_content) return;
+  SystemDiagnosis d;
+  d.time = e.time;
+  d.station = s.address;
+  d.line = line;
+  d.diag.assign(e.diag.begin(), e.diag.end());
+  d.previous = s.diag_du;
+  s.diag_content = std::move(content);
+  s.diag_du = d.diag;
+  ++m_diag_changes;
+  if (m_diag_cb) m_diag_cb(d);
 }
 
 void MasterSystem::on_alarm_ack(Station& s, int line, const dp::MasterEvent& e) {

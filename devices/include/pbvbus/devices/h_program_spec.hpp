@@ -24,10 +24,15 @@
 namespace pbvbus::devices {
 
 /// PII[from_input .. +length) → PIQ[to_output .. +length).
+/// direct: "L PIB / T PQB" instead of the process image (docs/h-programs.md "Direct access"):
+/// the same bytes (in this model the peripheral is read at the scan start, as the PII is, and
+/// written at the scan end, as the PIQ is), but the owner checks every direct access: a byte of
+/// a module that is not reachable reads 0 and raises OB 122 (h_system.hpp).
 struct CopyNetwork {
   std::uint32_t from_input = 0;
   std::uint32_t to_output = 0;
   std::uint32_t length = 1;
+  bool direct = false;
 };
 
 /// A counter in PIQ[output .. +width) (width 1, 2 or 4, big-endian, wraps), incremented by

@@ -111,8 +111,9 @@ namespace pbvbus::devices {
 struct HSystemEvent {
   /// Cpu: the pair's OB 72/121; Io: the master systems' S7 events (OB 70/86) and OB 85;
   /// Program: the program's own events (error 7960); Alarm: DP-V1 alarms as OBs (40/82/83 ...);
-  /// Image: OB 85 (process-image transfer error).
-  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm, Image };
+  /// Image: OB 85 (process-image transfer error); Diagnosis: OB 82 from a diagnosis change
+  /// (DP-V0 slave, a slave in STOP); Access: OB 122 (direct access to unreachable I/O).
+  enum class Source : std::uint8_t { Cpu, Io, Program, Alarm, Image, Diagnosis, Access };
   bus::Ticks time = 0;
   int rack = -1;                  ///< the CPU the OB runs on; -1 = both
   CpuRole role = CpuRole::None;   ///< the role of that CPU (both: Master)
@@ -127,6 +128,14 @@ struct HSystemEvent {
   /// after t5 or the abort, original_time = when the master system received it).
   bus::Ticks original_time = 0;
   bool incoming = true;  ///< Program (7960) and OB 85: false = outgoing ("gone")
+  // ---- F3/F15/OB 122 ---- OB start information any OB may fill (docs/h-system.md
+  // "Interrupts, ..."): OB 82/83: OB8x_MDL_ADDR = the module's logical address from the I/O
+  // map (its input address if it has inputs, else its output address; a station-level event:
+  // the station's first module's); OB 122: OB122_MEM_ADDR (the IB/QB address accessed).
+  std::uint16_t mdl_addr = 0;
+  bool mdl_stop = false;  ///< OB 82: OB82_MDL_STOP (F15: the slave's CPU is in STOP)
+  int module = -1;        ///< the module (slot order) concerned, -1 = the station / none
+  // ---- end F3/F15/OB 122 ----
 };
 
 enum class BusLed : std::uint8_t { Off, On, Flashing };
@@ -422,6 +431,75 @@ class HSystemModel final : public bus::EventTarget {
   SslResult ssl_protection(int cpu, std::uint16_t index) const;
   HConnections m_comms;
   std::size_t m_comms_logged = 0;  ///< comms events already in the diagnostic buffers
+
+  // ---- F3/F15/OB 122 ---- (h_system_diag.cpp; docs/h-system.md "Interrupts, ...")
+  // - OB 82 (W#16#3942 incoming / W#16#3842 outgoing, EV_CLASS 39/38, FLT_ID 42) from a DP-V1
+  //   Diagnostic alarm AND from a change of the station's diagnosis on its active channel
+  //   (MasterSystem::on_diagnosis): per mapped module, "faulty" = a channel block for one of
+  //   its identifiers or its bit in the identifier-related block; a change of that state is one
+  //   OB 82 for the module (mdl_addr = its address). A diagnosis that carries a DP-V1
+  //   Diagnostic/Pull/Plug alarm PDU for the module's slot (slot = module + 1) updates the state
+  //   silently: the alarm is that module's OB (no OB 82 twice; dp::Master reports the diagnosis
+  //   before the alarm it contains). Station level: the S7 diagnostic record 0 with MDL_STOP
+  //   (slave_fault.hpp; DP-V0 device block of 5 octets or Status_Message 0x81 slot 0) -> OB 82
+  //   3942 mdl_stop = 1 / 3842 mdl_stop = 0 (F15), mdl_addr = the station's first module.
+  // - OB 83: pull alarm W#16#3961 (module removed), plug alarm W#16#3861 (module inserted, type
+  //   OK); the module counts as not reachable for OB 122 between them.
+  // - OB 122 (digest D1): a copy network with `direct` (L PIB / T PQB) whose source or target
+  //   bytes lie in a module that is not reachable (no active channel, or pulled) -> OB 122
+  //   W#16#2942 (read) / W#16#2943 (write), once per network, direction and scan while it
+  //   lasts (S7 calls it per access; one per network is what the program sees per scan); the
+  //   read bytes are 0 for that scan (only for the program's run; pii() keeps the image), the
+  //   write goes nowhere (the station is not there).
+  // - Every one of these events is logged in both powered CPUs' diagnostic buffers (F3: "both
+  //   CPUs log"); the OB runs on the CPUs running the program (rack -1 = both, synchronously).
+  // - Automatic re-parameterisation (F3): after a plug (OB 83 W#16#3861, from the alarm or the
+  //   Module_Status) the master writes the module's parameter data record, as the S7 CPU sends
+  //   a plugged module its parameter records: MSAC_C1 Write (MasterSystem::write over the
+  //   active channel) to slot = module + 1 with the index and octets the configuration gave
+  //   (set_module_parameters; the GSD's module parameters). A module without a registered
+  //   record gets none (the model knows no parameters for it). The result is not an OB.
+ public:
+  /// Registers module `module`'s parameter data record (index, octets <= 240) written after
+  /// each plug. False: bad system/station/module or record length.
+  bool set_module_parameters(std::size_t system, std::uint8_t station, std::size_t module,
+                             std::uint8_t index, std::vector<std::uint8_t> record);
+  /// Parameter records written after plugs so far (the jobs started).
+  std::uint64_t reparameterisations() const { return m_reparams; }
+  /// OB 122 episodes so far (one per network, direction and scan).
+  std::uint64_t access_errors() const { return m_access_errors; }
+
+ private:
+  void on_diagnosis(std::size_t system, const redundancy::SystemDiagnosis& d);
+  /// OB 82/83 start information of a DP-V1 alarm (code, mdl_addr, module) and its bookkeeping.
+  void alarm_start_info(std::size_t system, const redundancy::SystemAlarm& a, HSystemEvent& h);
+  /// mdl_addr of module `module` of a station (-1: the station's first module).
+  std::uint16_t module_address(int system, std::uint8_t station, int module) const;
+  bool module_reachable(const HIoEntry& e) const;
+  /// OB 122 for the direct networks; zeroes the unreachable source bytes in `pii`.
+  void direct_access(bus::Ticks now, std::vector<std::uint8_t>& pii);
+  /// An I/O event in both powered CPUs' buffers, then (if a program runs) as an OB.
+  void io_ob(HSystemEvent h);
+  static std::uint32_t module_key(int system, std::uint8_t station, std::size_t module) {
+    return (static_cast<std::uint32_t>(system) << 24) | (std::uint32_t{station} << 16) |
+           static_cast<std::uint32_t>(module & 0xFFFF);
+  }
+  std::vector<std::uint32_t> m_faulty;   ///< module_key: faulty in the last diagnosis
+  std::vector<std::uint32_t> m_pulled;   ///< module_key: "no module" in the last diagnosis
+  std::vector<std::uint32_t> m_pulled_alarm;  ///< module_key: pull alarm, no plug alarm yet
+  std::vector<std::uint32_t> m_stopped;  ///< module_key(system, station, 0xFFFF): MDL_STOP
+  std::vector<CopyNetwork> m_direct;     ///< the spec's copy networks (those with `direct` count)
+  std::vector<std::uint8_t> m_direct_pii;
+  std::uint64_t m_access_errors = 0;
+  struct ModulePrm {
+    std::uint32_t key = 0;
+    std::uint8_t index = 0;
+    std::vector<std::uint8_t> record;
+  };
+  std::vector<ModulePrm> m_module_prm;
+  std::uint64_t m_reparams = 0;
+  void reparameterise(int system, std::uint8_t station, std::size_t module);
+  // ---- end F3/F15/OB 122 ----
 };
 
 }  // namespace pbvbus::devices

@@ -20,6 +20,10 @@ struct SlaveFault {
     ModulePulled,
     ModulePlugged,
     ProcessAlarm,       ///< DP-V1 process alarm for `module`'s slot with `data`
+    /// F15: an intelligent slave's own CPU goes to STOP / back to RUN (slave_model.hpp has the
+    /// wire behaviour: data exchange goes on, inputs 0, S7 diagnostic record 0 with MDL_STOP).
+    SlaveStop,
+    SlaveRun,
   };
   Kind kind = Kind::Mute;
   std::size_t module = 0;   ///< 0-based module index of the slave's module list
@@ -53,6 +57,8 @@ struct SlaveFault {
   }
   static SlaveFault pulled(std::size_t module) { return of(Kind::ModulePulled, module); }
   static SlaveFault plugged(std::size_t module) { return of(Kind::ModulePlugged, module); }
+  static SlaveFault slave_stop() { return of(Kind::SlaveStop); }
+  static SlaveFault slave_run() { return of(Kind::SlaveRun); }
   static SlaveFault process_alarm(std::size_t module, std::vector<std::uint8_t> d) {
     SlaveFault f;
     f.kind = Kind::ProcessAlarm;
@@ -63,5 +69,14 @@ struct SlaveFault {
 };
 
 std::string_view to_string(SlaveFault::Kind k);
+
+/// S7 diagnostic data record 0 (4 octets, the OB 82 start information bytes 8..11; "System
+/// Software for S7-300/400", OB 82 local data): octet 0 bit 0 MDL_DEFECT (module fault), octet 2
+/// bit 2 MDL_STOP (operating mode STOP). An intelligent slave in STOP reports {01 00 04 00}.
+inline constexpr std::uint8_t kS7Rec0ModuleFault = 0x01;  ///< octet 0
+inline constexpr std::uint8_t kS7Rec0MdlStop = 0x04;      ///< octet 2
+inline constexpr std::size_t kS7Rec0MdlStopOctet = 2;
+/// DP-V1 status type of the record as a status PDU (Status_Message, protocol-facts §E).
+inline constexpr std::uint8_t kStatusMessage = 0x81;
 
 }  // namespace pbvbus::devices

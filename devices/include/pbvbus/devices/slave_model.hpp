@@ -45,6 +45,17 @@
 // - Channel diagnosis refers to a module; the channel block carries the module's first identifier
 //   number (Chk_Cfg order), as the standard numbers identifiers. With `alarm` set, a DP-V1 slave
 //   also raises a Diagnostic alarm for the module's slot (data = the 3 channel octets).
+// - SlaveStop / SlaveRun (F15, an intelligent slave whose own CPU stops; digest §6 "DP master
+//   event detection"): the DP interface keeps running, so the slave STAYS in data exchange (a
+//   CPU in STOP does not leave the bus; the master's failure detection is not involved); its
+//   inputs read 0 (its program no longer writes them) and outputs are ignored by it; its
+//   diagnosis gets Ext_Diag and the S7 diagnostic record 0 {01 00 04 00} (MDL_DEFECT, MDL_STOP =
+//   octet 2 bit 2; slave_fault.hpp) — for a DP-V0 slave as a free-format device-related block
+//   `05 01 00 04 00`, for a DP-V1 slave as a Status_Message PDU (0x81, slot 0, specifier
+//   "appears") `08 81 00 01 01 00 04 00`, because a DP-V1 master reads the second octet of a
+//   device-related block as an alarm/status type. Back to RUN: the block is removed (its
+//   absence is MDL_STOP = 0) and Ext_Diag cleared; inputs follow the behaviours again. Each
+//   change makes the next Data_Exchange answer DH, so the master reads the new diagnosis.
 // - Time-based behaviours use absolute virtual time (tick 0 = line start), so values at a given
 //   time are known in advance and survive power cycles.
 
@@ -175,6 +186,8 @@ class SlaveModel final : public bus::Device {
   std::string schedule(bus::Ticks at, SlaveFault f);
   bool muted() const { return m_muted; }
   bool module_pulled(std::size_t m) const { return m_modules[m].pulled; }
+  /// F15: the slave's own CPU is in STOP.
+  bool stopped() const { return m_stopped; }
 
   // --- bus::Device
   void on_power_on(bus::Ticks now) override;
@@ -221,6 +234,7 @@ class SlaveModel final : public bus::Device {
   std::uint64_t m_fault_order = 0;
   std::uint64_t m_dp_cycles = 0;
   bool m_muted = false;
+  bool m_stopped = false;
   bool m_powered = false;
   bus::Ticks m_station_timer = bus::kNever;
   bus::Ticks m_armed = bus::kNever;

@@ -75,6 +75,10 @@ struct HIoEvent {
   int ob = 0;
   std::uint16_t code = 0;
   std::string text;
+  /// OB 82/83/122 (F3/F15): OB8x_MDL_ADDR / OB122_MEM_ADDR and OB82_MDL_STOP (JSON only for
+  /// these OBs; the text names them too).
+  std::optional<std::uint16_t> mdl_addr;
+  bool mdl_stop = false;
 };
 
 struct HUpdateWindow {

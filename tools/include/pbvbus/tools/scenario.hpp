@@ -28,6 +28,8 @@
 //    repair exists (power returns, RUN again, spliced, replaced, released); HOLD and the
 //    operator swap not on an S7-1500R/H pair. They are planned with line = -1 and are not
 //    applied by the Simulation until the H-system runtime exists.
+//  - slave_stop (F15) is a DP slave fault like slave_mute: a dp_slave by line and address, no
+//    module; repair_at = back to RUN (docs/h-scenarios.md "F3 / F15 / OB 122 in scenarios").
 
 #include <cstdint>
 #include <optional>
@@ -110,6 +112,7 @@ struct PlanFault {
     ChannelDiag,
     ModulePull,
     ProcessAlarm,
+    SlaveStop,  ///< F15: the slave's CPU to STOP; repair: back to RUN
     // Switched I/O: applied through the redundant system's models.
     InterfaceFailure,  ///< `switched`, `side`
     StationPowerLoss,  ///< `switched`

@@ -81,6 +81,15 @@
 //   `record_attempts` times in all; the callback runs once, with the final result (id = the
 //   system's job id). A Read is idempotent; a Write repeated after an interruption may reach the
 //   station twice — as on the S7-400H, where the record job is repeated by the system.
+// - Diagnosis changes (S7 masters call OB 82 when a DP-V0 slave's diagnosis changes; H-system
+//   F3/F15): on_diagnosis() gets the station's Slave_Diag whenever its CONTENT changed on the
+//   ACTIVE channel (one-sided: its own line). Content = the extended-diagnosis blocks without
+//   the redundancy status PDUs (Prm_Cmd_Ack 0x9E, Red_Status 0x9F, which differ per line and
+//   change at every switchover); the six standard octets are not compared (master-set bits,
+//   WD_On ...). The baseline is "no blocks" at construction; start-up reads raise nothing
+//   (dp::Master raises Diagnosis only in data exchange), so a station that comes up with a
+//   fault is reported at its first change. A passive channel's diagnosis is never delivered
+//   (the program reads the active one), so a switchover alone raises nothing.
 
 #include <array>
 #include <cstdint>
@@ -125,6 +134,18 @@ struct SystemAlarm {
   std::uint8_t specifier = 0;
   std::vector<std::uint8_t> data;
 };
+
+/// A change of a station's diagnosis content on its active channel (see above).
+struct SystemDiagnosis {
+  bus::Ticks time = 0;
+  std::uint8_t station = 0;
+  int line = -1;
+  std::vector<std::uint8_t> diag;  ///< the whole Slave_Diag DU as the master stored it
+  std::vector<std::uint8_t> previous;  ///< the last delivered one (empty: none before)
+};
+/// The extended-diagnosis blocks of a Slave_Diag DU without Prm_Cmd_Ack/Red_Status PDUs (the
+/// content on_diagnosis compares); empty for a DU of six octets or a broken block length.
+std::vector<std::uint8_t> diagnosis_content(std::span<const std::uint8_t> diag);
 
 /// Why a whole line is lost.
 enum class LineLoss : std::uint8_t {
@@ -227,6 +248,9 @@ class MasterSystem {
   }
   void on_alarm(std::function<void(const SystemAlarm&)> cb) { m_alarm_cb = std::move(cb); }
   const std::vector<SystemAlarm>& alarms() const { return m_alarms; }
+  /// Diagnosis content changes on the active channel (see above), delivered in order.
+  void on_diagnosis(std::function<void(const SystemDiagnosis&)> cb) { m_diag_cb = std::move(cb); }
+  std::uint64_t diagnosis_changes() const { return m_diag_changes; }
   /// Alarms a station raised again after a switchover that were recognised and not delivered.
   std::uint64_t alarm_repeats() const { return m_alarm_repeats; }
 
@@ -266,6 +290,8 @@ class MasterSystem {
       bus::Ticks orphaned = bus::kNever;  ///< its channel went down before the ack
     };
     std::vector<Unacked> unacked;
+    std::vector<std::uint8_t> diag_content;  ///< last delivered diagnosis content
+    std::vector<std::uint8_t> diag_du;       ///< its whole DU
   };
 
   Station* find(std::uint8_t address);
@@ -277,6 +303,7 @@ class MasterSystem {
                           bus::Ticks now);
   void on_alarm_event(Station& s, int line, const dp::MasterEvent& e);
   void on_alarm_ack(Station& s, int line, const dp::MasterEvent& e);
+  void on_diagnosis_event(Station& s, int line, const dp::MasterEvent& e);
   struct Record {
     std::uint32_t id = 0;
     std::uint8_t address = 0;
@@ -314,6 +341,8 @@ class MasterSystem {
   std::function<void(const SystemAlarm&)> m_alarm_cb;
   std::vector<SystemAlarm> m_alarms;
   std::uint64_t m_alarm_repeats = 0;
+  std::function<void(const SystemDiagnosis&)> m_diag_cb;
+  std::uint64_t m_diag_changes = 0;
   std::vector<Record> m_records;
   std::uint32_t m_next_record = 1;
   std::uint64_t m_record_repeats = 0;

@@ -1,0 +1,172 @@
+// The scenario side of F3, F15 and OB 122 (docs/h-scenarios.md: fault slave_stop, program copy
+// `direct`): planned, refused with FILE:LINE:COLUMN, and run through the Simulation
+// (HSystemNode -> HSystemModel), asserted from the report's I/O events (OB, code, racks,
+// mdl_addr, mdl_stop) and its JSON.
+//
+// The run (pair defaults as examples/h-system.textproto: startup 1 s, link-up 2 s, update
+// 145 ms): Redundant from 3.145 s. I/O map (addresses sorted): station 3 IB 0..1 / QB 0..1,
+// station 20 (DP-V0, PBVB0A02) 8DI IB 2 / 8DO QB 2, station 21 (DP-V1, PBVB0A03) 8DI IB 3 / 8DO
+// QB 3. Program: copy IB 2 -> QB 2 direct.
+//   5 s / 6 s   slave_stop of 20 and back to RUN: OB 82 3942 MDL_STOP 1 / 3842 MDL_STOP 0
+//   7 s / 8 s   channel_diag on 21's module 0 (no alarm: the diagnosis change): OB 82 3942/3842
+//   9 s / 10 s  module_pull of 21's module 1 (DP-V1 pull/plug alarms): OB 83 3961 / 3861
+//   11 s / 12 s slave_mute of 20: OB 86 39C4, then OB 122 2942/2943 at every scan until back
+// The OB times are the master's Slave_Diag confirmations after the slave's DH answer: within
+// one DP cycle plus one Slave_Diag (< 20 ms at 1.5 Mbit/s with three slaves) of the fault.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "pbvbus/tools/h_report.hpp"
+#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/tools/simulation.hpp"
+
+namespace pbvbus::tools {
+namespace {
+
+constexpr bus::Ticks kMs = bus::kTicksPerMs;
+constexpr bus::Ticks kS = bus::kTicksPerSecond;
+using K = PlanFault::Kind;
+const std::string kFile = PBVBUS_SOURCE_DIR "/examples/test.textproto";
+
+const std::string kHead = R"(name: "f3-f15"
+duration: "14s"
+line { name: "DP_A" baud: "1.5M" }
+line { name: "DP_B" baud: "1.5M" }
+dp_master { address: 1 line: "DP_A" watchdog: "100ms" }
+dp_master { address: 1 line: "DP_B" watchdog: "100ms" }
+redundant_master_system { name: "S" line_a: "DP_A" master_a: 1 line_b: "DP_B" master_b: 1 }
+switched_station { system: "S" address: 3 gsd: "gsd/PBVB0A10.gsd" modules: ["16DI DC24V", "16DO DC24V/0.5A"] }
+dp_slave { address: 20 line: "DP_A" gsd: "gsd/PBVB0A02.gsd" master: 1 modules: ["8DI DC24V", "8DO DC24V/0.5A"] }
+dp_slave { address: 21 line: "DP_A" gsd: "gsd/PBVB0A03.gsd" master: 1 modules: ["8DI with process alarm", "8DO DC24V/0.5A"] }
+h_system {
+  name: "H"
+  dp_system { system: "S" t_pto: "1250ms" }
+  cpu { cpu0 { power_on: "0s" } cpu1 { power_on: "0s" } startup_time: "1s" link_up_time: "2s" }
+  program { scan_time: "10ms" copy { from_input: 2 to_output: 2 direct: true } }
+}
+)";
+const std::string kFaults = R"(fault { at: "5s" repair_at: "6s" slave_stop { line: "DP_A" address: 20 } }
+fault { at: "7s" repair_at: "8s" channel_diag { line: "DP_A" address: 21 module_index: 0 channel: 2 error_type: 6 } }
+fault { at: "9s" repair_at: "10s" module_pull { line: "DP_A" address: 21 module_index: 1 } }
+fault { at: "11s" repair_at: "12s" slave_mute { line: "DP_A" address: 20 } }
+)";
+
+std::vector<std::string> errors_of(const std::string& text) {
+  std::vector<std::string> out;
+  for (const auto& d : parse_scenario(text, kFile).errors) out.push_back(d.str());
+  return out;
+}
+
+TEST(HF3F15Scenario, SlaveStopAndDirectArePlanned) {
+  const auto r = parse_scenario(kHead + kFaults, kFile);
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  const auto& f = r.plan->faults;
+  ASSERT_EQ(f.size(), 4u);
+  EXPECT_EQ(f[0].kind, K::SlaveStop);
+  EXPECT_EQ(f[0].at, 5 * kS);
+  EXPECT_EQ(f[0].repair_at, 6 * kS);
+  EXPECT_EQ(f[0].slave, 20);
+  EXPECT_EQ(f[0].description, "CPU of DP slave 20 on line DP_A to STOP");
+  EXPECT_FALSE(is_h_fault(K::SlaveStop));
+  ASSERT_EQ(r.plan->h_systems.size(), 1u);
+  ASSERT_TRUE(r.plan->h_systems[0].runtime.has_value());
+  const auto& copies = r.plan->h_systems[0].runtime->program.copies;
+  ASSERT_EQ(copies.size(), 1u);
+  EXPECT_TRUE(copies[0].direct);
+}
+
+// Columns by hand: `fault { at: "1s" ` is 17 characters -> the kind at 18; `slave_stop { ` is
+// 13 more -> its fields at 31.
+TEST(HF3F15Scenario, SlaveStopRefusalsCarryTheirPositions) {
+  EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" address: 20 module_index: 0 } }\n"),
+            (std::vector<std::string>{kFile + ":17:18: slave_stop takes no module"}));
+  EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" address: 22 } }\n"),
+            (std::vector<std::string>{
+                // `line: "DP_A" ` is 13 more -> address at 44.
+                kFile + ":17:44: slave_stop: no dp_slave 22 on line \"DP_A\""}));
+  EXPECT_EQ(errors_of(kHead + "fault { at: \"1s\" slave_stop { line: \"DP_A\" } }\n"),
+            (std::vector<std::string>{
+                kFile + ":17:18: slave_stop needs the address of a dp_slave"}));
+}
+
+TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
+  const auto loaded = parse_scenario(kHead + kFaults, kFile);
+  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
+  Simulation sim(*loaded.plan);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(1.0);
+  ASSERT_EQ(rep.h_systems.size(), 1u);
+  const auto& io = rep.h_systems[0].io_events;
+  auto find = [&](int ob, std::uint16_t code, bus::Ticks from) -> const HIoEvent* {
+    for (const auto& e : io)
+      if (e.ob == ob && e.code == code && e.at >= from) return &e;
+    return nullptr;
+  };
+  auto within = [](const HIoEvent* e, bus::Ticks at) { return e->at > at && e->at < at + 20 * kMs; };
+  const std::vector<int> both{0, 1};
+
+  const HIoEvent* stop = find(82, 0x3942, 5 * kS);
+  ASSERT_NE(stop, nullptr);
+  EXPECT_TRUE(within(stop, 5 * kS)) << stop->at;
+  EXPECT_EQ(stop->racks, both);
+  EXPECT_EQ(stop->mdl_addr, std::optional<std::uint16_t>(2));
+  EXPECT_TRUE(stop->mdl_stop);
+  const HIoEvent* run = find(82, 0x3842, 6 * kS);
+  ASSERT_NE(run, nullptr);
+  EXPECT_TRUE(within(run, 6 * kS)) << run->at;
+  EXPECT_FALSE(run->mdl_stop);
+  EXPECT_EQ(run->mdl_addr, std::optional<std::uint16_t>(2));
+
+  const HIoEvent* diag = find(82, 0x3942, 7 * kS);
+  ASSERT_NE(diag, nullptr);
+  EXPECT_TRUE(within(diag, 7 * kS)) << diag->at;
+  EXPECT_EQ(diag->mdl_addr, std::optional<std::uint16_t>(3));
+  EXPECT_FALSE(diag->mdl_stop);
+  EXPECT_EQ(diag->racks, both);
+  const HIoEvent* gone = find(82, 0x3842, 8 * kS);
+  ASSERT_NE(gone, nullptr);
+  EXPECT_TRUE(within(gone, 8 * kS)) << gone->at;
+
+  const HIoEvent* pull = find(83, 0x3961, 9 * kS);
+  ASSERT_NE(pull, nullptr);
+  EXPECT_TRUE(within(pull, 9 * kS)) << pull->at;
+  EXPECT_EQ(pull->racks, both);
+  EXPECT_EQ(pull->mdl_addr, std::optional<std::uint16_t>(3));  // 21's 8DO: QB 3
+  const HIoEvent* plug = find(83, 0x3861, 10 * kS);
+  ASSERT_NE(plug, nullptr);
+  EXPECT_TRUE(within(plug, 10 * kS)) << plug->at;
+
+  const HIoEvent* failure = find(86, 0x39C4, 11 * kS);
+  ASSERT_NE(failure, nullptr);
+  const HIoEvent* rd = find(122, 0x2942, 11 * kS);
+  const HIoEvent* wr = find(122, 0x2943, 11 * kS);
+  ASSERT_NE(rd, nullptr);
+  ASSERT_NE(wr, nullptr);
+  EXPECT_GE(rd->at, failure->at);
+  EXPECT_EQ(rd->at, wr->at);  // the same scan
+  EXPECT_EQ(rd->mdl_addr, std::optional<std::uint16_t>(2));
+  EXPECT_EQ(rd->racks, both);
+  // Nothing before 11 s (the slave stopped at 5 s stays reachable), nothing after the return.
+  for (const auto& e : io) {
+    if (e.ob == 122) {
+      EXPECT_TRUE(e.at >= failure->at && e.at < 12500 * kMs) << e.at;
+    }
+  }
+  // No OB 82 twice: exactly the four above.
+  int n82 = 0;
+  for (const auto& e : io) n82 += e.ob == 82;
+  EXPECT_EQ(n82, 4);
+  // The JSON report carries mdl_addr and mdl_stop.
+  std::ostringstream os;
+  write_h_json(rep.h_systems, os);
+  const std::string json = os.str();
+  EXPECT_NE(json.find("\"ob\":82,\"code\":14658,\"mdl_addr\":2,\"mdl_stop\":true"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

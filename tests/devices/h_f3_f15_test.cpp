@@ -53,11 +53,15 @@ struct DiagTap final : bus::Tap {
     Bytes du;
   };
   std::vector<Resp> seen;
-  std::vector<Resp> to_sw;  ///< SD2 requests to station 5 (DA 0x85): DU after the SAPs
+  std::vector<Resp> to_sw;  ///< SD2/SD3 requests to station 5 (DA 0x85): `station` = the DSAP, DU after the SAPs
   void on_frame(const bus::TapFrame& f) override {
     const auto b = f.bytes;
     if (b.size() >= 11 && b[0] == 0x68 && b[4] == (0x80 | 5) && (b[5] & 0x80) != 0)
       to_sw.push_back({f.end, b[7], Bytes(b.begin() + 9, b.end() - 2)});
+    // SD3 (A2 DA SA FC DSAP SSAP DU[6] FCS 16): a request with exactly 6 DU octets, e.g. an
+    // MSAC_C1 Write of 2 data octets (5F slot index 02 d0 d1).
+    if (b.size() == 14 && b[0] == 0xA2 && b[1] == (0x80 | 5) && (b[2] & 0x80) != 0)
+      to_sw.push_back({f.end, b[4], Bytes(b.begin() + 6, b.end() - 2)});
     // SD2 (68 LE LEr 68 DA SA FC DSAP SSAP DU FCS 16), or SD3 for exactly 8 data octets
     // (A2 DA SA FC DSAP SSAP DU[6] FCS 16): a 6-octet diagnosis comes as SD3.
     if (b.size() == 14 && b[0] == 0xA2 && (b[2] & 0x80) != 0 && b[5] == 60) {
@@ -376,12 +380,18 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   EXPECT_EQ(o83[1].rack, -1);
   // The alarms' acknowledgements (their PDUs leave the diagnosis) raise nothing more.
   f.at(t2 + 1000 * kMs);
-  // Re-parameterisation after the plug: the MSAC_C1 Write job (slot 2, index 1, 12 34) was
-  // started on the active channel, once (after the plug, not after the pull). Its octets on the
-  // wire are NOT asserted yet: the job completes (negatively: the station model keeps no
-  // parameter records), but this tap did not find its request frame (left open, see
-  // docs/h-system.md "Not done yet").
+  // Re-parameterisation after the plug: the MSAC_C1 Write (slot 2, index 1, 12 34) on the active
+  // channel, once (after the plug, not after the pull). On the wire it is an SD3 frame (six DU
+  // octets): DSAP 51 (0x33, MSAC_C1), DU = Function_Num 5F, Slot_Number 02, Index 01, Length 02,
+  // data 12 34. The station model keeps no parameter records and answers negatively (DF ...).
   EXPECT_EQ(f.h->reparameterisations(), 1u);
+  std::vector<DiagTap::Resp> writes;
+  for (const auto& r : f.tap.to_sw)
+    if (r.station == 0x33 && !r.du.empty() && r.du[0] == 0x5F) writes.push_back(r);
+  ASSERT_EQ(writes.size(), 1u);
+  EXPECT_EQ(writes[0].du, (Bytes{0x5F, 0x02, 0x01, 0x02, 0x12, 0x34}));
+  EXPECT_GT(writes[0].end, o83[1].time);  // after the plug's OB 83
+  EXPECT_LT(writes[0].end, o83[1].time + 10 * kMs);
 
   EXPECT_EQ(f.obs(82).size(), 1u);
   EXPECT_EQ(f.obs(83).size(), 2u);

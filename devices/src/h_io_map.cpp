@@ -80,4 +80,15 @@ void HIoMap::write_outputs(std::span<RedundantMasterSystemModel* const> systems,
   }
 }
 
+void HIoMap::write_outputs(std::span<RedundantMasterSystemModel* const> systems,
+                           std::span<const std::uint8_t> piq, int line) const {
+  if (piq.size() != m_piq) return;
+  for (const auto& e : m_entries) {
+    if (e.central || e.out_len == 0 || static_cast<std::size_t>(e.system) >= systems.size()) continue;
+    // A one-sided slave of the other line is not this line's: write_outputs refuses it.
+    (void)systems[static_cast<std::size_t>(e.system)]->system().write_outputs(
+        line, e.address, e.module, piq.subspan(e.out_addr, e.out_len));
+  }
+}
+
 }  // namespace pbvbus::devices

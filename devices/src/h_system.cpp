@@ -280,7 +280,10 @@ void HSystemModel::scan(bus::Ticks now) {
   read_racks(now);  // F8: the expansion racks' OB 85 and inputs (h_system_racks.cpp)
   if (m_exec) {
     scan_execution(now);
-    write_racks();
+    if (m_split_outputs)  // two masters: each side's racks take their own CPU's PIQ
+      write_racks(m_exec->image(0).piq(), m_exec->image(1).piq());
+    else
+      write_racks();
     return;
   }
   ++m_scans;

@@ -39,15 +39,19 @@ void HSystemModel::scan_execution(bus::Ticks now) {
   if (!running[0] && !running[1]) return;
   ++m_scans;
   std::optional<int> out;
-  if (m_pair.master_count() >= 2) {
+  m_split_outputs = m_pair.master_count() >= 2;
+  if (m_split_outputs) {
     // F6/F7: two masters, no longer redundant: each CPU runs alone as its own master, no
-    // comparison. Both run on the same PII; the outputs sent are rack 0's (one write_outputs
-    // serves both lines, h_io_map.hpp), rack 1's when rack 0 does not run.
+    // comparison, and drives its own side: its PIQ goes into line r's master images only (a
+    // switched station takes the outputs of the line it has as primary). Both run on the same
+    // PII (the inputs of the active channels). piq() shows rack 0's (rack 1's when 0 does not
+    // run).
     for (int r = 1; r >= 0; --r) {
       if (!running[static_cast<std::size_t>(r)]) continue;
       std::array<bool, 2> one{r == 0, r == 1};
       ScanResult res = m_exec->scan(now, one, r);
       for (const auto& e : res.events) on_program_event(e, one);
+      m_map.write_outputs(m_systems, m_exec->image(r).piq(), r);
       if (res.output_rack) out = res.output_rack;
     }
   } else {
@@ -74,7 +78,7 @@ void HSystemModel::scan_execution(bus::Ticks now) {
       after_op();
     }
   }
-  if (out) m_map.write_outputs(m_systems, m_exec->image(*out).piq());
+  if (out && !m_split_outputs) m_map.write_outputs(m_systems, m_exec->image(*out).piq());
   const auto piq = m_exec->image(out.value_or(m_pair.master() >= 0 ? m_pair.master() : 0)).piq();
   std::copy(piq.begin(), piq.end(), m_piq.begin());
 }

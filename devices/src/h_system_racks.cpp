@@ -249,15 +249,19 @@ void HSystemModel::read_racks(bus::Ticks now) {
   }
 }
 
-void HSystemModel::write_racks() {
+void HSystemModel::write_racks() { write_racks(m_piq, m_piq); }
+
+void HSystemModel::write_racks(std::span<const std::uint8_t> piq0,
+                               std::span<const std::uint8_t> piq1) {
   for (std::size_t k = 0; k < m_racks.size(); ++k) {
     if (!rack_reachable(k)) continue;  // its modules keep what they had
     RackState& st = m_racks[k];
     const HExpansionRack& cfg = m_rack_cfg[k];
     for (std::size_t m = 0; m < cfg.modules.size(); ++m) {
       const HIoEntry* e = m_map.find_central(cfg.number, m);
-      if (e == nullptr || e->out_len == 0 || e->out_addr + e->out_len > m_piq.size()) continue;
-      const auto from = m_piq.begin() + static_cast<std::ptrdiff_t>(e->out_addr);
+      const std::span<const std::uint8_t> piq = cfg.side == 0 ? piq0 : piq1;
+      if (e == nullptr || e->out_len == 0 || e->out_addr + e->out_len > piq.size()) continue;
+      const auto from = piq.begin() + static_cast<std::ptrdiff_t>(e->out_addr);
       std::copy(from, from + static_cast<std::ptrdiff_t>(e->out_len), st.out[m].begin());
     }
   }

@@ -57,6 +57,40 @@ TEST(HSystemProgram, CopyThroughTheMapBothCpusRunInRedundant) {
   EXPECT_EQ(s.h->execution()->image(0), s.h->execution()->image(1));
 }
 
+// F6 with the real program: both fibres cut at 4.0 s -> two masters, each CPU runs alone and
+// drives its own side. Counter 0 -> QB 4..5 (one-sided slave 10, line A), counter 1 -> QB 6..7
+// (slave 11, line B). At 4.5 s a bit of rack 1's counter 1 is flipped (memory offset 16 + 10 =
+// 26, the high octet of the low word of its 32-bit value: +/- 0x8000); no comparison runs any
+// more, so the two CPUs' counters 1 differ by 0x8000 from then on. Line B's slave shows rack 1's
+// value, line A's slave rack 0's: each CPU's PIQ goes to its own line only.
+TEST(HSystemProgram, TwoMastersEachDrivesItsOwnLine) {
+  HSys s;
+  ProgramSpec p;
+  p.scan_time = kScan;
+  p.counters.push_back({4, 2, 10 * kMs, 1, 0, 0, 0});
+  p.counters.push_back({6, 2, 10 * kMs, 1, 0, 0, 0});
+  s.h->set_program(p);
+  s.bring_up();
+  s.at(4000 * kMs);
+  s.h->cut_both_fibres();
+  ASSERT_EQ(s.h->pair().master_count(), 2);
+  s.at(4500 * kMs);
+  ASSERT_TRUE(s.h->inject_divergence(1, Area::Memory, 26, 0x80));
+  // Scans lie on 3.157 + k x 10 ms: the last before 5.005 s is at 4.997 s; one DP cycle of
+  // these lines (four slaves at 1.5 Mbit/s) is well below the 8 ms left until 5.005 s.
+  s.at(5005 * kMs);
+  auto word = [](std::span<const std::uint8_t> b, std::size_t at) {
+    return static_cast<std::uint16_t>((b[at] << 8) | b[at + 1]);
+  };
+  const auto q0 = s.h->execution()->image(0).piq();
+  const auto q1 = s.h->execution()->image(1).piq();
+  EXPECT_EQ(word(q0, 6) ^ word(q1, 6), 0x8000);  // the CPUs diverged (no comparison)
+  EXPECT_EQ(word(q0, 4), word(q1, 4));            // counter 0 untouched
+  EXPECT_EQ(s.one_outputs(0), word(q0, 4));       // line A: rack 0's outputs
+  EXPECT_EQ(s.one_outputs(1), word(q1, 6));       // line B: rack 1's outputs, not rack 0's
+  EXPECT_NE(s.one_outputs(1), word(q0, 6));
+}
+
 // F16 found by the comparison: a bit of the standby's memory flipped at 3.460 s (counter 0's
 // flags byte, memory offset 12: 01 -> 03, it never reaches the PIQ) is found by the comparison
 // after the next Redundant scan at 3.467 s: standby ERROR-SEARCH, OB 72 on the master, Solo.

@@ -614,6 +614,13 @@ bool MasterSystem::write_outputs(std::uint8_t a, std::size_t module,
   return ok;
 }
 
+bool MasterSystem::write_outputs(int line, std::uint8_t a, std::size_t module,
+                                 std::span<const std::uint8_t> data) {
+  const Station* s = find(a);
+  if (s == nullptr || line < 0 || line > 1 || (!s->switched && s->home != line)) return false;
+  return m_master[line]->image(a).write_outputs(module, data) == dp::ImageAccess::Ok;
+}
+
 const dp::MasterImage* MasterSystem::active_image(std::uint8_t a) const {
   const int l = active(a);
   return l < 0 ? nullptr : &m_master[l]->image(a);

@@ -69,6 +69,10 @@ class HIoMap {
   /// Every output module's PIQ bytes written with MasterSystem::write_outputs.
   void write_outputs(std::span<RedundantMasterSystemModel* const> systems,
                      std::span<const std::uint8_t> piq) const;
+  /// The same into line `line`'s master images only (MasterSystem::write_outputs(line, ...)):
+  /// two masters (F6/F7), each CPU's PIQ to its own side.
+  void write_outputs(std::span<RedundantMasterSystemModel* const> systems,
+                     std::span<const std::uint8_t> piq, int line) const;
 
  private:
   std::vector<HIoEntry> m_entries;

@@ -40,7 +40,8 @@
 //   plus a "sync error" entry in both diagnostic buffers; F18 is checked before F16 (the sync
 //   error happens during the run, the comparison at its end). Program events (7960) ->
 //   events() with source Program, code 0x7960, no OB. Two masters (F6/F7): each CPU scans alone
-//   (no comparison), rack 0's PIQ is sent. set_program(hook) replaces a spec and vice versa.
+//   (no comparison) and its PIQ goes to its own side only (line r's master images, the racks
+//   of side r); with a hook (one program) the same PIQ to both. set_program(hook) replaces a spec and vice versa.
 // - Update phases (400H, pair rules: io_frozen, outputs_held_by_both, interrupts_held): no OB 1
 //   and no I/O update (inputs or outputs) while io_frozen() ([t3, t5)); a scan due then is
 //   dropped and OB 1 restarts AT t5 (or the abort) — a late OB 1 starts at once — so the
@@ -328,6 +329,8 @@ class HSystemModel final : public bus::EventTarget {
   void rack_event(std::size_t k, bool failed);
   void read_racks(bus::Ticks now);  ///< at each OB 1: OB 85, the reachable racks' inputs
   void write_racks();               ///< after OB 1: the PIQ into the reachable racks' modules
+  /// The same with a PIQ per side (two masters: each rack takes its own CPU's outputs).
+  void write_racks(std::span<const std::uint8_t> piq0, std::span<const std::uint8_t> piq1);
   bus::Ticks end_cycle(bus::Ticks start);  ///< the next OB 1's start; arms the monitoring
   void cycle_check(bus::Ticks start, bool extended);
   void log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text);
@@ -379,6 +382,7 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<std::uint8_t> m_pii, m_piq;
   Program m_program;
   std::unique_ptr<RedundantExecution> m_exec;
+  bool m_split_outputs = false;  ///< the last scan had two masters (F6/F7): outputs per side
   std::vector<UpdateMeasure> m_measures;
   bool m_update_copied = false;
   bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1  ///< the last measure's output/state copy (t4) is done

@@ -235,6 +235,11 @@ class MasterSystem {
 
   /// Writes one module's outputs into both masters' images (one-sided: its master's).
   bool write_outputs(std::uint8_t address, std::size_t module, std::span<const std::uint8_t> data);
+  /// The same into line `line`'s master image only (a one-sided slave of the other line: false,
+  /// nothing written). For two masters each driving its own line (H-system F6/F7: each CPU
+  /// runs alone and sends its own outputs).
+  bool write_outputs(int line, std::uint8_t address, std::size_t module,
+                     std::span<const std::uint8_t> data);
   /// The image the program reads inputs and diagnosis from: the active channel's; nullptr when
   /// there is none.
   const dp::MasterImage* active_image(std::uint8_t address) const;

@@ -384,16 +384,16 @@ class HSystemModel final : public bus::EventTarget {
   std::unique_ptr<RedundantExecution> m_exec;
   bool m_split_outputs = false;  ///< the last scan had two masters (F6/F7): outputs per side
   std::vector<UpdateMeasure> m_measures;
-  bool m_update_copied = false;
-  bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1  ///< the last measure's output/state copy (t4) is done
-  std::string m_ob72_note;
+  bool m_update_copied = false;  ///< the last measure's output/state copy (t4) is done
+  bus::Ticks m_last_scan = bus::kNever;  ///< start of the last OB 1
+  std::string m_ob72_note;  ///< appended to the next OB 72 ComparisonError text (F16's place)
   std::vector<HSystemEvent> m_held_alarms;  ///< received while interrupts_held()
   struct HeldRecord {
     RecordJobCallback cb;
     RecordJobResult res;
   };
   std::vector<HeldRecord> m_held_records;  ///< jobs completed during the update (80C3 after t5)
-  std::vector<std::vector<bool>> m_ob85;   ///< [system][address]: OB 85 episode open  ///< appended to the next OB 72 ComparisonError text (F16's place)
+  std::vector<std::vector<bool>> m_ob85;   ///< [system][address]: OB 85 episode open
   IoGate m_gate;
   bus::Ticks m_scan_time = bus::kTicksPerMs;
   bool m_scan_armed = false;

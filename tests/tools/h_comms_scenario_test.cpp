@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "scenario_run_support.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/simulation.hpp"
 
@@ -47,9 +48,7 @@ fault { at: "10s" repair_at: "12s" cpu_failure { rack: 1 } }
 )";
 
 std::vector<std::string> errors_of(const std::string& text) {
-  std::vector<std::string> out;
-  for (const auto& d : parse_scenario(text, "h.textproto").errors) out.push_back(d.str());
-  return out;
+  return test::scenario_errors(text, "h.textproto");
 }
 
 TEST(HCommsScenario, CpsConnectionsAndTheFaultArePlanned) {
@@ -110,12 +109,9 @@ fault { at: "1s" cp_failure { rack: 0 } }
 }
 
 TEST(HCommsScenario, RunShowsF4StandardLostFaultTolerantSwitchedAndBack) {
-  const auto loaded = parse_scenario(kText, "h.textproto");
-  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
-  Simulation sim(*loaded.plan);
-  sim.start();
-  sim.run_until(*sim.duration());
-  const Report r = sim.report(1.0);
+  const test::ScenarioRun run = test::run_scenario(kText, "h.textproto");
+  ASSERT_TRUE(run.report) << run.error;
+  const Report& r = *run.report;
   ASSERT_EQ(r.h_systems.size(), 1u);
   const HSystemReport& h = r.h_systems[0];
   ASSERT_EQ(h.connections.size(), 3u);

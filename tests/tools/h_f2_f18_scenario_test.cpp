@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "scenario_run_support.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/simulation.hpp"
 
@@ -44,9 +45,7 @@ fault { at: "25s" sync_error { h_system: "H-CPU" } }
 )";
 
 std::vector<std::string> errors_of(const std::string& text) {
-  std::vector<std::string> out;
-  for (const auto& d : parse_scenario(text, "h.textproto").errors) out.push_back(d.str());
-  return out;
+  return test::scenario_errors(text, "h.textproto");
 }
 
 bool has_row(const HCpuReport& c, bus::Ticks at, const std::string& change) {
@@ -111,12 +110,9 @@ fault { at: "1s" sync_error { h_system: "X" } }
 }
 
 TEST(HF2F18Scenario, RunShowsStopResetRequestAndSyncError) {
-  const auto loaded = parse_scenario(kText, "h.textproto");
-  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
-  Simulation sim(*loaded.plan);
-  sim.start();
-  sim.run_until(*sim.duration());
-  const Report r = sim.report(1.0);
+  const test::ScenarioRun run = test::run_scenario(kText, "h.textproto");
+  ASSERT_TRUE(run.report) << run.error;
+  const Report& r = *run.report;
   ASSERT_EQ(r.h_systems.size(), 1u);
   const HSystemReport& h = r.h_systems[0];
   const HCpuReport& c0 = h.cpus[0];

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "scenario_run_support.hpp"
 #include "pbvbus/tools/h_report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/simulation.hpp"
@@ -55,9 +56,7 @@ fault { at: "11s" repair_at: "12s" slave_mute { line: "DP_A" address: 20 } }
 )";
 
 std::vector<std::string> errors_of(const std::string& text) {
-  std::vector<std::string> out;
-  for (const auto& d : parse_scenario(text, kFile).errors) out.push_back(d.str());
-  return out;
+  return test::scenario_errors(text, kFile);
 }
 
 TEST(HF3F15Scenario, SlaveStopAndDirectArePlanned) {
@@ -93,12 +92,9 @@ TEST(HF3F15Scenario, SlaveStopRefusalsCarryTheirPositions) {
 }
 
 TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
-  const auto loaded = parse_scenario(kHead + kFaults, kFile);
-  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
-  Simulation sim(*loaded.plan);
-  sim.start();
-  sim.run_until(*sim.duration());
-  const Report rep = sim.report(1.0);
+  const test::ScenarioRun done = test::run_scenario(kHead + kFaults, kFile);
+  ASSERT_TRUE(done.report) << done.error;
+  const Report& rep = *done.report;
   ASSERT_EQ(rep.h_systems.size(), 1u);
   const auto& io = rep.h_systems[0].io_events;
   auto find = [&](int ob, std::uint16_t code, bus::Ticks from) -> const HIoEvent* {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "scenario_run_support.hpp"
 #include "pbvbus/tools/h_report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/simulation.hpp"
@@ -51,9 +52,7 @@ fault { at: "3503ms" cycle_overload { extra: "95ms" } }
 )";
 
 std::vector<std::string> errors_of(const std::string& text) {
-  std::vector<std::string> out;
-  for (const auto& d : parse_scenario(text, "h.textproto").errors) out.push_back(d.str());
-  return out;
+  return test::scenario_errors(text, "h.textproto");
 }
 
 TEST(HRacksScenario, RacksAndFaultsArePlanned) {
@@ -123,12 +122,9 @@ fault { at: "1s" cycle_overload { extra: "0s" } }
 }
 
 TEST(HRacksScenario, RunReportsRacksOb86Ob85AndOb80) {
-  const auto loaded = parse_scenario(kText, "h.textproto");
-  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
-  Simulation sim(*loaded.plan);
-  sim.start();
-  sim.run_until(*sim.duration());
-  const Report r = sim.report(1.0);
+  const test::ScenarioRun run = test::run_scenario(kText, "h.textproto");
+  ASSERT_TRUE(run.report) << run.error;
+  const Report& r = *run.report;
   ASSERT_EQ(r.h_systems.size(), 1u);
   const HSystemReport& h = r.h_systems[0];
 

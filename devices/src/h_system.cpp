@@ -325,6 +325,18 @@ void HSystemModel::on_pair_event(const HEvent& e) {
   add_event(std::move(h));
 }
 
+// Every powered CPU logs an I/O event with its role (F3 "both CPUs log"), the newest
+// diag_capacity entries.
+void HSystemModel::log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text) {
+  const auto cap = m_pair.params().diag_capacity;
+  for (int r = 0; r < 2; ++r) {
+    if (m_pair.state(r) == CpuState::Off) continue;
+    auto& d = m_io_diag[static_cast<std::size_t>(r)];
+    d.push_back({now, m_pair.role(r), code, text});
+    if (cap > 0 && d.size() > cap) d.erase(d.begin());
+  }
+}
+
 void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) {
   if (!e.s7()) return;
   std::string text = "OB " + std::to_string(e.ob()) + " " + hex4(e.code()) + " " +
@@ -332,13 +344,7 @@ void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) 
                      std::to_string(s + 1) + ", line " + (e.line == 1 ? "B" : "A");
   if (e.station != 0xFF) text += ", station " + std::to_string(e.station);
   // Every powered CPU logs it; the OB runs on the CPUs that run a program.
-  const auto cap = m_pair.params().diag_capacity;
-  for (int r = 0; r < 2; ++r) {
-    if (m_pair.state(r) == CpuState::Off) continue;
-    auto& d = m_io_diag[static_cast<std::size_t>(r)];
-    d.push_back({e.time, m_pair.role(r), e.code(), text});
-    if (cap > 0 && d.size() > cap) d.erase(d.begin());
-  }
+  log_on_powered(e.time, e.code(), text);
   const bool run0 = m_pair.dp_master_operate(0), run1 = m_pair.dp_master_operate(1);
   if (!run0 && !run1) return;  // no program runs: no OB, only the buffer entries
   HSystemEvent h;

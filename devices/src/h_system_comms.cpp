@@ -21,15 +21,9 @@ void HSystemModel::comms_update(bus::Ticks now) {
 
 void HSystemModel::comms_log(bus::Ticks now) {
   const auto& ev = m_comms.events();
-  const auto cap = m_pair.params().diag_capacity;
   for (; m_comms_logged < ev.size(); ++m_comms_logged) {
     const CommEvent& e = ev[m_comms_logged];
-    for (int r = 0; r < 2; ++r) {
-      if (m_pair.state(r) == CpuState::Off) continue;
-      auto& d = m_io_diag[static_cast<std::size_t>(r)];
-      d.push_back({std::max(e.at, now), m_pair.role(r), 0, e.text});
-      if (cap > 0 && d.size() > cap) d.erase(d.begin());
-    }
+    log_on_powered(std::max(e.at, now), 0, e.text);
   }
 }
 

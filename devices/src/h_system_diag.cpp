@@ -98,13 +98,7 @@ bool HSystemModel::module_reachable(const HIoEntry& e) const {
 }
 
 void HSystemModel::io_ob(HSystemEvent h) {
-  const auto cap = m_pair.params().diag_capacity;
-  for (int r = 0; r < 2; ++r) {
-    if (m_pair.state(r) == CpuState::Off) continue;
-    auto& d = m_io_diag[static_cast<std::size_t>(r)];
-    d.push_back({h.time, m_pair.role(r), h.code, h.text});
-    if (cap > 0 && d.size() > cap) d.erase(d.begin());
-  }
+  log_on_powered(h.time, h.code, h.text);
   const bool run0 = m_pair.dp_master_operate(0), run1 = m_pair.dp_master_operate(1);
   if (!run0 && !run1) return;  // no program runs: only the buffer entries
   h.rack = run0 && run1 ? -1 : (run0 ? 0 : 1);
@@ -136,13 +130,7 @@ void HSystemModel::alarm_start_info(std::size_t s, const redundancy::SystemAlarm
                 static_cast<unsigned>(h.mdl_addr));
   h.text += buf;
   // Both CPUs log it at receipt (the OB itself may be held until t5).
-  const auto cap = m_pair.params().diag_capacity;
-  for (int r = 0; r < 2; ++r) {
-    if (m_pair.state(r) == CpuState::Off) continue;
-    auto& d = m_io_diag[static_cast<std::size_t>(r)];
-    d.push_back({a.time, m_pair.role(r), h.code, h.text});
-    if (cap > 0 && d.size() > cap) d.erase(d.begin());
-  }
+  log_on_powered(a.time, h.code, h.text);
 }
 
 void HSystemModel::on_diagnosis(std::size_t s, const redundancy::SystemDiagnosis& d) {

@@ -52,15 +52,9 @@ void HSystemModel::sync_error_reaction(int standby, bus::Ticks now, std::string_
   // The pair has no sync-error operation: the standby's switch_to_stop gives exactly F18's
   // reaction (standby STOP, Solo, OB 72 StandbyStop on the master); like every fault STOP it
   // needs a STOP -> RUN to restart. Both CPUs log it.
-  const auto cap = m_pair.params().diag_capacity;
-  for (int r = 0; r < 2; ++r) {
-    if (m_pair.state(r) == CpuState::Off) continue;
-    auto& dg = m_io_diag[static_cast<std::size_t>(r)];
-    dg.push_back({now, m_pair.role(r), 0,
-                  "sync error (F18): " + std::string(cause) + "; standby rack " +
-                      std::to_string(standby) + " to STOP"});
-    if (cap > 0 && dg.size() > cap) dg.erase(dg.begin());
-  }
+  log_on_powered(now, 0,
+                 "sync error (F18): " + std::string(cause) + "; standby rack " +
+                     std::to_string(standby) + " to STOP");
   m_pair.switch_to_stop(standby, now);
 }
 

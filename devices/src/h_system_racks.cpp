@@ -139,15 +139,6 @@ bool HSystemModel::expansion_rack_on(int number) {
   return true;
 }
 
-void HSystemModel::log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text) {
-  const auto cap = m_pair.params().diag_capacity;
-  for (int r = 0; r < 2; ++r) {
-    if (m_pair.state(r) == CpuState::Off) continue;
-    auto& d = m_io_diag[static_cast<std::size_t>(r)];
-    d.push_back({now, m_pair.role(r), code, text});
-    if (cap > 0 && d.size() > cap) d.erase(d.begin());
-  }
-}
 
 void HSystemModel::rack_event(std::size_t k, bool failed) {
   const HExpansionRack& cfg = m_rack_cfg[k];

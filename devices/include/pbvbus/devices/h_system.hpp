@@ -333,7 +333,6 @@ class HSystemModel final : public bus::EventTarget {
   void write_racks(std::span<const std::uint8_t> piq0, std::span<const std::uint8_t> piq1);
   bus::Ticks end_cycle(bus::Ticks start);  ///< the next OB 1's start; arms the monitoring
   void cycle_check(bus::Ticks start, bool extended);
-  void log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text);
   std::vector<HExpansionRack> m_rack_cfg;
   std::vector<RackState> m_racks;
   bus::Ticks m_max_cycle = 150 * bus::kTicksPerMs;
@@ -372,6 +371,8 @@ class HSystemModel final : public bus::EventTarget {
   void on_pair_event(const HEvent& e);
   void on_io_event(std::size_t system, const redundancy::SystemEvent& e);
   void add_event(HSystemEvent e);
+  /// Every powered CPU logs an entry with its role (F3 "both CPUs log").
+  void log_on_powered(bus::Ticks now, std::uint16_t code, const std::string& text);
   bool valid_rack(int r) const { return r == 0 || r == 1; }
 
   bus::Scheduler& m_sched;

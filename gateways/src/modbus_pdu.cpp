@@ -149,7 +149,7 @@ std::vector<std::uint8_t> encode_modbus_write_single(std::uint8_t function, std:
 }
 
 std::vector<std::uint8_t> encode_modbus_write_coils(std::uint16_t address,
-                                                    std::span<const bool> coils) {
+                                                    const std::vector<bool>& coils) {
   std::vector<std::uint8_t> v{kFcWriteMultipleCoils};
   put16(v, address);
   put16(v, static_cast<std::uint16_t>(coils.size()));

@@ -97,7 +97,7 @@ std::vector<std::uint8_t> encode_modbus_write_single(std::uint8_t function, std:
                                                      std::uint16_t value);
 /// FC15: coil values 0/1, packed LSB first.
 std::vector<std::uint8_t> encode_modbus_write_coils(std::uint16_t address,
-                                                    std::span<const bool> coils);
+                                                    const std::vector<bool>& coils);
 /// FC16.
 std::vector<std::uint8_t> encode_modbus_write_registers(std::uint16_t address,
                                                         std::span<const std::uint16_t> regs);

@@ -132,6 +132,7 @@ ModbusMap::ModbusMap(const ProcessSource& source, const ModbusGatewayOptions& op
                                "slave addresses");
         continue;
       }
+      if (pass == 1 && !s.switched) continue;  // a one-sided slave has no standby side
       const ModbusSlaveOptions& so = options.slave(s.address);
       ModbusUnitMap u;
       u.address = s.address;

@@ -320,7 +320,10 @@ TEST_F(ModbusGatewayTest, StatusFlagsOfASwitchedStationAndTheStandbyUnit) {
   EXPECT_EQ(ask(148, encode_modbus_read(0x04, 0x1001, 1)), (Bytes{4, 2, 0x01, 0xA4}));
   EXPECT_EQ(ask(148, encode_modbus_read(0x04, 0x1000, 1)), (Bytes{4, 2, 0x00, 0x07}));
   // Read-only: any write to a standby unit is 0x01.
-  EXPECT_EQ(ask(133, Bytes{0x06, 0, 0, 0, 1}), (Bytes{0x86, 0x01}));
+  EXPECT_EQ(ask(148, Bytes{0x06, 0, 0, 0, 1}), (Bytes{0x86, 0x01}));
+  EXPECT_TRUE(src.writes().empty());
+  // Slave 5 is one-sided (not switched): no standby unit 133.
+  EXPECT_EQ(ask(133, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
   // A changeover swaps the views for the very next request.
   src.swap_sides(20);
   EXPECT_EQ(ask(148, encode_modbus_read(0x04, 0, 1)), (Bytes{4, 2, 0x01, 0x02}));
@@ -328,12 +331,15 @@ TEST_F(ModbusGatewayTest, StatusFlagsOfASwitchedStationAndTheStandbyUnit) {
 }
 
 TEST_F(ModbusGatewayTest, NoStandbyUnitsOnAPlainMasterSystem) {
+  src.add_slave(6, 1, {{"DI2", 0, 2, 0, 0, false}}).switched = true;
   opt.standby_units = true;  // ignored: the source is not redundant
-  EXPECT_EQ(ask(133, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
+  EXPECT_EQ(ask(134, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
   m_gw.reset();
   src.set_redundant(true);
-  opt.standby_units = false;  // off: unit 133 unknown
-  EXPECT_EQ(ask(133, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
+  EXPECT_EQ(ask(134, encode_modbus_read(0x04, 0, 1)), (Bytes{0x04, 0x02, 0x00, 0x00}));
+  m_gw.reset();
+  opt.standby_units = false;  // off: unit 134 unknown
+  EXPECT_EQ(ask(134, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
 }
 
 TEST_F(ModbusGatewayTest, GatewayUnitRegisters) {
@@ -416,7 +422,7 @@ TEST_F(ModbusGatewayTest, ReadDeviceIdentification) {
 TEST_F(ModbusGatewayTest, RandomRequestsNeverCrashAndAlwaysAnswerWellFormed) {
   src.set_redundant(true);
   opt.standby_units = true;
-  src.add_slave(9, 1, {{"A", 0, 4, 0, 4, false}, {"B", 0, 3, 0, 5, false}});
+  src.add_slave(9, 1, {{"A", 0, 4, 0, 4, false}, {"B", 0, 3, 0, 5, false}}).switched = true;
   std::mt19937 rng(42);
   const std::uint8_t fcs[] = {1, 2, 3, 4, 5, 6, 15, 16, 23, 43, 0x11, 0x80, 0};
   for (int i = 0; i < 20000; ++i) {

@@ -5,7 +5,8 @@
 // Decisions fixed by the integrator (docs/gateway-modbus.md has the tables):
 // - Unit id = PROFIBUS address of the slave (1..125). A slave at address 0 is not mapped
 //   (unit 0 is the gateway): the map carries a warning. With `standby_units` on a redundant
-//   source, unit address + 128 is the same slave seen through the Standby side (read-only).
+//   source, unit address + 128 is the same switched station seen through the Standby side
+//   (read-only); a one-sided slave has no standby unit (0x0A).
 // - Input registers (FC04) from 0: the input telegram, each module starting on a new register,
 //   its first octet in the high byte; an odd-length module's last register has 0 in the low
 //   byte. Holding registers (FC03/06/16/23) from 0: the output telegram, same rule.

@@ -168,7 +168,7 @@ TEST(ModbusMap, GatewayRowsTextAndJson) {
                       "\"out_octets\":1,\"holding_register\":0,\"holding_register_count\":1,"
                       "\"coil\":0}"),
             std::string::npos);
-  EXPECT_EQ(json.substr(json.size() - 15), "\"warnings\":[]}");
+  EXPECT_EQ(json.substr(json.size() - 14), "\"warnings\":[]}");
 }
 
 }  // namespace

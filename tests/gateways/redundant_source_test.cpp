@@ -16,6 +16,7 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/devices/h_system.hpp"
 #include "pbvbus/devices/slave_model.hpp"
 #include "pbvbus/devices/switched_station.hpp"
 #include "pbvbus/gateways/modbus_gateway.hpp"
@@ -186,6 +187,43 @@ TEST(RedundantSource, StandbyUnitThroughTheModbusGateway) {
   // Standby is read-only; the one-sided slave has no standby unit.
   EXPECT_EQ(ask(133, Bytes{0x06, 0, 0, 0, 1}), (Bytes{0x86, 0x01}));
   EXPECT_EQ(ask(138, Bytes{0x04, 0, 0, 0, 1}), (Bytes{0x84, 0x0A}));
+}
+
+TEST(RedundantSource, DrivenByAnHSystemIsReadOnlyAndReportsTheCpuPair) {
+  System s;
+  devices::HSystemModel h(s.sched, devices::HCpuPairParams{},
+                          std::vector<devices::RedundantMasterSystemModel*>{s.sys.get()});
+  RedundantSource src(*s.sys, "H system", {}, &h);
+  for (const auto& sl : src.slaves()) EXPECT_FALSE(sl.outputs_writable);
+  EXPECT_FALSE(src.write_module_outputs(kSw, 1, Bytes{1, 2}));
+  EXPECT_FALSE(src.command(dp::MasterMode::Stop));
+  auto hs = src.h_status();
+  ASSERT_TRUE(hs.has_value());
+  EXPECT_EQ(hs->master_rack, -1);  // both CPUs off
+  h.power_on_both();
+  s.start();
+  s.sched.run_until(6000 * kMs);
+  hs = src.h_status();
+  ASSERT_TRUE(hs.has_value());
+  ASSERT_GE(hs->master_rack, 0);
+  EXPECT_EQ(hs->master_rack, h.pair().master());
+  EXPECT_EQ(hs->cpu_role[static_cast<std::size_t>(hs->master_rack)],
+            static_cast<std::uint8_t>(devices::CpuRole::Master));
+  EXPECT_EQ(hs->system_mode, static_cast<std::uint8_t>(h.pair().system_mode()));
+  EXPECT_EQ(src.master_address(), s.sys->master(hs->master_rack).address());
+  // Through the gateway: unit 0 IR 32 = 1 (H present), IR 38 = the master rack; a write to a
+  // slave is 0x01 (read-only), the mode command 0x04 (refused).
+  ModbusGateway gw(src);
+  std::array<std::uint8_t, kModbusMaxPdu> rsp{};
+  auto ask = [&](std::uint8_t unit, const Bytes& pdu) {
+    const std::size_t n = gw.handle(unit, pdu, rsp, false);
+    return Bytes(rsp.begin(), rsp.begin() + static_cast<std::ptrdiff_t>(n));
+  };
+  EXPECT_EQ(ask(0, Bytes{0x04, 0, 32, 0, 1}), (Bytes{0x04, 0x02, 0x00, 0x01}));
+  EXPECT_EQ(ask(0, Bytes{0x04, 0, 38, 0, 1}),
+            (Bytes{0x04, 0x02, 0x00, static_cast<std::uint8_t>(hs->master_rack)}));
+  EXPECT_EQ(ask(kSw, Bytes{0x06, 0, 0, 0, 1}), (Bytes{0x86, 0x01}));
+  EXPECT_EQ(ask(0, Bytes{0x06, 0, 0, 0, 2}), (Bytes{0x86, 0x04}));
 }
 
 }  // namespace

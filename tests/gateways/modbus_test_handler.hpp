@@ -9,6 +9,9 @@
 //    quantity or byte count -> 0x03;
 //  - broadcast (RTU unit 0): writes go to unit 1's registers, nothing is answered.
 // It records every call so tests can assert what reached the core.
+//
+// Also here: driving a paced runner on the test thread while a client (a raw socket in a
+// thread, or a child process) runs, and blocking raw-socket helpers for clients.
 
 #include <array>
 #include <cstdint>
@@ -16,6 +19,26 @@
 #include <vector>
 
 #include "pbvbus/gateways/modbus_handler.hpp"
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <future>
+#include <span>
+#include <vector>
+
+#include "pbvbus/bus/paced_runner.hpp"
+#include "pbvbus/bus/scheduler.hpp"
+#include "pbvbus/bus/time.hpp"
+
 
 namespace pbvbus::gateways::test {
 
@@ -94,5 +117,81 @@ class RegisterFileHandler final : public ModbusHandler {
     }
   }
 };
+
+/// Runs the paced runner in 5 ms virtual slices until `done()` or `limit` of wall time passed
+/// (a generous upper bound for a client to finish, never an assertion on speed).
+inline bool drive_until(bus::PacedRunner& runner, const std::function<bool()>& done,
+                        std::chrono::milliseconds limit = std::chrono::seconds(20)) {
+  const auto until = std::chrono::steady_clock::now() + limit;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    runner.run_for(5 * bus::kTicksPerMs);
+  }
+  return true;
+}
+
+/// Runs `client` on its own thread while the test thread drives the runner; returns its result.
+template <class F>
+auto with_client(bus::PacedRunner& runner, F client,
+                 std::chrono::milliseconds limit = std::chrono::seconds(20)) {
+  auto fut = std::async(std::launch::async, std::move(client));
+  drive_until(
+      runner, [&] { return fut.wait_for(std::chrono::seconds(0)) == std::future_status::ready; },
+      limit);
+  return fut.get();  // if the limit passed, the client's own receive timeout ends it
+}
+
+/// A blocking TCP client socket to 127.0.0.1:port with a 10 s receive/send timeout; -1 on error.
+inline int tcp_connect(std::uint16_t port, int rcvbuf = 0) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return -1;
+  timeval tv{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  ::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
+  if (rcvbuf > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(port);
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+inline bool send_all(int fd, std::span<const std::uint8_t> b) {
+  while (!b.empty()) {
+    const ssize_t n = ::send(fd, b.data(), b.size(), MSG_NOSIGNAL);
+    if (n <= 0) return false;
+    b = b.subspan(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+/// Receives exactly n octets; fewer on EOF, error or timeout.
+inline std::vector<std::uint8_t> recv_n(int fd, std::size_t n) {
+  std::vector<std::uint8_t> out(n);
+  std::size_t got = 0;
+  while (got < n) {
+    const ssize_t r = ::recv(fd, out.data() + got, n - got, 0);
+    if (r <= 0) break;
+    got += static_cast<std::size_t>(r);
+  }
+  out.resize(got);
+  return out;
+}
+
+/// True when the peer has closed (EOF or reset) within the socket's receive timeout; octets
+/// that still arrive before the close are skipped.
+inline bool wait_closed(int fd) {
+  std::uint8_t b[512];
+  for (;;) {
+    const ssize_t r = ::recv(fd, b, sizeof b, 0);
+    if (r == 0) return true;
+    if (r < 0) return errno == ECONNRESET || errno == EPIPE;
+  }
+}
+
 
 }  // namespace pbvbus::gateways::test

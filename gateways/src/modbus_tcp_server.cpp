@@ -67,6 +67,7 @@ struct ModbusTcpServer::Impl::Connection : std::enable_shared_from_this<Connecti
   std::vector<std::uint8_t> out_pending;
   std::vector<std::uint8_t> out_flight;
   bool writing = false;
+  bool eof = false;  // the client half-closed; close once the responses are out
   Clock::time_point last_request{};
 };
 
@@ -149,6 +150,11 @@ void ModbusTcpServer::Impl::Connection::read() {
   sock.async_read_some(asio::buffer(in.data() + end, in.size() - end),
                        [c = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
                          if (!c->srv) return;
+                         if (ec == asio::error::eof && (c->writing || !c->out_pending.empty())) {
+                           // Half-closed after its last request: finish sending, then close.
+                           c->eof = true;
+                           return;
+                         }
                          if (ec) {
                            c->close(false);  // EOF or reset: the client left
                            return;
@@ -241,6 +247,7 @@ void ModbusTcpServer::Impl::Connection::flush() {
                       }
                       c->out_flight.clear();
                       c->flush();
+                      if (c->srv && c->eof && !c->writing && c->out_pending.empty()) c->close(false);
                     });
 }
 

@@ -131,6 +131,28 @@ TEST_F(ModbusTcpDoor, PipelinedRequestsInOneSegmentAreAnsweredInOrder) {
             "00 0C 00 00 00 03 09 83 0A");
 }
 
+TEST_F(ModbusTcpDoor, AClientThatHalfClosesAfterItsRequestsGetsEveryResponse) {
+  open();
+  handler.record = false;
+  // 500 pipelined FC03 of 16 registers (41-octet responses: 20 500 octets), then shutdown(WR).
+  const auto req = bytes_from_hex("00 01 00 00 00 06 01 03 00 00 00 10");
+  std::vector<std::uint8_t> all;
+  for (int i = 0; i < 500; ++i) all.insert(all.end(), req.begin(), req.end());
+  const auto [octets, closed] = with_client(runner, [&, p = port] {
+    const int fd = tcp_connect(p);
+    send_all(fd, all);
+    ::shutdown(fd, SHUT_WR);
+    const auto r = recv_n(fd, 500 * 41);
+    const bool c = wait_closed(fd);
+    ::close(fd);
+    return std::pair{r.size(), c};
+  });
+  EXPECT_EQ(octets, 500u * 41u);
+  EXPECT_TRUE(closed);
+  EXPECT_EQ(srv->stats().requests, 500u);
+  EXPECT_EQ(srv->stats().clients_closed_bad, 0u);
+}
+
 TEST_F(ModbusTcpDoor, SlowClientSendingByteByByteIsServed) {
   open();
   handler.regs[3] = 0xCAFE;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "../tests/gateways/modbus_test_handler.hpp"
+
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/gateways/modbus_tcp_server.hpp"
@@ -61,7 +62,9 @@ void client_loop(benchmark::State& state, int port) {
 class Tick final : public bus::EventTarget {
  public:
   explicit Tick(bus::Scheduler& s) : m_s(s) { m_s.schedule(bus::kTicksPerMs, *this); }
-  void on_event(bus::Ticks now, std::uint64_t) override { m_s.schedule(now + bus::kTicksPerMs, *this); }
+  void on_event(bus::Ticks now, std::uint64_t) override {
+    m_s.schedule(now + bus::kTicksPerMs, *this);
+  }
 
  private:
   bus::Scheduler& m_s;
@@ -73,7 +76,8 @@ void BM_ModbusTcp_pbvbus(benchmark::State& state) {
   Tick tick(sched);
   gateways::test::RegisterFileHandler handler;
   handler.record = false;
-  for (std::size_t i = 0; i < handler.regs.size(); ++i) handler.regs[i] = static_cast<std::uint16_t>(i);
+  for (std::size_t i = 0; i < handler.regs.size(); ++i)
+    handler.regs[i] = static_cast<std::uint16_t>(i);
   gateways::ModbusTcpServer srv(runner.io_context(), handler, {"127.0.0.1", 0});
   std::thread bus_thread([&] { runner.run_for(3600 * bus::kTicksPerSecond); });
   client_loop(state, srv.port());

@@ -7,11 +7,16 @@ namespace pbvbus::gateways {
 
 std::string_view to_string(MbapError e) {
   switch (e) {
-    case MbapError::None: return "ok";
-    case MbapError::Short: return "short header";
-    case MbapError::ProtocolId: return "protocol id not 0";
-    case MbapError::LengthTooSmall: return "length below 2";
-    case MbapError::LengthTooLarge: return "length above 254";
+    case MbapError::None:
+      return "ok";
+    case MbapError::Short:
+      return "short header";
+    case MbapError::ProtocolId:
+      return "protocol id not 0";
+    case MbapError::LengthTooSmall:
+      return "length below 2";
+    case MbapError::LengthTooLarge:
+      return "length above 254";
   }
   return "?";
 }
@@ -90,18 +95,34 @@ std::size_t encode_rtu_adu(std::uint8_t unit, std::span<const std::uint8_t> pdu,
 std::optional<std::size_t> rtu_request_length(std::span<const std::uint8_t> head) {
   if (head.size() < 2) return std::size_t{0};
   switch (head[1]) {
-    case 1: case 2: case 3: case 4: case 5: case 6: case 8: return std::size_t{8};
-    case 7: case 11: case 12: case 17: return std::size_t{4};
-    case 15: case 16:
+    case 1:
+    case 2:
+    case 3:
+    case 4:
+    case 5:
+    case 6:
+    case 8:
+      return std::size_t{8};
+    case 7:
+    case 11:
+    case 12:
+    case 17:
+      return std::size_t{4};
+    case 15:
+    case 16:
       if (head.size() < 7) return std::size_t{0};
       return std::size_t{7} + head[6] + 2;
-    case 22: return std::size_t{10};
+    case 22:
+      return std::size_t{10};
     case 23:
       if (head.size() < 11) return std::size_t{0};
       return std::size_t{11} + head[10] + 2;
-    case 24: return std::size_t{6};
-    case 43: return std::size_t{7};
-    default: return std::nullopt;
+    case 24:
+      return std::size_t{6};
+    case 43:
+      return std::size_t{7};
+    default:
+      return std::nullopt;
   }
 }
 

@@ -54,7 +54,8 @@ struct ModbusRtuPort::Impl {
     }
     if (rsp[0] & 0x80) ++stats.exceptions;
     std::array<std::uint8_t, kModbusRtuMaxAdu> adu{};
-    const std::size_t len = encode_rtu_adu(f.unit, std::span<const std::uint8_t>(rsp.data(), n), adu);
+    const std::size_t len =
+        encode_rtu_adu(f.unit, std::span<const std::uint8_t>(rsp.data(), n), adu);
     if (port && len > 0) port->write(std::span<const std::uint8_t>(adu.data(), len));
   }
 
@@ -84,13 +85,27 @@ ModbusRtuPort::ModbusRtuPort(boost::asio::io_context& io, ModbusHandler& handler
                              ModbusRtuOptions opt)
     : m(std::make_unique<Impl>(io, handler, opt)) {}
 
-ModbusRtuPort::~ModbusRtuPort() { m->close(); }
+ModbusRtuPort::~ModbusRtuPort() {
+  m->close();
+}
 
-const std::string& ModbusRtuPort::path() const { return m->port->path(); }
-std::chrono::microseconds ModbusRtuPort::silence() const { return m->silence; }
-const ModbusDoorStats& ModbusRtuPort::stats() const { return m->stats; }
-const RtuFramer::Stats& ModbusRtuPort::framer_stats() const { return m->framer.stats(); }
-const SerialPort::Stats& ModbusRtuPort::port_stats() const { return m->port->stats(); }
-void ModbusRtuPort::close() { m->close(); }
+const std::string& ModbusRtuPort::path() const {
+  return m->port->path();
+}
+std::chrono::microseconds ModbusRtuPort::silence() const {
+  return m->silence;
+}
+const ModbusDoorStats& ModbusRtuPort::stats() const {
+  return m->stats;
+}
+const RtuFramer::Stats& ModbusRtuPort::framer_stats() const {
+  return m->framer.stats();
+}
+const SerialPort::Stats& ModbusRtuPort::port_stats() const {
+  return m->port->stats();
+}
+void ModbusRtuPort::close() {
+  m->close();
+}
 
 }  // namespace pbvbus::gateways

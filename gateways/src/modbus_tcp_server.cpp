@@ -147,21 +147,22 @@ void ModbusTcpServer::Impl::Connection::arm_idle(Clock::time_point at) {
 }
 
 void ModbusTcpServer::Impl::Connection::read() {
-  sock.async_read_some(asio::buffer(in.data() + end, in.size() - end),
-                       [c = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
-                         if (!c->srv) return;
-                         if (ec == asio::error::eof && (c->writing || !c->out_pending.empty())) {
-                           // Half-closed after its last request: finish sending, then close.
-                           c->eof = true;
-                           return;
-                         }
-                         if (ec) {
-                           c->close(false);  // EOF or reset: the client left
-                           return;
-                         }
-                         c->end += n;
-                         c->process();
-                       });
+  sock.async_read_some(
+      asio::buffer(in.data() + end, in.size() - end),
+      [c = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+        if (!c->srv) return;
+        if (ec == asio::error::eof && (c->writing || !c->out_pending.empty())) {
+          // Half-closed after its last request: finish sending, then close.
+          c->eof = true;
+          return;
+        }
+        if (ec) {
+          c->close(false);  // EOF or reset: the client left
+          return;
+        }
+        c->end += n;
+        c->process();
+      });
 }
 
 void ModbusTcpServer::Impl::Connection::process() {
@@ -180,9 +181,10 @@ void ModbusTcpServer::Impl::Connection::process() {
     if (served == srv->opt.max_requests_per_turn) {
       // Fairness: let the bus's timer and the other connections run, then go on.
       flush();
-      if (srv) asio::post(srv->io, [c = shared_from_this()] {
-        if (c->srv) c->process();
-      });
+      if (srv)
+        asio::post(srv->io, [c = shared_from_this()] {
+          if (c->srv) c->process();
+        });
       return;
     }
     serve(d, in.data() + begin);
@@ -220,7 +222,8 @@ void ModbusTcpServer::Impl::Connection::serve(const MbapDecoded& d, const std::u
   if (rsp[0] & 0x80) ++srv->stats.exceptions;
   const std::size_t at = out_pending.size();
   out_pending.resize(at + kMbapHeaderLen + n);
-  encode_tcp_adu(d.header.transaction_id, d.header.unit, std::span<const std::uint8_t>(rsp.data(), n),
+  encode_tcp_adu(d.header.transaction_id, d.header.unit,
+                 std::span<const std::uint8_t>(rsp.data(), n),
                  std::span<std::uint8_t>(out_pending.data() + at, kMbapHeaderLen + n));
   if (out_pending.size() + out_flight.size() > srv->opt.max_output) close(true);
 }
@@ -247,7 +250,8 @@ void ModbusTcpServer::Impl::Connection::flush() {
                       }
                       c->out_flight.clear();
                       c->flush();
-                      if (c->srv && c->eof && !c->writing && c->out_pending.empty()) c->close(false);
+                      if (c->srv && c->eof && !c->writing && c->out_pending.empty())
+                        c->close(false);
                     });
 }
 
@@ -272,11 +276,21 @@ ModbusTcpServer::ModbusTcpServer(asio::io_context& io, ModbusHandler& handler, M
   m->start();
 }
 
-ModbusTcpServer::~ModbusTcpServer() { m->close(); }
+ModbusTcpServer::~ModbusTcpServer() {
+  m->close();
+}
 
-std::uint16_t ModbusTcpServer::port() const { return m->port; }
-const ModbusDoorStats& ModbusTcpServer::stats() const { return m->stats; }
-std::uint64_t ModbusTcpServer::rejected() const { return m->rejected; }
-void ModbusTcpServer::close() { m->close(); }
+std::uint16_t ModbusTcpServer::port() const {
+  return m->port;
+}
+const ModbusDoorStats& ModbusTcpServer::stats() const {
+  return m->stats;
+}
+std::uint64_t ModbusTcpServer::rejected() const {
+  return m->rejected;
+}
+void ModbusTcpServer::close() {
+  m->close();
+}
 
 }  // namespace pbvbus::gateways

@@ -22,18 +22,30 @@ namespace {
 
 std::optional<speed_t> baud_constant(std::uint32_t baud) {
   switch (baud) {
-    case 1200: return B1200;
-    case 2400: return B2400;
-    case 4800: return B4800;
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 115200: return B115200;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    case 921600: return B921600;
-    default: return std::nullopt;
+    case 1200:
+      return B1200;
+    case 2400:
+      return B2400;
+    case 4800:
+      return B4800;
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    case 230400:
+      return B230400;
+    case 460800:
+      return B460800;
+    case 921600:
+      return B921600;
+    default:
+      return std::nullopt;
   }
 }
 
@@ -45,8 +57,9 @@ void make_raw(int fd, const SerialSettings* s, const std::string& what) {
   t.c_cc[VTIME] = 0;
   if (s) {
     const auto sp = baud_constant(s->baud);
-    if (!sp) throw std::invalid_argument("serial port " + what + ": unsupported baud rate " +
-                                         std::to_string(s->baud));
+    if (!sp)
+      throw std::invalid_argument("serial port " + what + ": unsupported baud rate " +
+                                  std::to_string(s->baud));
     ::cfsetispeed(&t, *sp);
     ::cfsetospeed(&t, *sp);
     t.c_cflag |= CLOCAL | CREAD;
@@ -153,7 +166,9 @@ std::unique_ptr<SerialPort> SerialPort::open_device(boost::asio::io_context& io,
   return std::unique_ptr<SerialPort>(new SerialPort(io, fd, -1, path, {}));
 }
 
-SerialPort::~SerialPort() { close(); }
+SerialPort::~SerialPort() {
+  close();
+}
 
 void SerialPort::close() {
   m_io.reset();
@@ -177,26 +192,28 @@ void SerialPort::start(OnBytes on_bytes) {
 
 void SerialPort::read_loop() {
   std::weak_ptr<bool> alive = m_io->alive;
-  m_io->sd.async_wait(boost::asio::posix::stream_descriptor::wait_read,
-                      [this, alive](const boost::system::error_code& ec) {
-                        if (ec || alive.expired()) return;
-                        std::uint8_t buf[1024];
-                        for (;;) {
-                          const ssize_t n = ::read(m_fd, buf, sizeof buf);
-                          if (n > 0) {
-                            m_stats.bytes_in += static_cast<std::size_t>(n);
-                            if (m_on_bytes) m_on_bytes(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(n)));
-                            if (alive.expired()) return;  // the callback closed the port
-                            continue;
-                          }
-                          if (n < 0 && errno == EINTR) continue;
-                          if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
-                          // EOF or an error (device gone): stop instead of spinning.
-                          m_io->reading = false;
-                          return;
-                        }
-                        read_loop();
-                      });
+  m_io->sd.async_wait(
+      boost::asio::posix::stream_descriptor::wait_read,
+      [this, alive](const boost::system::error_code& ec) {
+        if (ec || alive.expired()) return;
+        std::uint8_t buf[1024];
+        for (;;) {
+          const ssize_t n = ::read(m_fd, buf, sizeof buf);
+          if (n > 0) {
+            m_stats.bytes_in += static_cast<std::size_t>(n);
+            if (m_on_bytes)
+              m_on_bytes(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(n)));
+            if (alive.expired()) return;  // the callback closed the port
+            continue;
+          }
+          if (n < 0 && errno == EINTR) continue;
+          if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) break;
+          // EOF or an error (device gone): stop instead of spinning.
+          m_io->reading = false;
+          return;
+        }
+        read_loop();
+      });
 }
 
 bool SerialPort::write(std::span<const std::uint8_t> bytes) {

@@ -49,10 +49,12 @@ Run frame(std::span<const std::uint8_t> s, std::span<const std::uint8_t> chunkin
   RtuFramer f;
   RtuFramer::Sink sink = [&](const RtuFrame& fr) {
     if (fr.adu.size() < 4 || fr.adu.size() > kModbusRtuMaxAdu) fail("frame size");
-    if (fr.unit != fr.adu[0] || fr.pdu.size() + 3 != fr.adu.size() || fr.pdu.data() != fr.adu.data() + 1)
+    if (fr.unit != fr.adu[0] || fr.pdu.size() + 3 != fr.adu.size() ||
+        fr.pdu.data() != fr.adu.data() + 1)
       fail("frame parts");
     const std::uint16_t crc = crc_bitwise(fr.adu.first(fr.adu.size() - 2));
-    if (fr.adu[fr.adu.size() - 2] != (crc & 0xFF) || fr.adu.back() != (crc >> 8)) fail("bad CRC delivered");
+    if (fr.adu[fr.adu.size() - 2] != (crc & 0xFF) || fr.adu.back() != (crc >> 8))
+      fail("bad CRC delivered");
     if (const auto want = rtu_request_length(fr.adu); want && *want != 0 && *want != fr.adu.size())
       fail("length rule");
     r.frames.emplace_back(fr.adu.begin(), fr.adu.end());

@@ -6,11 +6,10 @@
 // test with the reason.
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <fstream>
 #include <regex>
@@ -18,6 +17,7 @@
 #include <thread>
 
 #include "modbus_test_handler.hpp"
+
 #include "pbvbus/gateways/modbus_rtu_port.hpp"
 #include "pbvbus/gateways/modbus_tcp_server.hpp"
 
@@ -35,7 +35,7 @@ bool have_pymodbus() {
 }
 
 struct ChildResult {
-  int rc = -1;  ///< exit code, -1 when killed or not started
+  int rc = -1;      ///< exit code, -1 when killed or not started
   std::string out;  ///< stdout + stderr
 };
 
@@ -84,7 +84,8 @@ ChildResult run_child(bus::PacedRunner& runner, const std::vector<std::string>& 
 std::vector<std::string> mbpoll_values(const std::string& out) {
   std::vector<std::string> v;
   static const std::regex line(R"(\[(\d+)\]:\s+(-?\d+))");
-  for (auto it = std::sregex_iterator(out.begin(), out.end(), line); it != std::sregex_iterator(); ++it)
+  for (auto it = std::sregex_iterator(out.begin(), out.end(), line); it != std::sregex_iterator();
+       ++it)
     v.push_back((*it)[1].str() + "=" + (*it)[2].str());
   return v;
 }
@@ -105,7 +106,8 @@ TEST_F(ModbusClients, MbpollOverTcp) {
   auto r = run_child(runner, {kMbpoll, "-m", "tcp", "-p", port, "-a", "1", "-t", "4", "-0", "-r",
                               "0", "-c", "4", "-1", "127.0.0.1"});
   ASSERT_EQ(r.rc, 0) << r.out;
-  EXPECT_EQ(mbpoll_values(r.out), (std::vector<std::string>{"0=555", "1=1", "2=2", "3=3"})) << r.out;
+  EXPECT_EQ(mbpoll_values(r.out), (std::vector<std::string>{"0=555", "1=1", "2=2", "3=3"}))
+      << r.out;
   // Write 3 registers at 10 (FC16).
   r = run_child(runner, {kMbpoll, "-m", "tcp", "-p", port, "-a", "1", "-t", "4", "-0", "-r", "10",
                          "127.0.0.1", "111", "222", "333"});
@@ -171,14 +173,20 @@ void pymodbus_round(bus::PacedRunner& runner, test::RegisterFileHandler& handler
 }
 
 TEST_F(ModbusClients, PymodbusOverTcp) {
-  if (!have_pymodbus()) GTEST_SKIP() << "/usr/bin/python3 cannot import pymodbus.client (apt install python3-pymodbus python3-serial-asyncio: pymodbus 3.0.0 imports serial_asyncio, only a Recommends)";
+  if (!have_pymodbus())
+    GTEST_SKIP()
+        << "/usr/bin/python3 cannot import pymodbus.client (apt install python3-pymodbus "
+           "python3-serial-asyncio: pymodbus 3.0.0 imports serial_asyncio, only a Recommends)";
   ModbusTcpServer srv(runner.io_context(), handler, {"127.0.0.1", 0});
   pymodbus_round(runner, handler, "tcp", std::to_string(srv.port()));
   EXPECT_EQ(srv.stats().exceptions, 2u);
 }
 
 TEST_F(ModbusClients, PymodbusOverRtuOnThePty) {
-  if (!have_pymodbus()) GTEST_SKIP() << "/usr/bin/python3 cannot import pymodbus.client (apt install python3-pymodbus python3-serial-asyncio: pymodbus 3.0.0 imports serial_asyncio, only a Recommends)";
+  if (!have_pymodbus())
+    GTEST_SKIP()
+        << "/usr/bin/python3 cannot import pymodbus.client (apt install python3-pymodbus "
+           "python3-serial-asyncio: pymodbus 3.0.0 imports serial_asyncio, only a Recommends)";
   ModbusRtuPort rtu(runner.io_context(), handler);
   pymodbus_round(runner, handler, "rtu", rtu.path());
   EXPECT_EQ(rtu.stats().exceptions, 2u);

@@ -10,8 +10,6 @@
 //   01 10 00 00 00 02 04 00 07 00 08 -> 43 A8
 //   00 06 00 01 00 07 -> 98 19   (broadcast)
 
-#include "pbvbus/gateways/modbus_frame.hpp"
-
 #include <gtest/gtest.h>
 
 #include <random>
@@ -19,6 +17,8 @@
 #include <vector>
 
 #include "hex.hpp"
+
+#include "pbvbus/gateways/modbus_frame.hpp"
 
 namespace pbvbus::gateways {
 namespace {

@@ -13,12 +13,11 @@
 #include "pbvbus/gateways/modbus_rtu_port.hpp"
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <poll.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -78,9 +77,8 @@ class ModbusRtuDoor : public ::testing::Test {
  protected:
   void SetUp() override { port = std::make_unique<ModbusRtuPort>(runner.io_context(), handler); }
   std::string exchange(const std::vector<std::string>& frames, std::size_t want) {
-    return test::with_client(runner, [p = port->path(), frames, want] {
-      return rtu_client(p, frames, want);
-    });
+    return test::with_client(
+        runner, [p = port->path(), frames, want] { return rtu_client(p, frames, want); });
   }
   bus::Scheduler sched;
   bus::PacedRunner runner{sched};
@@ -153,8 +151,8 @@ TEST(ModbusRtuPort, LinkPointsAtThePtyAndGoesAwayOnClose) {
   bus::Scheduler sched;
   bus::PacedRunner runner{sched};
   test::RegisterFileHandler handler;
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("pbvbus-mbrtu-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("pbvbus-mbrtu-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string link = (dir / "ttyMB0").string();
   ModbusRtuOptions o;
@@ -164,7 +162,8 @@ TEST(ModbusRtuPort, LinkPointsAtThePtyAndGoesAwayOnClose) {
   EXPECT_GE(port->silence(), 20ms);  // the pty default
   handler.regs[0] = 7;
   handler.regs[1] = 8;
-  const auto got = test::with_client(runner, [&] { return rtu_client(link, {"01 03 00 00 00 02 C4 0B"}, 9); });
+  const auto got =
+      test::with_client(runner, [&] { return rtu_client(link, {"01 03 00 00 00 02 C4 0B"}, 9); });
   EXPECT_EQ(got, "01 03 04 00 07 00 08 4A 34");
   port->close();
   port->close();

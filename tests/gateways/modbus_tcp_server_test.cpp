@@ -180,7 +180,7 @@ TEST_F(ModbusTcpDoor, HalfOpenClientIsClosedAfterTheIdleTimeout) {
   auto client = std::async(std::launch::async, [&, p = port] {
     const int fd = tcp_connect(p);
     send_all(fd, bytes_from_hex("00 01 00"));  // three octets of a header, then nothing
-    closed = wait_closed(fd);                   // the door must end it (10 s receive timeout)
+    closed = wait_closed(fd);                  // the door must end it (10 s receive timeout)
     ::close(fd);
     return true;
   });
@@ -202,14 +202,17 @@ TEST_F(ModbusTcpDoor, StalledClientThatNeverReadsIsClosed) {
   const auto req = bytes_from_hex("00 01 00 00 00 06 01 03 00 00 00 10");
   std::vector<std::uint8_t> block;
   for (int i = 0; i < 1000; ++i) block.insert(block.end(), req.begin(), req.end());
-  const bool send_failed = with_client(runner, [&, p = port] {
-    const int fd = tcp_connect(p, 4096);
-    bool failed = false;
-    for (int i = 0; i < 400 && !failed; ++i) failed = !send_all(fd, block);
-    if (!failed) failed = wait_closed(fd);
-    ::close(fd);
-    return failed;
-  }, 60s);
+  const bool send_failed = with_client(
+      runner,
+      [&, p = port] {
+        const int fd = tcp_connect(p, 4096);
+        bool failed = false;
+        for (int i = 0; i < 400 && !failed; ++i) failed = !send_all(fd, block);
+        if (!failed) failed = wait_closed(fd);
+        ::close(fd);
+        return failed;
+      },
+      60s);
   EXPECT_TRUE(send_failed);
   EXPECT_EQ(srv->stats().clients_closed_bad, 1u);
   EXPECT_EQ(srv->stats().clients_now, 0u);
@@ -240,7 +243,8 @@ TEST_F(ModbusTcpDoor, FloodOf10000PipelinedRequestsDoesNotStopTheBus) {
   probe.inner = &handler;
   probe.tick = &tick;
   probe.sched = &sched;
-  srv = std::make_unique<ModbusTcpServer>(runner.io_context(), probe, ModbusTcpOptions{"127.0.0.1", 0});
+  srv = std::make_unique<ModbusTcpServer>(runner.io_context(), probe,
+                                          ModbusTcpOptions{"127.0.0.1", 0});
   port = srv->port();
   handler.regs[0] = 42;
 
@@ -248,26 +252,39 @@ TEST_F(ModbusTcpDoor, FloodOf10000PipelinedRequestsDoesNotStopTheBus) {
   std::vector<std::uint8_t> all;
   for (int i = 0; i < kN; ++i) {
     // TID = i; FC03 of register 0.
-    const std::uint8_t t[12] = {static_cast<std::uint8_t>(i >> 8), static_cast<std::uint8_t>(i), 0, 0,
-                                0, 6, 1, 3, 0, 0, 0, 1};
+    const std::uint8_t t[12] = {static_cast<std::uint8_t>(i >> 8),
+                                static_cast<std::uint8_t>(i),
+                                0,
+                                0,
+                                0,
+                                6,
+                                1,
+                                3,
+                                0,
+                                0,
+                                0,
+                                1};
     all.insert(all.end(), t, t + 12);
   }
-  const auto [answers, in_order] = with_client(runner, [&, p = port] {
-    const int fd = tcp_connect(p);
-    std::thread writer([&] { send_all(fd, all); });
-    int got = 0;
-    bool ordered = true;
-    // Each response: TID, 00 00 00 05 01 03 02 00 2A (11 octets).
-    for (; got < kN; ++got) {
-      const auto r = recv_n(fd, 11);
-      if (r.size() != 11) break;
-      ordered &= r[0] == static_cast<std::uint8_t>(got >> 8) && r[1] == static_cast<std::uint8_t>(got) &&
-                 r[9] == 0 && r[10] == 42;
-    }
-    writer.join();
-    ::close(fd);
-    return std::pair{got, ordered};
-  }, 60s);
+  const auto [answers, in_order] = with_client(
+      runner,
+      [&, p = port] {
+        const int fd = tcp_connect(p);
+        std::thread writer([&] { send_all(fd, all); });
+        int got = 0;
+        bool ordered = true;
+        // Each response: TID, 00 00 00 05 01 03 02 00 2A (11 octets).
+        for (; got < kN; ++got) {
+          const auto r = recv_n(fd, 11);
+          if (r.size() != 11) break;
+          ordered &= r[0] == static_cast<std::uint8_t>(got >> 8) &&
+                     r[1] == static_cast<std::uint8_t>(got) && r[9] == 0 && r[10] == 42;
+        }
+        writer.join();
+        ::close(fd);
+        return std::pair{got, ordered};
+      },
+      60s);
   EXPECT_EQ(answers, kN);
   EXPECT_TRUE(in_order);
   EXPECT_EQ(srv->stats().requests, static_cast<std::uint64_t>(kN));
@@ -301,7 +318,8 @@ TEST_F(ModbusTcpDoor, GarbageBytesCloseTheConnection) {
 TEST_F(ModbusTcpDoor, WrongMbapLengthClosesAfterAnsweringWhatCameBefore) {
   open();
   handler.regs[0] = 0x00AA;
-  for (const char* bad : {"00 02 00 00 00 FF 01 03", "00 02 00 00 00 01 01", "00 02 00 00 00 00 01"}) {
+  for (const char* bad :
+       {"00 02 00 00 00 FF 01 03", "00 02 00 00 00 01 01", "00 02 00 00 00 00 01"}) {
     const auto [first, closed] = with_client(runner, [p = port, bad] {
       const int fd = tcp_connect(p);
       // A good FC03 (LEN 6) and, in the same segment, a header with a bad LEN.

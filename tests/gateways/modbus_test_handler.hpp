@@ -13,12 +13,6 @@
 // Also here: driving a paced runner on the test thread while a client (a raw socket in a
 // thread, or a child process) runs, and blocking raw-socket helpers for clients.
 
-#include <array>
-#include <cstdint>
-#include <span>
-#include <vector>
-
-#include "pbvbus/gateways/modbus_handler.hpp"
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -27,6 +21,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -38,7 +33,7 @@
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
-
+#include "pbvbus/gateways/modbus_handler.hpp"
 
 namespace pbvbus::gateways::test {
 
@@ -113,7 +108,8 @@ class RegisterFileHandler final : public ModbusHandler {
         std::copy(pdu.begin(), pdu.begin() + 5, rsp.begin());
         return 5;
       }
-      default: return exception(fc, kExIllegalFunction, rsp);
+      default:
+        return exception(fc, kExIllegalFunction, rsp);
     }
   }
 };
@@ -192,6 +188,5 @@ inline bool wait_closed(int fd) {
     if (r < 0) return errno == ECONNRESET || errno == EPIPE;
   }
 }
-
 
 }  // namespace pbvbus::gateways::test

@@ -34,8 +34,8 @@
 namespace pbvbus::gateways {
 
 struct ModbusRtuOptions {
-  std::string device;   ///< a serial device path; empty = a new pty
-  std::string link;     ///< pty only: a symlink to its slave path (e.g. "./ttyMB0"); may be empty
+  std::string device;     ///< a serial device path; empty = a new pty
+  std::string link;       ///< pty only: a symlink to its slave path (e.g. "./ttyMB0"); may be empty
   SerialSettings serial;  ///< device only (a pty ignores it, except for the silence default)
   std::chrono::microseconds silence{0};  ///< t3.5; zero = the default described above
 };

@@ -51,7 +51,7 @@ struct ModbusTcpOptions {
   std::uint16_t port = 502;           ///< 0 = an ephemeral port (see port())
   std::size_t max_clients = 32;
   std::size_t max_requests_per_turn = 16;
-  std::size_t max_output = 64 * 1024;  ///< octets of unsent responses per connection
+  std::size_t max_output = 64 * 1024;              ///< octets of unsent responses per connection
   std::chrono::milliseconds idle_timeout{60'000};  ///< zero = never
 };
 

@@ -66,7 +66,6 @@ struct ModbusRtuPort::Impl {
 
   void close() {
     alive.reset();
-    boost::system::error_code ec;
     timer.cancel();
     if (port) port->close();
   }

@@ -240,3 +240,24 @@ TEST(SerialFormat, ParsesTheModbusCharacterFormats) {
 
 }  // namespace
 }  // namespace pbvbus::gateways
+
+namespace pbvbus::gateways {
+namespace {
+
+TEST(SerialPort, AClientThatNeverReadsGetsWritesRefusedNotABlockedBus) {
+  boost::asio::io_context io;
+  auto port = SerialPort::open_pty(io);
+  port->set_max_backlog(256);
+  // Nobody reads the slave side: the pty's buffer fills, then 256 octets wait, then whole
+  // writes are refused. Every call returns at once (a blocking write would hang this test).
+  const std::vector<std::uint8_t> chunk(64, 0x55);
+  int refused = 0;
+  for (int i = 0; i < 10'000 && refused == 0; ++i)
+    if (!port->write(chunk)) ++refused;
+  EXPECT_EQ(refused, 1);
+  EXPECT_EQ(port->stats().writes_refused, 1u);
+  EXPECT_GT(port->stats().bytes_out, 0u);
+}
+
+}  // namespace
+}  // namespace pbvbus::gateways

@@ -31,6 +31,9 @@
 // heartbeats. A cyclic TPDO and a changed one due at the same instant are one frame.
 //
 // Threading: the bus thread only (hub receivers and scheduler events), like every door.
+// Lifetime: the scheduler has no cancel, so the gateway must be destroyed only when its
+// scheduler will not run again (as every other target); the destructor removes its hub port.
+// Frames that arrive before start() are ignored (the node is not on the bus yet).
 
 #include <array>
 #include <cstdint>

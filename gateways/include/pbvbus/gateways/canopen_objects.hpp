@@ -18,6 +18,9 @@
 // - The error register (0x1001) has bit 0 (generic) set whenever any other bit is, as CiA 301
 //   requires; bit 4 (communication) while a station failure is active, bit 7 (manufacturer)
 //   while the slave reports Ext_Diag.
+// - 0x1018 sub 1..4 are UNSIGNED32 as CiA 301 declares them (product code = Ident_Number,
+//   serial number = PROFIBUS address): a tool that reads the identity by its declared type
+//   rejects a shorter answer. The 16-bit ident is also at 0x2000 sub 4.
 
 #include <cstdint>
 #include <optional>

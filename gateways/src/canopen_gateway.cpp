@@ -167,12 +167,12 @@ void CanopenGateway::check_node(Node& n, bus::Ticks now, bool cyclic) {
 }
 
 void CanopenGateway::send_tpdos(Node& n, bus::Ticks now, bool cyclic) {
-  m_buf.assign(n.map.input_len, 0);
-  if (!m_source.read_inputs(n.map.address, Side::Primary, m_buf)) return;
+  m_in_buf.assign(n.map.input_len, 0);
+  if (!m_source.read_inputs(n.map.address, Side::Primary, m_in_buf)) return;
   for (std::size_t i = 0; i < n.map.tpdos; ++i) {
     const std::size_t off = i * kPdoOctets;
-    const auto len = static_cast<std::uint8_t>(std::min(kPdoOctets, m_buf.size() - off));
-    const std::uint8_t* p = m_buf.data() + off;
+    const auto len = static_cast<std::uint8_t>(std::min(kPdoOctets, m_in_buf.size() - off));
+    const std::uint8_t* p = m_in_buf.data() + off;
     const bool changed = !n.sent[i] || n.last_len[i] != len ||
                          std::memcmp(n.last[i].data(), p, len) != 0;
     if (!changed && !cyclic) continue;
@@ -311,12 +311,12 @@ void CanopenGateway::on_rpdo(Node& n, std::size_t pdo, const CanFrame& f) {
     return;
   }
   const std::size_t len = std::min<std::size_t>({f.dlc, kPdoOctets, n.map.output_len - off});
-  m_buf.assign(n.map.output_len, 0);
-  if (!m_source.read_outputs(n.map.address, Side::Primary, m_buf)) {
+  m_out_buf.assign(n.map.output_len, 0);
+  if (!m_source.read_outputs(n.map.address, Side::Primary, m_out_buf)) {
     ++m_stats.rpdo_refused;
     return;
   }
-  std::copy_n(f.data.begin(), len, m_buf.begin() + static_cast<std::ptrdiff_t>(off));
+  std::copy_n(f.data.begin(), len, m_out_buf.begin() + static_cast<std::ptrdiff_t>(off));
   bool ok = true;
   const auto& modules = n.slave->modules;
   for (std::size_t m = 0; m < modules.size() && len > 0; ++m) {
@@ -325,7 +325,7 @@ void CanopenGateway::on_rpdo(Node& n, std::size_t pdo, const CanFrame& f) {
       continue;
     ok = m_source.write_module_outputs(
              n.map.address, m,
-             std::span<const std::uint8_t>(m_buf).subspan(mod.out_offset, mod.out_len)) &&
+             std::span<const std::uint8_t>(m_out_buf).subspan(mod.out_offset, mod.out_len)) &&
          ok;
   }
   if (ok)

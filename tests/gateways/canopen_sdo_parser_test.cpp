@@ -138,7 +138,7 @@ TEST(CanopenSdoEncode, DownloadResponseAndAbort) {
 
 // --- the object dictionary --------------------------------------------------------------------
 
-struct Dict : ::testing::Test {
+struct CanopenDict : ::testing::Test {
   SourceSlave slave;
   NodeObjects node;
   void SetUp() override {
@@ -160,7 +160,7 @@ struct Dict : ::testing::Test {
   }
 };
 
-TEST_F(Dict, StandardObjects) {
+TEST_F(CanopenDict, StandardObjects) {
   EXPECT_EQ(read(0x1000, 0), "4:0");
   EXPECT_EQ(read(0x1001, 0), "1:129");  // 0x81
   EXPECT_EQ(read(0x1017, 0), "2:1000");
@@ -174,7 +174,7 @@ TEST_F(Dict, StandardObjects) {
   EXPECT_EQ(read(0x1016, 0), "abort " + std::to_string(kAbortNoObject));
 }
 
-TEST_F(Dict, StatusBlockAndDiagnosis) {
+TEST_F(CanopenDict, StatusBlockAndDiagnosis) {
   EXPECT_EQ(read(0x2000, 0), "1:7");
   EXPECT_EQ(read(0x2000, 1), "1:6");       // DataExchange
   EXPECT_EQ(read(0x2000, 2), "1:3");       // data valid (bit 0) + ext diag (bit 1)
@@ -194,7 +194,7 @@ TEST_F(Dict, StatusBlockAndDiagnosis) {
   EXPECT_EQ(read(0x2001, 1), "abort " + std::to_string(kAbortNoSubIndex));
 }
 
-TEST_F(Dict, StateCodesAndFlags) {
+TEST_F(CanopenDict, StateCodesAndFlags) {
   using S = dp::SlaveStatusState;
   const std::pair<S, int> codes[] = {{S::Inactive, 1},  {S::Diag, 2},         {S::Prm, 3},
                                      {S::Cfg, 4},       {S::CheckDiag, 5},    {S::DataExchange, 6},
@@ -215,7 +215,7 @@ TEST_F(Dict, StateCodesAndFlags) {
   EXPECT_EQ(dp_status_flags(slave, node.status), 0x64);  // failure + switched + red. lost
 }
 
-TEST_F(Dict, OnlyTheHeartbeatTimeIsWritable) {
+TEST_F(CanopenDict, OnlyTheHeartbeatTimeIsWritable) {
   auto w = check_write(node, 0x1017, 0, 2, 500);
   EXPECT_EQ(w.abort, 0u);
   EXPECT_EQ(w.value, 500u);

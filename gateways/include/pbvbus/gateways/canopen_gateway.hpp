@@ -177,7 +177,10 @@ class CanopenGateway final : public bus::EventTarget {
   bus::Ticks m_next_cycle = bus::kNever;
   bus::Ticks m_armed_at = bus::kNever;
   std::uint64_t m_generation = 0;
-  std::vector<std::uint8_t> m_buf;  ///< inputs / outputs copy, reused
+  // Reused copies; two of them because a hub receiver may answer a TPDO with an RPDO inside
+  // our send (the RPDO handler must not touch the buffer the TPDO loop is reading).
+  std::vector<std::uint8_t> m_in_buf;
+  std::vector<std::uint8_t> m_out_buf;
   CanopenStats m_stats;
 };
 

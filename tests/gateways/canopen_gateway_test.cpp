@@ -166,6 +166,41 @@ TEST_F(CanopenGatewayTest, FourTpdosOnlyTheChangedOneAndUnmappedInputsWarned) {
   EXPECT_EQ(log(), (Log{"21ms 287#08990A0B0C0D0E0F"}));
 }
 
+TEST_F(CanopenGatewayTest, TimesCountFromTheStartInstant) {
+  add_slave5();
+  make();
+  run_to(7 * ms);
+  start();  // t0 = 7 ms: cyclic TPDOs at 107, 207 ms; the first heartbeat at 1007 ms
+  run_to(1100 * ms);
+  const Log l = log();
+  ASSERT_GE(l.size(), 5u);
+  EXPECT_EQ((Log{l[0], l[1], l[2], l[3]}), (Log{"7ms 705#00", "7ms 185#0102030405",
+                                               "107ms 185#0102030405", "207ms 185#0102030405"}));
+  EXPECT_EQ(log({"705"}), (Log{"7ms 705#00", "1007ms 705#05"}));
+}
+
+TEST_F(CanopenGatewayTest, AnRpdoSentInsideATpdoDeliveryIsApplied) {
+  // A port that answers every TPDO at once with an RPDO (a PLC echoing inputs to outputs),
+  // inside the gateway's own send.
+  src.add_slave(5, 0x0A03, {mod("16 in", 16, 0), mod("2DO", 0, 2)});
+  for (std::uint8_t i = 0; i < 16; ++i) src.data(5).inputs[i] = i;
+  CanHub::PortId plc = 0;
+  plc = hub.add_port("plc", [&](const CanFrame& f, bus::Ticks now) {
+    if (f.id != 0x185) return;
+    CanFrame r = frame("205#0000");
+    r.data[0] = f.data[7];
+    r.data[1] = f.data[6];
+    hub.send(plc, r, now);
+  });
+  make();
+  start();
+  // TPDO2 (octets 8..15) still goes out whole after the RPDO handler ran inside TPDO1's send.
+  EXPECT_EQ(log({"185", "285", "205"}),
+            (Log{"0ms 185#0001020304050607", "0ms 205#0706", "0ms 285#08090A0B0C0D0E0F"}));
+  EXPECT_EQ(src.data(5).outputs, (std::vector<std::uint8_t>{7, 6}));
+  EXPECT_EQ(gw->stats().rpdo_received, 1u);
+}
+
 // --- heartbeat, boot-up, EMCY ------------------------------------------------------------------
 
 TEST_F(CanopenGatewayTest, HeartbeatEverySecondWithTheDpState) {

@@ -123,8 +123,7 @@ TEST(SlcanDoor, TcpClientOpensSendsAndReceives) {
     ::close(fd);
   });
   EXPECT_TRUE(rig.run_until([&] { return !rig.seen.empty(); }));
-  ASSERT_EQ(rig.seen.size(), 1u);
-  EXPECT_EQ(rig.seen[0], frame(0x205, false, {0xAA, 0xBB}));
+  EXPECT_EQ(rig.seen, std::vector<CanFrame>{frame(0x205, false, {0xAA, 0xBB})});
   EXPECT_EQ(rig.hub.ports(), 2u);  // the test and the connection
   rig.hub.send(rig.me, frame(0x123, false, {0x42}), rig.sched.now());
   EXPECT_TRUE(rig.run_until([&] { return door.stats().clients == 0; }));  // the client hung up
@@ -203,7 +202,7 @@ TEST(SlcanDoor, ClientThatNeverReadsCannotStallTheBus) {
     while (!release) std::this_thread::sleep_for(5ms);
     ::close(fd);
   });
-  ASSERT_TRUE(rig.run_until([&] { return door.stats().lines == 1; }));
+  EXPECT_TRUE(rig.run_until([&] { return door.stats().lines == 1; }));
   // 100 events, 1 ms apart, each sending 1000 frames of 8 bytes (22 characters per line):
   // 100 000 frames, 2.2 MB, far beyond the 64 KiB queue and the socket buffers.
   int ticks = 0;

@@ -111,7 +111,6 @@ TEST(SlcanDoor, TcpClientOpensSendsAndReceives) {
   SlcanDoor door(rig.runner, rig.hub, tcp_only());
   ASSERT_EQ(door.open(), "");
   ASSERT_NE(door.port(), 0);
-  std::atomic<bool> go_read{false};
   std::string got;
   std::thread client([&] {
     const int fd = connect_tcp(door.port());

@@ -17,6 +17,10 @@ constexpr bus::Ticks kMs = bus::kTicksPerMs;
 // GSD paths are relative to the scenario file: the name places it in examples/.
 const std::string kFile = std::string(PBVBUS_SOURCE_DIR) + "/examples/gw.textproto";
 
+// Positions are those of the field's name (or of the entry/message when the field is absent),
+// counted by hand in the text below: e.g. `gateway { name: "g2" line: "A" master: 7` has
+// `gateway { ` (10 columns), so `name` at 11, `line` at 11 + 11 = 22, `master` at 22 + 10 = 32.
+//
 // The DP system of dp-basic (slaves 3, 4, 5 on master 1), lines 1..13; a test appends its
 // gateway entries from line 14 on.
 const std::string kBase = R"(name: "gw"
@@ -135,12 +139,12 @@ gateway { name: "g4" modbus_tcp { listen: "127.0.0.1:0" } }
 gateway { name: "g5" line: "A" modbus_tcp { listen: "127.0.0.1:0" } }
 )"),
             (std::vector<std::string>{
-                "gw.textproto:14:29: unknown line \"C\"",
-                "gw.textproto:15:30: no dp_master 7 on line \"A\"",
-                "gw.textproto:16:11: unknown redundant_master_system \"R\"",
+                "gw.textproto:14:22: unknown line \"C\"",
+                "gw.textproto:15:32: no dp_master 7 on line \"A\"",
+                "gw.textproto:16:22: unknown redundant_master_system \"R\"",
                 "gw.textproto:17:11: give the master system: line and master (a dp_master) or "
                 "redundant_master_system",
-                "gw.textproto:18:30: a gateway on a dp_master needs both line and master",
+                "gw.textproto:18:22: a gateway on a dp_master needs both line and master",
             }));
 }
 
@@ -212,8 +216,8 @@ TEST(GatewayScenario, ModbusOptions) {
             (std::vector<std::string>{
                 "gw.textproto:18:5: standby_units needs a redundant_master_system",
                 "gw.textproto:19:13: address 9 is not a slave of dp_master 1 on A",
-                "gw.textproto:20:25: stale_value 65536 is out of range 0..65535",
-                "gw.textproto:20:55: module_index 3 is out of range: slave 4 has 3 modules (0..2)",
+                "gw.textproto:20:24: stale_value 65536 is out of range 0..65535",
+                "gw.textproto:20:52: module_index 3 is out of range: slave 4 has 3 modules (0..2)",
                 "gw.textproto:21:13: options for slave 4 are given twice",
                 "gw.textproto:22:5: a slave option needs its address",
             }));
@@ -233,14 +237,27 @@ TEST(GatewayScenario, CanNodes) {
 }
 )"),
             (std::vector<std::string>{
-                "gw.textproto:17:29: node 0 is out of range 1..127",
+                "gw.textproto:17:23: node 0 is out of range 1..127",
                 "gw.textproto:18:12: address 9 is not a slave of dp_master 1 on A",
                 // slave 3 mapped to node 5, which is slave 5's own address (its default node)
-                "gw.textproto:19:29: node 5 is used twice (slave 3 and slave 5)",
-                "gw.textproto:20:17: must be longer than 0",
-                "gw.textproto:21:16: bad duration \"soon\" (expected a number and a unit: ns, us, "
+                "gw.textproto:19:23: node 5 is used twice (slave 3 and slave 5)",
+                "gw.textproto:20:5: must be longer than 0",
+                "gw.textproto:21:5: bad duration \"soon\" (expected a number and a unit: ns, us, "
                 "ms, s, min, h)",
                 "gw.textproto:22:5: socketcan needs an interface, e.g. \"vcan0\"",
+            }));
+}
+
+TEST(GatewayScenario, HeartbeatIsSixteenBitsOfMilliseconds) {
+  EXPECT_EQ(errors(R"(gateway { name: "g" line: "A" master: 1 can { heartbeat: "66s" socketcand { } } }
+gateway { name: "h" line: "B" master: 2 can { heartbeat: "1500us" socketcand { listen: "127.0.0.1:0" } } }
+)"),
+            (std::vector<std::string>{
+                // `gateway { name: "g" line: "A" master: 1 can { ` = 10 + 10 + 10 + 10 + 6 = 46 columns
+                "gw.textproto:14:47: heartbeat must be whole milliseconds up to 65535ms (object "
+                "0x1017 is 16 bits)",
+                "gw.textproto:15:47: heartbeat must be whole milliseconds up to 65535ms (object "
+                "0x1017 is 16 bits)",
             }));
 }
 
@@ -251,7 +268,7 @@ TEST(GatewayScenario, ASideOfARedundantSystemIsServedThroughTheSystem) {
 )", kFile);
   ASSERT_EQ(r.errors.size(), 1u);
   EXPECT_EQ(r.errors[0].line, 15);
-  EXPECT_EQ(r.errors[0].column, 41);
+  EXPECT_EQ(r.errors[0].column, 31);  // `master`
   EXPECT_EQ(r.errors[0].message,
             "dp_master 2 on line \"B\" is part of redundant_master_system \"R\": give "
             "redundant_master_system instead");

@@ -329,7 +329,14 @@ class GwPlanner {
       }
     }
     if (auto t = duration(i, {{"can"}, {"tpdo_cycle"}}, c.tpdo_cycle(), can.tpdo_cycle)) can.tpdo_cycle = *t;
-    if (auto t = duration(i, {{"can"}, {"heartbeat"}}, c.heartbeat(), can.heartbeat)) can.heartbeat = *t;
+    if (auto t = duration(i, {{"can"}, {"heartbeat"}}, c.heartbeat(), can.heartbeat)) {
+      // Object 0x1017 holds it as u16 milliseconds.
+      if (*t % bus::kTicksPerMs != 0 || *t > 65535 * bus::kTicksPerMs)
+        error(i, {{"can"}, {"heartbeat"}},
+              "heartbeat must be whole milliseconds up to 65535ms (object 0x1017 is 16 bits)");
+      else
+        can.heartbeat = *t;
+    }
     if (c.has_slcan_pty()) {
       can.slcan_pty = c.slcan_pty().link();
       link(i, {{"can"}, {"slcan_pty"}, {"link"}}, c.slcan_pty().link());

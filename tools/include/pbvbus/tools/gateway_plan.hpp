@@ -25,7 +25,8 @@
 //    module option's module_index below that slave's module count, once; stale_value 0..65535;
 //    standby_units only on a redundant_master_system.
 //  - can: node map entries name a slave of the system (once) and a node id 1..127; every served
-//    slave's node id (mapped, else its address) is unique; tpdo_cycle and heartbeat > 0.
+//    slave's node id (mapped, else its address) is unique; tpdo_cycle and heartbeat > 0, the
+//    heartbeat in whole milliseconds up to 65535 ms (CiA 301 object 0x1017 is u16 ms).
 #include <cstdint>
 #include <functional>
 #include <optional>

@@ -293,7 +293,8 @@ def run(bus):
     first = None
     while first is None and time.time() < end:
         m = bus.recv(0.5)
-        if m is not None and m.arbitration_id == 0x186 and not m.is_extended_id:
+        # (python-can 4.1's socketcand backend marks every received frame extended)
+        if m is not None and m.arbitration_id == 0x186:
             first = m
     print('first', first.data.hex() if first else None, first.dlc if first else None)
     bus.send(can.Message(arbitration_id=0x206, is_extended_id=False,

@@ -9,12 +9,14 @@
 
 #include <array>
 #include <atomic>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "pbvbus/bus/paced_runner.hpp"
+#include "pbvbus/gateways/modbus_map.hpp"
 #include "pbvbus/tools/report.hpp"
 #include "pbvbus/tools/scenario.hpp"
 #include "pbvbus/tools/simulation.hpp"
@@ -151,6 +153,36 @@ TEST(GatewayRun, ModbusTcpReadThroughThePacedRun) {
   EXPECT_EQ(r.gateways[0].doors[0].requests, 1u);
   EXPECT_EQ(r.gateways[0].doors[0].exceptions, 0u);
   EXPECT_EQ(r.gateways[0].modbus->requests, 1u);
+}
+
+TEST(GatewayRun, ARedundantSystemsGatewayOwnsItsOutputs) {
+  // examples/switched-io.textproto (switched stations 3..6 of "H-DP 1", one-sided slaves 10 on
+  // DP_A and 11 on DP_B) with a gateway on the system and Quantum-style standby units.
+  std::ifstream f(std::string(PBVBUS_SOURCE_DIR) + "/examples/switched-io.textproto");
+  const std::string text{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  auto r = parse_scenario(text + R"(gateway { name: "red" redundant_master_system: "H-DP 1"
+  modbus_tcp { listen: "127.0.0.1:0" } modbus { standby_units: true } }
+)", std::string(PBVBUS_SOURCE_DIR) + "/examples/switched-io.textproto");
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  SimulationOptions o;
+  o.duration = 900 * kMs;  // before the first fault (1 s)
+  Simulation sim(*r.plan, o);
+  sim.start();
+  sim.run_until(900 * kMs);
+  const Report rep = sim.report(1.0);
+  ASSERT_EQ(rep.gateways.size(), 1u);
+  EXPECT_EQ(rep.gateways[0].served, "redundant_master_system \"H-DP 1\"");
+  // The system's program is off: every switched station's backplane outputs are still 0.
+  ASSERT_EQ(rep.redundancy.size(), 1u);
+  ASSERT_EQ(rep.redundancy[0].stations.size(), 4u);
+  for (const auto& st : rep.redundancy[0].stations) {
+    EXPECT_FALSE(st.outputs.empty());
+    EXPECT_EQ(st.outputs, std::vector<std::uint8_t>(st.outputs.size(), 0)) << int(st.address);
+  }
+  // Units: 3..6, 10, 11 and the standby views 128 + 3..6 of the switched stations.
+  std::vector<int> units;
+  for (const auto& u : sim.gateway(0).modbus_map().units()) units.push_back(u.unit);
+  EXPECT_EQ(units, (std::vector<int>{3, 4, 5, 6, 10, 11, 131, 132, 133, 134}));
 }
 
 }  // namespace

@@ -185,5 +185,29 @@ TEST(GatewayRun, ARedundantSystemsGatewayOwnsItsOutputs) {
   EXPECT_EQ(units, (std::vector<int>{3, 4, 5, 6, 10, 11, 131, 132, 133, 134}));
 }
 
+TEST(GatewayRun, AGatewayOnAnHSystemIsReadOnly) {
+  // examples/h-system.textproto: "H-DP 1" is driven by the simulated CPU pair, whose program
+  // owns the outputs: the system's masters keep their (switched-off) program state, and the
+  // source (RedundantSource with the HSystemModel) refuses writes: every unit is read-only.
+  const std::string file = std::string(PBVBUS_SOURCE_DIR) + "/examples/h-system.textproto";
+  std::ifstream f(file);
+  const std::string text{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+  auto r = parse_scenario(text + R"(gateway { name: "h" redundant_master_system: "H-DP 1"
+  modbus_tcp { listen: "127.0.0.1:0" } }
+)", file);
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  const GatewayPlan& g = r.plan->gateways[0];
+  EXPECT_GE(g.h_system, 0);
+  for (const auto& m : r.plan->dp_masters) EXPECT_FALSE(m.gateway_outputs);
+  SimulationOptions o;
+  o.duration = 100 * kMs;
+  Simulation sim(*r.plan, o);
+  sim.start();
+  sim.run_until(100 * kMs);
+  const auto units = sim.gateway(0).modbus_map().units();
+  ASSERT_FALSE(units.empty());
+  for (const auto& u : units) EXPECT_FALSE(u.writable) << int(u.unit);
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

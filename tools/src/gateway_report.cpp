@@ -31,8 +31,11 @@ void write_gateways_text(const std::vector<GatewayReport>& r, std::ostream& os) 
          << " bad\n";
     }
     for (const GatewayDoorReport& d : g.doors) {
-      os << "  " << d.kind << " " << d.where;
+      // The link names the pty, the first part of `where` ("PTY HOST:PORT" for slcan).
+      const auto sp = d.where.find(' ');
+      os << "  " << d.kind << " " << d.where.substr(0, sp);
       if (!d.link.empty()) os << " (" << d.link << ")";
+      if (sp != std::string::npos) os << d.where.substr(sp);
       if (!d.error.empty()) {
         os << ": not open: " << d.error << "\n";
         continue;

@@ -16,8 +16,11 @@
 //  - Progress (virtual time, speed ratio, frames, error frames) goes to stderr only when stderr
 //    is a terminal, --quiet is not given, and the run
 //    has taken more than a second of wall time; it is erased before the report.
-//  - Exit codes: 0 done, 1 the run failed (capture could not be written), 2 bad usage or a bad
-//    scenario.
+//  - A scenario with a gateway runs paced (its doors face programs in real time); --fast is
+//    refused for it. The doors print where they listen (the port an ephemeral one got) unless
+//    --quiet; a door that cannot open ends the run with exit 1 before it starts.
+//  - Exit codes: 0 done, 1 the run failed (capture could not be written, a gateway's door could
+//    not open), 2 bad usage or a bad scenario.
 
 #include <unistd.h>
 
@@ -54,8 +57,10 @@ constexpr const char* kUsage =
     "SCENARIO, a built-in default scenario.\n"
     "\n"
     "options:\n"
-    "  --fast            run as fast as possible (default without serial attachments)\n"
-    "  --paced           virtual time follows the wall clock (default with serial attachments)\n"
+    "  --fast            run as fast as possible (default without serial attachments and\n"
+    "                    gateways; refused with a gateway)\n"
+    "  --paced           virtual time follows the wall clock (default with serial attachments\n"
+    "                    or gateways)\n"
     "  --duration T      how long to run, e.g. 500ms, 5s, 2min (overrides the scenario);\n"
     "                    a paced run without any duration runs until interrupted\n"
     "  --seed N          seed of the random choices (overrides the scenario)\n"
@@ -262,7 +267,12 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   for (const auto& l : plan.lines)
     for (const auto& st : l.stations)
       has_serial |= st.kind == StationKind::SerialMonitor || st.kind == StationKind::SerialStation;
-  const bool paced = ra.paced || (!ra.fast && has_serial);
+  // Gateways are doors to the outside like a pty: paced by default, and only paced.
+  if (!plan.gateways.empty() && ra.fast) {
+    err << "pbvbus run: " << plan.file << " has a gateway: its doors need a paced run (drop --fast)\n";
+    return 2;
+  }
+  const bool paced = ra.paced || (!ra.fast && (has_serial || !plan.gateways.empty()));
   const std::optional<bus::Ticks> duration = ra.duration ? ra.duration : plan.duration;
   if (!duration && !paced) {
     err << "pbvbus run: " << plan.file
@@ -338,7 +348,17 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   if (paced) {
     // The runner belongs to the simulation (torn down after its doors); the signal set below
     // is the only other user of its io_context and goes at the end of this block.
-    bus::PacedRunner& runner = sim->paced_runner(ra.speed.value_or(bus::Speed{}));
+    bus::PacedRunner* runner_ptr = nullptr;
+    try {
+      runner_ptr = &sim->paced_runner(ra.speed.value_or(bus::Speed{}));
+    } catch (const std::exception& e) {
+      err << "pbvbus run: " << e.what() << "\n";
+      return 1;
+    }
+    bus::PacedRunner& runner = *runner_ptr;
+    if (!ra.quiet)
+      for (std::size_t i = 0; i < sim->gateway_count(); ++i)
+        for (const std::string& line : sim->gateway(i).door_lines()) err << line << "\n";
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {
       if (!ec) {

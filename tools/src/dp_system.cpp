@@ -21,7 +21,8 @@ std::vector<dp::SlaveParams> slave_params(const DpMasterPlan& plan,
 
 DpMasterNode::DpMasterNode(const DpMasterPlan& plan, const std::vector<DpSlavePlan>& slaves,
                            const fdl::BusParams& params)
-    : m_master(plan.params, slave_params(plan, slaves)), m_program(plan.outputs) {
+    : m_master(plan.params, slave_params(plan, slaves)), m_program(plan.outputs),
+      m_program_off(plan.gateway_outputs) {
   m_station = std::make_unique<fdl::ActiveStation>(plan.params.address, params, *this);
 }
 
@@ -40,6 +41,11 @@ bool DpMasterNode::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request
 
 void DpMasterNode::on_token(bus::Ticks now, bus::Ticks trr) {
   ++m_tokens;
+  // Served by a gateway: its clients own the outputs (scenario.proto, DpMaster.outputs).
+  if (m_program_off) {
+    m_master.on_token(now, trr);
+    return;
+  }
   // The "PLC program": one output update per token receipt, i.e. per bus cycle.
   const auto value =
       static_cast<std::uint8_t>(m_program == scenario::DpMaster::COUNT ? (m_tokens & 0xFF) : 0);

@@ -20,6 +20,7 @@ const Command kCommands[] = {
     {"inspect", pbvbus::tools::cmd_inspect, "summarise a pcapng capture (frames, errors, gaps, events)"},
     {"timeline", pbvbus::tools::cmd_timeline, "draw a capture as an interactive HTML page or an SVG"},
     {"timing", pbvbus::tools::cmd_timing, "plan DP rotation and switchover times of a scenario"},
+    {"gateway", pbvbus::tools::cmd_gateway, "print a scenario's gateway maps (Modbus registers, CAN PDOs)"},
 };
 
 void usage(std::ostream& os) {

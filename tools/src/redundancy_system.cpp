@@ -37,6 +37,7 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
     }
   }
   m_program = plan.dp_masters.at(static_cast<std::size_t>(rp.master[0])).outputs;
+  m_program_off = plan.dp_masters.at(static_cast<std::size_t>(rp.master[0])).gateway_outputs;
   o.bus_params = params[0];
   o.bus_params_b = params[1];
   o.system.preferred = rp.preferred;
@@ -57,6 +58,7 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
   // The program: once for the system, at every token receipt of either master.
   m_model->set_cycle_hook([this](devices::RedundantMasterSystemModel& m, int, bus::Ticks) {
     ++m_cycles;
+    if (m_program_off) return;  // a gateway's clients own the outputs
     const auto value =
         static_cast<std::uint8_t>(m_program == scenario::DpMaster::COUNT ? (m_cycles & 0xFF) : 0);
     redundancy::MasterSystem& ms = m.system();

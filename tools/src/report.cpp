@@ -132,6 +132,7 @@ void write_text(const Report& r, std::ostream& os) {
   write_dp_slaves_text(r.dp_slaves, os);
   write_redundancy_text(r.redundancy, os);
   write_h_text(r.h_systems, os);
+  write_gateways_text(r.gateways, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -235,6 +236,7 @@ void write_json(const Report& r, std::ostream& os) {
   write_dp_slaves_json(r.dp_slaves, os);
   write_redundancy_json(r.redundancy, os);
   write_h_json(r.h_systems, os);
+  write_gateways_json(r.gateways, os);
   os << "}\n";
 }
 

@@ -188,6 +188,21 @@ class Planner {
       return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
     };
     plan_h(plan, locate, hlocate, m_errors);
+    const GwLocator glocate = [this](int index, const std::vector<HPathStep>& path) {
+      Where w = nested(m_root, scenario::Scenario::descriptor(), "gateway", index);
+      const pb::Descriptor* d = scenario::Gateway::descriptor();
+      for (std::size_t k = 0; k < path.size() && d != nullptr; ++k) {
+        const pb::FieldDescriptor* f = field_of(d, path[k].field);
+        if (k + 1 == path.size() && f->message_type() == nullptr) {
+          w = at_field(w, d, path[k].field, path[k].index);
+        } else {
+          w = nested(w, d, path[k].field, path[k].index);
+          d = f->message_type();
+        }
+      }
+      return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
+    };
+    plan_gateways(plan, glocate, m_errors);
     plan_stations(plan);
     plan_captures(plan);
     plan_faults(plan);

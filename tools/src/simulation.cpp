@@ -130,6 +130,7 @@ bus::PacedRunner& Simulation::paced_runner(bus::Speed speed) {
   for (auto& ls : m_lines)
     for (auto& s : ls->stations)
       if (s.pty) s.pty->attach_io(*m_runner);
+  for (auto& g : m_gateways) g->open(*m_runner);
   return *m_runner;
 }
 
@@ -305,7 +306,30 @@ void Simulation::start() {
   }
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
+  build_gateways();
   schedule_faults();
+}
+
+void Simulation::build_gateways() {
+  for (const GatewayPlan& gp : m_plan.gateways) {
+    dp::Master* master = nullptr;
+    devices::RedundantMasterSystemModel* system = nullptr;
+    const devices::HSystemModel* h = nullptr;
+    if (gp.dp_master >= 0) {
+      const DpMasterPlan& mp = m_plan.dp_masters.at(static_cast<std::size_t>(gp.dp_master));
+      if (DpMasterNode* n = dp_master(static_cast<std::size_t>(mp.line), mp.params.address))
+        master = &n->master();
+    } else if (gp.system >= 0) {
+      system = &m_redundant.at(static_cast<std::size_t>(gp.system))->model();
+      if (gp.h_system >= 0) {
+        const int source = m_plan.h_systems.at(static_cast<std::size_t>(gp.h_system)).source;
+        for (auto& node : m_h)
+          if (node->plan().source == source) h = &node->model();
+      }
+    }
+    m_gateways.push_back(std::make_unique<GatewayNode>(m_plan, gp, m_sched, master, system, h));
+    m_gateways.back()->start(m_sched.now());
+  }
 }
 
 void Simulation::schedule_faults() {
@@ -528,6 +552,7 @@ Report Simulation::report(double wall_seconds) const {
   }
   for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
   for (const auto& h : m_h) r.h_systems.push_back(h->report());
+  for (const auto& g : m_gateways) r.gateways.push_back(g->report());
   return r;
 }
 

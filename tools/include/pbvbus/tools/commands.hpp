@@ -16,5 +16,6 @@ int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timing(const Args& args, std::ostream& out, std::ostream& err);
+int cmd_gateway(const Args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace pbvbus::tools

@@ -122,6 +122,9 @@ struct DpMasterPlan {
   int line = -1;
   dp::MasterParams params;
   scenario::DpMaster::Outputs outputs = scenario::DpMaster::COUNT;
+  /// A gateway serves this master (system): no master-side test program, the gateway's
+  /// clients own the outputs (gateway_plan.hpp; set by plan_gateways).
+  bool gateway_outputs = false;
   std::vector<int> slaves;  ///< indices into ScenarioPlan::dp_slaves, in file order
 };
 

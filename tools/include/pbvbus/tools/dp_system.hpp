@@ -5,6 +5,7 @@
 // models on both sides so that data exchange is visible:
 //  - master side (DpMasterNode, "the test program"): at every token receipt it writes every
 //    output octet of every slave = the number of token receipts so far (mod 256), or zeros;
+//    nothing at all when a gateway serves the master (its clients own the outputs);
 //  - device side (DpSlaveNode): a devices::SlaveModel built from the GSD and module list, with
 //    one I/O behaviour per module that has inputs: COUNTER = a big-endian counter of the DP
 //    cycles over the module's input octets; ECHO = the module's own outputs, or, for an
@@ -60,6 +61,7 @@ class DpMasterNode final : public fdl::InitiatorUser {
  private:
   dp::Master m_master;
   scenario::DpMaster::Outputs m_program;
+  bool m_program_off = false;  ///< a gateway's clients own the outputs
   std::unique_ptr<fdl::ActiveStation> m_station;
   std::uint64_t m_tokens = 0;
   std::uint64_t m_global_controls = 0;

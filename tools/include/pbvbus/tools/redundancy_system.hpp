@@ -138,6 +138,7 @@ class RedundantSystemNode {
   captures::PcapngWriter* m_capture = nullptr;
   redundancy::SwitchoverPlan m_timing;
   scenario::DpMaster::Outputs m_program = scenario::DpMaster::COUNT;
+  bool m_program_off = false;  ///< a gateway's clients own the outputs
   std::uint64_t m_cycles = 0;
   std::vector<std::uint8_t> m_buf;
   struct Fault {

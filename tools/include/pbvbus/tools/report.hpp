@@ -119,7 +119,9 @@
 //       "updates": [ { "rack": int, "t1_*","t3_*","t4_*","t5_*", "completed": bool,
 //                      "t_p15_window_*","planned_t_p15_*", "t_p15_verdict": str,
 //                      "t_ph_window_*","planned_t_ph_*", "t_ph_verdict": str,
-//                      "last_io_before_*","first_io_after_*" } ] } ] }   // *_ns, *_ms; null
+//                      "last_io_before_*","first_io_after_*" } ] } ],   // *_ns, *_ms; null
+//     "gateways": [ ... ] }        // every gateway (issue 9): its doors' clients, requests,
+//                                  // exceptions and CAN frames; fields in gateway_report.hpp
 //
 // A DP slave's "requests" count each request that reached its DP layer once, from any master
 // (FCB repeats are answered by its FDL layer and counted under "fdl"."repeats"), so they match
@@ -147,6 +149,7 @@
 #include "pbvbus/devices/fdl_poller.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/dp_system.hpp"
+#include "pbvbus/tools/gateway_report.hpp"
 #include "pbvbus/tools/line_stats.hpp"
 #include "pbvbus/tools/h_report.hpp"
 #include "pbvbus/tools/redundancy_system.hpp"
@@ -234,6 +237,7 @@ struct Report {
   std::vector<DpSlaveView> dp_slaves;
   std::vector<RedundancyReport> redundancy;  ///< redundant master systems (issue 7)
   std::vector<HSystemReport> h_systems;      ///< simulated H-system CPU pairs (issue 8)
+  std::vector<GatewayReport> gateways;       ///< gateways (issue 9; gateway_report.hpp)
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

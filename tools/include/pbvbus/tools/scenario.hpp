@@ -40,6 +40,7 @@
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/dp_plan.hpp"
+#include "pbvbus/tools/gateway_plan.hpp"
 #include "pbvbus/tools/h_plan.hpp"
 #include "scenario.pb.h"
 
@@ -190,6 +191,7 @@ struct ScenarioPlan {
   std::vector<RedundancyPlan> redundant_systems;  ///< in file order
   std::vector<SwitchedPlan> switched;             ///< in file order, valid ones only
   std::vector<HSystemPlan> h_systems;  ///< h_system entries (update timing; runtime if simulated)
+  std::vector<GatewayPlan> gateways;   ///< gateway entries, in file order (gateway_plan.hpp)
 };
 
 struct LoadResult {

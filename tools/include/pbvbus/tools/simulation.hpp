@@ -19,6 +19,12 @@
 //    applied and are listed in the report.
 //  - A serial attachment's slot time (bus::PtyStation reply window and Interface timing) is
 //    the line's TSL, so it waits as long for a reply as the line's masters would.
+//  - Gateways (gateway_node.hpp) are external attachments too: a scenario with one runs paced.
+//    start() builds their cores after the h_systems (a source reads the H-system's model);
+//    paced_runner() opens their doors on the runner's io_context and throws
+//    std::runtime_error if one cannot open (a port in use). They are declared last, so they
+//    are destroyed first: before the H-systems, lines and redundant systems they read and
+//    before the runner whose io_context their doors use.
 
 #include <cstdint>
 #include <memory>
@@ -30,6 +36,7 @@
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/tools/capture_probes.hpp"
+#include "pbvbus/tools/gateway_node.hpp"
 #include "pbvbus/tools/h_system_node.hpp"
 #include "pbvbus/tools/redundancy_system.hpp"
 #include "pbvbus/tools/report.hpp"
@@ -89,15 +96,21 @@ class Simulation {
   HSystemNode& h_system(std::size_t i) { return *m_h.at(i); }
   const HSystemNode& h_system(std::size_t i) const { return *m_h.at(i); }
 
-  /// Whether something outside the process is attached (a pty): then the run must be paced.
-  bool has_external_attachments() const { return !m_serial.empty(); }
+  /// Whether something outside the process is attached (a pty, a gateway): then the run must
+  /// be paced.
+  bool has_external_attachments() const { return !m_serial.empty() || !m_plan.gateways.empty(); }
+  /// The gateways, in file order; built by start(), their doors opened by paced_runner().
+  std::size_t gateway_count() const { return m_gateways.size(); }
+  GatewayNode& gateway(std::size_t i) { return *m_gateways.at(i); }
+  const GatewayNode& gateway(std::size_t i) const { return *m_gateways.at(i); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
 
   /// Paced driver: creates the simulation's PacedRunner (once) and registers every pty
   /// attachment's I/O on its io_context. The Simulation owns the runner so that the order of
   /// tear-down is fixed: the doors (ptys) go first, then the runner and its io_context, then
   /// the scheduler — a door never cancels I/O on a dead io_context. Anything else registered
-  /// on runner.io_context() by the caller must be gone before the Simulation.
+  /// on runner.io_context() by the caller must be gone before the Simulation. Opens the
+  /// gateways' doors (start() first); throws std::runtime_error if a door cannot open.
   bus::PacedRunner& paced_runner(bus::Speed speed);
   /// Fast driver with ptys: reads what the programs wrote so far (call between slices).
   void poll_serial();
@@ -115,6 +128,7 @@ class Simulation {
   struct LineState;
   void build_line(std::size_t li);
   void schedule_faults();
+  void build_gateways();
   void apply_fault(const PlanFault& f, bool on);
   void apply_slave_fault(const PlanFault& f, bool on);
   void make_link(const std::string& target, const std::string& link);
@@ -133,6 +147,9 @@ class Simulation {
   std::vector<std::unique_ptr<LineState>> m_lines;
   // H-systems drive the redundant systems' models and schedule on m_sched: destroyed first.
   std::vector<std::unique_ptr<HSystemNode>> m_h;
+  // Gateways read the master systems (and H-systems) and use the runner's io_context:
+  // declared last, destroyed first.
+  std::vector<std::unique_ptr<GatewayNode>> m_gateways;
   std::vector<SerialReport> m_serial;
   std::vector<std::string> m_not_reached;
   std::vector<std::string> m_links;  ///< symlinks to ptys, removed at the end

@@ -165,6 +165,40 @@ void client(int id, int port, ClientResult& res, std::atomic<int>& done) {
   done.fetch_add(1);
 }
 
+// The wire check can fail: a hand-built Data_Exchange request (SD2) with one word from another
+// write counts as torn; the same telegram whole counts writer 1.
+//   68 23 23 68 | DA 04 SA 01 FC 5D (SRD_high, FCV=1 FCB=0: 0x40|0x10|0x0D) | 32 octets | FCS 16
+//   LE = 0x23 = 35 = 3 + 32. DU = 16 words 0x1001 (writer 1, sequence 1).
+//   FCS = (04 + 01 + 5D + 16 x (10 + 01)) mod 256 = (0x62 + 0x110) mod 256 = 0x172 mod 256 = 0x72;
+//   with word 5 = 0x2001: 0x62 + 15 x 0x11 + 0x21 = 0x62 + 0x120 = 0x182 -> 0x82.
+TEST(ModbusConsistency, WireCheckCountsATornTelegram) {
+  std::vector<std::uint8_t> f{0x68, 0x23, 0x23, 0x68, 0x04, 0x01, 0x5D};
+  for (int i = 0; i < kWords; ++i) {
+    f.push_back(0x10);
+    f.push_back(0x01);
+  }
+  f.push_back(0x72);
+  f.push_back(0x16);
+  OutputTelegramTap tap;
+  bus::TapFrame tf;
+  tf.bytes = f;
+  tap.on_frame(tf);
+  EXPECT_EQ(tap.telegrams, 1u);
+  EXPECT_EQ(tap.torn, 0u);
+  EXPECT_EQ(tap.writers, (std::set<int>{1}));
+  f[7 + 2 * 5] = 0x20;
+  f[7 + 2 * kWords] = 0x82;
+  tf.bytes = f;
+  tap.on_frame(tf);
+  EXPECT_EQ(tap.telegrams, 2u);
+  EXPECT_EQ(tap.torn, 1u);
+  // A Set_Prm-like frame (DA with the SAP bit, 0x84) is not a Data_Exchange request.
+  f[4] = 0x84;
+  tf.bytes = f;
+  tap.on_frame(tf);
+  EXPECT_EQ(tap.telegrams, 2u);
+}
+
 TEST(ModbusConsistency, FourClientsNeverSeeOrSendATornImage) {
   bus::Scheduler sched;
   bus::Line line{sched, "dp", kBaud};

@@ -202,7 +202,7 @@ void SocketcandSession::handle(std::string_view content, std::vector<std::string
 std::optional<std::string> SocketcandSession::frame_to_client(const CanFrame& f,
                                                               bus::Ticks now) const {
   if (m_mode != Mode::Raw) return std::nullopt;
-  return encode_frame(f, now) + ' ';
+  return ' ' + encode_frame(f, now);
 }
 
 }  // namespace pbvbus::gateways::socketcand

@@ -126,7 +126,7 @@ TEST(SocketcandDoor, HandshakeSendAndRawFrames) {
     write_all(fd, "< rawmode >");
     got.push_back(recv_once(fd));  // "< ok >"
     write_all(fd, "< send 205 2 aa bb >< send 18FF0001 1 7 >");
-    // The test's frame at virtual time 23.424242 s: "< frame 123 23.424242 42 > " (27 bytes).
+    // The test's frame at virtual time 23.424242 s: " < frame 123 23.424242 42 >" (27 bytes).
     got.push_back(read_n(fd, 27));
     ::close(fd);
   });
@@ -139,7 +139,7 @@ TEST(SocketcandDoor, HandshakeSendAndRawFrames) {
   EXPECT_TRUE(rig.run_until([&] { return door.stats().clients == 0; }));
   client.join();
   const std::vector<std::string> want{"< hi >", "< ok >", "< ok >",
-                                      "< frame 123 23.424242 42 > "};
+                                      " < frame 123 23.424242 42 >"};
   EXPECT_EQ(got, want);
   const auto s = door.stats();
   EXPECT_EQ(s.clients_total, 1u);
@@ -172,7 +172,7 @@ TEST(SocketcandDoor, FramesWaitForRawModeAndThenForTheClientToReadItsOk) {
     wait_step(3);                  // the test has queued a frame behind the `< ok >`
     got.push_back(recv_once(fd));  // still exactly "< ok >"
     write_all(fd, "< echo >");
-    // "< frame 181 0.000000 01 > " (26) then "< echo >" (8).
+    // " < frame 181 0.000000 01 >" (26) then "< echo >" (8).
     got.push_back(read_n(fd, 26 + 8));
     ::close(fd);
   });
@@ -186,7 +186,7 @@ TEST(SocketcandDoor, FramesWaitForRawModeAndThenForTheClientToReadItsOk) {
   EXPECT_TRUE(rig.run_until([&] { return door.stats().clients == 0; }));
   client.join();
   const std::vector<std::string> want{"< hi >", "< ok >", "< ok >",
-                                      "< frame 181 0.000000 01 > < echo >"};
+                                      " < frame 181 0.000000 01 >< echo >"};
   EXPECT_EQ(got, want);
   EXPECT_EQ(door.stats().frames_out, 1u);
 }

@@ -80,7 +80,7 @@ TEST(SocketcandSession, PythonCanHandshakeThenRawFrames) {
   EXPECT_FALSE(s.frame_to_client(frame(0x181, false, {1}), 0));  // BCM mode: no raw frames
   s.feed("< rawmode >", replies, bus);
   ASSERT_EQ(replies, (std::vector<std::string>{"< ok >", "< ok >"}));
-  EXPECT_EQ(s.frame_to_client(frame(0x181, false, {1}), 0), "< frame 181 0.000000 01 > ");
+  EXPECT_EQ(s.frame_to_client(frame(0x181, false, {1}), 0), " < frame 181 0.000000 01 >");
   // Split across feeds, two spaces for no data, plus an echo.
   s.feed("< send 205 2 aa", replies, bus);
   s.feed(" bb >< send 80 0  >\n< echo >", replies, bus);

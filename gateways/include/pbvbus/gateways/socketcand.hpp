@@ -25,10 +25,11 @@
 //    (`< ok >`). `< controlmode >`, `< statistics .. >`, `< isotpmode >` and the BCM commands
 //    (add update delete filter subscribe unsubscribe) → `< error ... not supported >`.
 //  - Pushed frames: `< frame ID SECS.USECS DATA >`, ID %03X / %08X, DATA upper-case hex without
-//    spaces, time = the frame's virtual time. Each is followed by ONE SPACE: python-can 4.1
+//    spaces, time = the frame's virtual time. Each is PRECEDED by ONE SPACE: python-can 4.1
 //    drops the character after the last complete element in its receive buffer (`[n + 1:]`), so
-//    without it a frame split over two recv() calls loses its '<' and is discarded by the
-//    client. Whitespace between elements is legal in the protocol.
+//    without a separator a frame split over two recv() calls loses its '<' and is discarded by
+//    the client; a space after the frame instead would be left over as "Bad data" (a warning
+//    on the client's stderr at every receive). Whitespace between elements is legal.
 //  - `< hi >` and every `< ok >` are sent exactly, alone (python-can compares one recv(256)
 //    with them); the door takes care not to coalesce frames with the rawmode `< ok >`.
 
@@ -77,7 +78,7 @@ struct Parsed {
 /// Parses an element's content, the text between '<' and '>'. Never throws.
 Parsed parse_element(std::string_view content);
 
-/// `< frame ID SECS.USECS DATA >` (without the trailing space the session adds).
+/// `< frame ID SECS.USECS DATA >` (without the leading space the session adds).
 std::string encode_frame(const CanFrame& f, bus::Ticks t);
 /// `< error TEXT >`.
 std::string encode_error(std::string_view text);
@@ -102,7 +103,7 @@ class SocketcandSession {
   void feed(std::string_view bytes, std::vector<std::string>& replies,
             std::vector<CanFrame>& to_bus);
   Mode mode() const { return m_mode; }
-  /// The text for a frame from the bus (with its trailing space), or nullopt unless raw mode.
+  /// The text for a frame from the bus (with its leading space), or nullopt unless raw mode.
   std::optional<std::string> frame_to_client(const CanFrame& f, bus::Ticks now) const;
   bool wants_close() const { return m_consecutive_errors >= kMaxConsecutiveErrors; }
   const Stats& stats() const { return m_stats; }

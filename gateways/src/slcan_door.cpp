@@ -176,6 +176,8 @@ SlcanDoor::Stats SlcanDoor::stats() const {
     s.dropped += l->dropped;
   }
   if (m_listener) s.clients_total = m_closed.clients_total + m_listener->accepted;
+  // The pty is one client for as long as the door has it (the report said "0 clients (1 now)").
+  if (m_pty_slave >= 0) ++s.clients_total;
   return s;
 }
 

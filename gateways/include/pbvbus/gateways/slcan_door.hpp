@@ -55,7 +55,7 @@ class SlcanDoor {
   using Options = SlcanDoorOptions;
   struct Stats {
     std::uint64_t clients = 0;         ///< connections now (the pty counts as one while open)
-    std::uint64_t clients_total = 0;   ///< TCP connections accepted so far
+    std::uint64_t clients_total = 0;   ///< TCP connections accepted so far, plus the pty if open
     std::uint64_t lines = 0;           ///< command lines handled
     std::uint64_t frames_in = 0;       ///< frames from clients onto the hub
     std::uint64_t frames_out = 0;      ///< frames queued to clients

@@ -16,8 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/bus/paced_runner.hpp"
-#include "pbvbus/bus/scheduler.hpp"
+#include "can_door_test_support.hpp"
 #include "pbvbus/gateways/slcan_door.hpp"
 #include "pbvbus/gateways/socketcan_door.hpp"
 #include "pbvbus/gateways/socketcand_door.hpp"
@@ -89,20 +88,15 @@ std::string python_can_missing() {
   return {};
 }
 
-struct Rig {
-  bus::Scheduler sched;
-  bus::PacedRunner runner{sched};
-  CanHub hub;
-  std::vector<CanFrame> seen;
-  CanHub::PortId me;
+/// The shared rig whose test port answers the client's frame 0x205 with `answer`.
+struct Rig : can_test::Rig {
   CanFrame answer;  // sent once the client's frame 0x205 has arrived
 
   explicit Rig(CanFrame reply) : answer(reply) {
-    me = hub.add_port("test", [this](const CanFrame& f, bus::Ticks now) {
-      seen.push_back(f);
+    on_frame = [this](const CanFrame& f, bus::Ticks now) {
       if (f.id == 0x205)  // reply on the bus's own time line, not from inside the delivery
         sched.schedule(now, [this] { hub.send(me, answer, sched.now()); });
-    });
+    };
   }
 
   /// Runs the bus until the child exits (or a generous bound); returns its output.
@@ -113,14 +107,7 @@ struct Rig {
   }
 };
 
-CanFrame frame(std::uint32_t id, bool ext, std::vector<std::uint8_t> data) {
-  CanFrame f;
-  f.id = id;
-  f.extended = ext;
-  f.dlc = static_cast<std::uint8_t>(data.size());
-  for (std::size_t i = 0; i < data.size(); ++i) f.data[i] = data[i];
-  return f;
-}
+using can_test::frame;
 
 // The client: sends 0x205 [AA BB] (standard) and 0x18FF0001 [01 02 03] (extended), then waits
 // (up to 10 s) for the frame with id 0x123 and prints it as "RX <id hex> <data hex>".

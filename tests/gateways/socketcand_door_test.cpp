@@ -3,51 +3,24 @@
 // hand from socketcand's doc/protocol.md and python-can 4.1's client (tools-and-formats.md §2.3).
 #include "pbvbus/gateways/socketcand_door.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <poll.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
-#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "pbvbus/bus/paced_runner.hpp"
-#include "pbvbus/bus/scheduler.hpp"
+#include "can_door_test_support.hpp"
 
 namespace pbvbus::gateways {
 namespace {
 
 using namespace std::chrono_literals;
-
-int connect_tcp(std::uint16_t port, int rcvbuf = 0) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (rcvbuf > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof rcvbuf);
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_port = htons(port);
-  sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-void write_all(int fd, const std::string& s) {
-  std::size_t done = 0;
-  while (done < s.size()) {
-    const ssize_t n = ::send(fd, s.data() + done, s.size() - done, MSG_NOSIGNAL);
-    if (n <= 0) return;
-    done += static_cast<std::size_t>(n);
-  }
-}
+using namespace can_test;  // frame(), connect_tcp, write_all, read_n, Rig
 
 /// One recv() of up to 256 bytes, as python-can reads `< hi >` and `< ok >` (waits up to a
 /// generous bound for something to arrive).
@@ -59,56 +32,11 @@ std::string recv_once(int fd) {
   return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : "(closed)";
 }
 
-/// Reads until `want` bytes arrived, EOF, or a generous bound.
-std::string read_n(int fd, std::size_t want, bool* eof = nullptr) {
-  std::string got;
-  const auto end = std::chrono::steady_clock::now() + 10s;
-  while (got.size() < want && std::chrono::steady_clock::now() < end) {
-    pollfd p{fd, POLLIN, 0};
-    if (::poll(&p, 1, 50) <= 0) continue;
-    char buf[512];
-    const ssize_t n = ::read(fd, buf, std::min(sizeof buf, want - got.size()));
-    if (n <= 0) {
-      if (eof) *eof = true;
-      break;
-    }
-    got.append(buf, static_cast<std::size_t>(n));
-  }
-  return got;
-}
-
-struct Rig {
-  bus::Scheduler sched;
-  bus::PacedRunner runner{sched};
-  CanHub hub;
-  std::vector<CanFrame> seen;
-  CanHub::PortId me =
-      hub.add_port("test", [this](const CanFrame& f, bus::Ticks) { seen.push_back(f); });
-
-  bool run_until(const std::function<bool()>& done, std::chrono::seconds limit = 10s) {
-    const auto end = std::chrono::steady_clock::now() + limit;
-    while (!done()) {
-      if (std::chrono::steady_clock::now() > end) return false;
-      runner.run_for(2 * bus::kTicksPerMs);
-    }
-    return true;
-  }
-};
-
 SocketcandDoor::Options ephemeral(std::chrono::milliseconds hold = 100ms) {
   SocketcandDoor::Options o;
   o.port = 0;
   o.raw_hold = hold;
   return o;
-}
-
-CanFrame frame(std::uint32_t id, bool ext, std::vector<std::uint8_t> data) {
-  CanFrame f;
-  f.id = id;
-  f.extended = ext;
-  f.dlc = static_cast<std::uint8_t>(data.size());
-  for (std::size_t i = 0; i < data.size(); ++i) f.data[i] = data[i];
-  return f;
 }
 
 TEST(SocketcandDoor, HandshakeSendAndRawFrames) {
@@ -221,30 +149,10 @@ TEST(SocketcandDoor, ClientThatNeverReadsCannotStallTheBus) {
   Rig rig;
   SocketcandDoor door(rig.runner, rig.hub, ephemeral(0ms));
   ASSERT_EQ(door.open(), "");
-  std::atomic<bool> release{false};
-  std::thread client([&] {
-    const int fd = connect_tcp(door.port(), 4096);
-    write_all(fd, "< open can0 >< rawmode >");
-    while (!release) std::this_thread::sleep_for(5ms);
-    ::close(fd);
-  });
+  can_test::StalledClient client(door.port(), "< open can0 >< rawmode >");
   EXPECT_TRUE(rig.run_until([&] { return door.stats().elements == 2; }));
-  int ticks = 0;
-  const bus::Ticks t0 = rig.sched.now();
-  const CanFrame f = frame(0x123, false, {1, 2, 3, 4, 5, 6, 7, 8});
-  std::function<void()> burst = [&] {
-    ++ticks;
-    for (int i = 0; i < 1000; ++i) rig.hub.send(rig.me, f, rig.sched.now());
-    if (ticks < 100) rig.sched.schedule(rig.sched.now() + bus::kTicksPerMs, burst);
-  };
-  rig.sched.schedule(t0 + bus::kTicksPerMs, burst);
-  rig.runner.run_for(100 * bus::kTicksPerMs);
-  EXPECT_EQ(ticks, 100);  // every burst ran on time: the stalled client delayed nothing
-  const auto s = door.stats();
-  EXPECT_EQ(s.frames_out + s.dropped, 100'000u);
-  EXPECT_GT(s.dropped, 0u);
-  release = true;
-  client.join();
+  can_test::expect_flood_absorbed(rig, door);  // the stalled client delays nothing
+  client.release();
 }
 
 TEST(SocketcandDoor, OpenReportsAPortInUseInsteadOfThrowing) {

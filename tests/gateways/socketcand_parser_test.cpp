@@ -8,17 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "can_door_test_support.hpp"
+
 namespace pbvbus::gateways::socketcand {
 namespace {
 
-CanFrame frame(std::uint32_t id, bool ext, std::vector<std::uint8_t> data) {
-  CanFrame f;
-  f.id = id;
-  f.extended = ext;
-  f.dlc = static_cast<std::uint8_t>(data.size());
-  for (std::size_t i = 0; i < data.size(); ++i) f.data[i] = data[i];
-  return f;
-}
+using can_test::frame;
 
 TEST(SocketcandParse, SendAsPythonCanWritesIt) {
   // python-can: f"< send {id:X} {dlc:X} {' '.join('{:x}')} >".

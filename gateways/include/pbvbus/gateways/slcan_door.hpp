@@ -82,17 +82,14 @@ class SlcanDoor {
   Stats stats() const;
 
  private:
-  struct Link;
-  struct Listener;
+  struct Link;      // a connection (door_stream::Stream) with its SLCAN session
+  struct Listener;  // door_stream::TcpListener
 
   std::shared_ptr<Link> add_link(int fd, bool is_socket, std::string name);
-  void start_read(const std::shared_ptr<Link>& l);
   void on_bytes(Link& l, const std::string& bytes, bus::Ticks now);
   void on_hub_frame(Link& l, const CanFrame& f, bus::Ticks now);
   void emit(Link& l, std::string_view s, bool frame);
-  void flush(Link& l);
   void drop_link(Link& l);
-  void start_accept();
 
   bus::PacedRunner& m_runner;
   CanHub& m_hub;
@@ -103,7 +100,6 @@ class SlcanDoor {
   std::unique_ptr<Listener> m_listener;
   std::map<std::uint64_t, std::shared_ptr<Link>> m_links;
   std::uint64_t m_next_link = 0;
-  std::shared_ptr<bool> m_alive = std::make_shared<bool>(true);
   Stats m_closed;  // counters of connections already gone
 };
 

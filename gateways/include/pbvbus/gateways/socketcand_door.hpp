@@ -75,16 +75,14 @@ class SocketcandDoor {
   Stats stats() const;
 
  private:
-  struct Link;
-  struct Listener;
+  struct Link;      // a connection (door_stream::Stream) with its socketcand session
+  struct Listener;  // door_stream::TcpListener
 
-  void start_accept();
-  void start_read(const std::shared_ptr<Link>& l);
   void on_bytes(Link& l, const std::string& bytes, bus::Ticks now);
   void on_hub_frame(Link& l, const CanFrame& f, bus::Ticks now);
   void emit(Link& l, std::string_view s, bool frame);
-  void flush(Link& l);
   void release_hold(Link& l);
+  void add_link(int fd, std::uint64_t n);
   void drop_link(Link& l);
 
   bus::PacedRunner& m_runner;
@@ -94,7 +92,6 @@ class SocketcandDoor {
   std::unique_ptr<Listener> m_listener;
   std::map<std::uint64_t, std::shared_ptr<Link>> m_links;
   std::uint64_t m_next_link = 0;
-  std::shared_ptr<bool> m_alive = std::make_shared<bool>(true);
   Stats m_closed;  // counters of connections already gone
 };
 

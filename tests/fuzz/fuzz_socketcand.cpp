@@ -52,6 +52,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const std::string& r : replies) check_element(r);
   if (to_bus.size() != s.stats().frames_in) __builtin_trap();
   for (const CanFrame& f : to_bus) check_frame(f);
-  if (auto t = s.frame_to_client(CanFrame{}, 0)) check_element(t->substr(0, t->size() - 1));
+  // A pushed frame is one space, then the element (python-can 4.1 eats that character).
+  if (auto t = s.frame_to_client(CanFrame{}, 0)) {
+    if (t->empty() || (*t)[0] != ' ') __builtin_trap();
+    check_element(t->substr(1));
+  }
   return 0;
 }

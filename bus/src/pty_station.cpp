@@ -1,5 +1,7 @@
 #include "pbvbus/bus/pty_station.hpp"
 
+#include "pbvbus/bus/pty.hpp"
+
 #include <fcntl.h>
 #include <poll.h>
 #include <termios.h>
@@ -97,29 +99,10 @@ struct PtyStation::Io {
 PtyStation::PtyStation(Options options) : m_opt(options) {
   if (m_opt.mode == Mode::Station && (m_opt.address < 0 || m_opt.address > 126))
     throw std::invalid_argument("pty station: an FDL address 0..126 is needed in station mode");
-  m_master = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (m_master < 0) throw_errno("posix_openpt");
-  try {
-    if (::grantpt(m_master) != 0) throw_errno("grantpt");
-    if (::unlockpt(m_master) != 0) throw_errno("unlockpt");
-    char name[128];
-    if (::ptsname_r(m_master, name, sizeof name) != 0) throw_errno("ptsname_r");
-    m_path = name;
-    m_slave = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
-    if (m_slave < 0) throw_errno("open pty slave");
-    termios tio{};
-    if (::tcgetattr(m_slave, &tio) != 0) throw_errno("tcgetattr");
-    ::cfmakeraw(&tio);  // 8 bits, no echo, no line editing, no CR/LF mapping
-    tio.c_cc[VMIN] = 1;
-    tio.c_cc[VTIME] = 0;
-    if (::tcsetattr(m_slave, TCSANOW, &tio) != 0) throw_errno("tcsetattr");
-    const int fl = ::fcntl(m_master, F_GETFL);
-    if (fl < 0 || ::fcntl(m_master, F_SETFL, fl | O_NONBLOCK) != 0) throw_errno("fcntl O_NONBLOCK");
-  } catch (...) {
-    if (m_slave >= 0) ::close(m_slave);
-    ::close(m_master);
-    throw;
-  }
+  const Pty pty = open_pty();
+  m_master = pty.master;
+  m_slave = pty.slave;
+  m_path = pty.path;
   m_out.reserve(4096);
 }
 

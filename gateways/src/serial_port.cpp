@@ -1,5 +1,7 @@
 #include "pbvbus/gateways/serial_port.hpp"
 
+#include "pbvbus/bus/pty.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <termios.h>
@@ -71,11 +73,6 @@ void make_raw(int fd, const SerialSettings* s, const std::string& what) {
   if (::tcsetattr(fd, TCSANOW, &t) != 0) throw_errno("tcsetattr " + what);
 }
 
-void set_nonblocking(int fd) {
-  const int fl = ::fcntl(fd, F_GETFL);
-  if (fl < 0 || ::fcntl(fd, F_SETFL, fl | O_NONBLOCK) != 0) throw_errno("fcntl O_NONBLOCK");
-}
-
 }  // namespace
 
 bool parse_serial_format(std::string_view fmt, SerialSettings& s) {
@@ -123,31 +120,16 @@ SerialPort::SerialPort(boost::asio::io_context& io, int fd, int slave, std::stri
 }
 
 std::unique_ptr<SerialPort> SerialPort::open_pty(boost::asio::io_context& io, std::string link) {
-  const int m = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (m < 0) throw_errno("posix_openpt");
-  int slave = -1;
-  std::string path;
-  try {
-    if (::grantpt(m) != 0) throw_errno("grantpt");
-    if (::unlockpt(m) != 0) throw_errno("unlockpt");
-    char name[128];
-    if (::ptsname_r(m, name, sizeof name) != 0) throw_errno("ptsname_r");
-    path = name;
-    slave = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
-    if (slave < 0) throw_errno("open pty slave " + path);
-    make_raw(slave, nullptr, path);
-    set_nonblocking(m);
-    if (!link.empty()) {
-      struct stat st {};
-      if (::lstat(link.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) ::unlink(link.c_str());
-      if (::symlink(name, link.c_str()) != 0) throw_errno("symlink " + link);
+  const bus::Pty pty = bus::open_pty();
+  if (!link.empty()) {
+    const std::string e = bus::make_pty_link(pty.path, link);
+    if (!e.empty()) {
+      ::close(pty.slave);
+      ::close(pty.master);
+      throw std::runtime_error(e);
     }
-  } catch (...) {
-    if (slave >= 0) ::close(slave);
-    ::close(m);
-    throw;
   }
-  return std::unique_ptr<SerialPort>(new SerialPort(io, m, slave, path, link));
+  return std::unique_ptr<SerialPort>(new SerialPort(io, pty.master, pty.slave, pty.path, link));
 }
 
 std::unique_ptr<SerialPort> SerialPort::open_device(boost::asio::io_context& io, std::string path,

@@ -1,5 +1,7 @@
 #include "pbvbus/gateways/slcan_door.hpp"
 
+#include "pbvbus/bus/pty.hpp"
+
 #include <fcntl.h>
 #include <termios.h>
 #include <unistd.h>
@@ -39,38 +41,23 @@ SlcanDoor::~SlcanDoor() { close(); }
 std::string SlcanDoor::open() {
   if (!m_links.empty() || m_listener) return "slcan door: already open";
   if (m_opt.pty) {
-    const int master = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-    if (master < 0) return errno_text("posix_openpt");
-    char name[128];
-    if (::grantpt(master) != 0 || ::unlockpt(master) != 0 ||
-        ::ptsname_r(master, name, sizeof name) != 0) {
-      const std::string e = errno_text("pty setup");
-      ::close(master);
-      return e;
+    // The slave side stays open (no EIO while no client holds it) and raw: SLCAN lines end in
+    // '\r', which must not be mapped.
+    bus::Pty pty;
+    try {
+      pty = bus::open_pty();
+    } catch (const std::system_error& e) {
+      return std::string("slcan door: ") + e.what();
     }
-    // Keep the slave side open ourselves (no EIO while no client holds it) and make it raw:
-    // no echo, no CR/LF mapping — SLCAN lines end in '\r'.
-    m_pty_slave = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
-    termios tio{};
-    if (m_pty_slave < 0 || ::tcgetattr(m_pty_slave, &tio) != 0) {
-      const std::string e = errno_text("open pty slave");
-      if (m_pty_slave >= 0) ::close(m_pty_slave);
-      m_pty_slave = -1;
-      ::close(master);
-      return e;
-    }
-    ::cfmakeraw(&tio);
-    ::tcsetattr(m_pty_slave, TCSANOW, &tio);
-    const int fl = ::fcntl(master, F_GETFL);
-    ::fcntl(master, F_SETFL, fl | O_NONBLOCK);
-    m_pty_path = name;
+    const int master = pty.master;
+    m_pty_slave = pty.slave;
+    m_pty_path = pty.path;
     if (!m_opt.pty_link.empty()) {
-      ::unlink(m_opt.pty_link.c_str());
-      if (::symlink(name, m_opt.pty_link.c_str()) != 0) {
-        const std::string e = errno_text(("symlink " + m_opt.pty_link).c_str());
+      const std::string e = bus::make_pty_link(pty.path, m_opt.pty_link);
+      if (!e.empty()) {
         ::close(master);
         close();
-        return e;
+        return "slcan door: " + e;
       }
     }
     door_stream::start_read(add_link(master, false, m_opt.name + ":pty"), m_runner);

@@ -1,5 +1,7 @@
 #include "pbvbus/tools/simulation.hpp"
 
+#include "pbvbus/bus/pty.hpp"
+
 #include <algorithm>
 #include <array>
 #include <stdexcept>
@@ -109,15 +111,8 @@ Simulation::~Simulation() {
 }
 
 void Simulation::make_link(const std::string& target, const std::string& link) {
-  // Replace a stale link from an earlier run, but never a file that is not a symlink.
-  struct stat st;
-  if (::lstat(link.c_str(), &st) == 0) {
-    if (!S_ISLNK(st.st_mode))
-      throw std::runtime_error("cannot link the pty to " + link + ": a file of that name exists");
-    ::unlink(link.c_str());
-  }
-  if (::symlink(target.c_str(), link.c_str()) != 0)
-    throw std::runtime_error("cannot link the pty to " + link + ": " + std::strerror(errno));
+  const std::string e = bus::make_pty_link(target, link);
+  if (!e.empty()) throw std::runtime_error(e);
   m_links.push_back(link);
 }
 

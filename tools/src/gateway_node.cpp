@@ -60,6 +60,15 @@ gateways::CanopenOptions can_options(const GwCan& c) {
   return o;
 }
 
+/// The frame counters every CAN door's stats have (SlcanDoor, SocketcandDoor, SocketcanDoor).
+template <class Stats>
+void can_door_counts(GatewayDoorReport& d, const Stats& s) {
+  d.frames_in = s.frames_in;
+  d.frames_out = s.frames_out;
+  d.errors = s.errors;
+  d.dropped = s.dropped;
+}
+
 }  // namespace
 
 GatewayNode::GatewayNode(const ScenarioPlan& plan, const GatewayPlan& gp, bus::Scheduler& sched,
@@ -262,10 +271,7 @@ GatewayReport GatewayNode::report() const {
     const auto s = m_slcan->stats();
     d.clients = s.clients;
     d.clients_total = s.clients_total;
-    d.frames_in = s.frames_in;
-    d.frames_out = s.frames_out;
-    d.errors = s.errors;
-    d.dropped = s.dropped;
+    can_door_counts(d, s);
     r.doors.push_back(std::move(d));
   }
   if (m_socketcand) {
@@ -276,10 +282,7 @@ GatewayReport GatewayNode::report() const {
     d.clients = s.clients;
     d.clients_total = s.clients_total;
     d.clients_closed_bad = s.closed_bad;
-    d.frames_in = s.frames_in;
-    d.frames_out = s.frames_out;
-    d.errors = s.errors;
-    d.dropped = s.dropped;
+    can_door_counts(d, s);
     r.doors.push_back(std::move(d));
   }
   if (m_socketcan) {
@@ -288,10 +291,7 @@ GatewayReport GatewayNode::report() const {
     d.where = *m_plan.can->socketcan;
     d.error = m_socketcan_error;
     const auto& s = m_socketcan->stats();
-    d.frames_in = s.frames_in;
-    d.frames_out = s.frames_out;
-    d.errors = s.errors;
-    d.dropped = s.dropped;
+    can_door_counts(d, s);
     r.doors.push_back(std::move(d));
   }
   return r;

@@ -1,0 +1,7 @@
+#include "groups.hpp"
+
+namespace pbvbus::conformance::detail {
+
+void add_read_service_tests(std::vector<TestCase>& /*out*/) {}
+
+}  // namespace pbvbus::conformance::detail

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "pbvbus/dp/diagnosis.hpp"
+#include "pbvbus/dp/prm.hpp"
 #include "pbvbus/dp/sap.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -117,6 +118,47 @@ std::string expect_sc(const Reply& r) {
 
 std::string expect_rs(const Reply& r) {
   return r.rs() ? std::string{} : "expected RS, got " + r.describe();
+}
+
+std::string check_diag(const Reply& r, const DiagExpect& e) {
+  if (!r.ok_with_data() || r.data.size() < 6)
+    return "expected Slave_Diag data (6+ octets), got " + r.describe();
+  const auto& d = r.data;
+  std::string why;
+  if ((d[0] & e.s1_mask) != e.s1) why += "Station_Status_1 bits " + hex(std::span(d).first(1));
+  if ((d[1] & e.s2_mask) != e.s2) why += (why.empty() ? "" : ", ") + std::string("Station_Status_2");
+  if (e.master && d[3] != *e.master) why += (why.empty() ? "" : ", ") + std::string("Master_Add");
+  if (e.ident && (d[4] != (*e.ident >> 8) || d[5] != (*e.ident & 0xFF)))
+    why += (why.empty() ? "" : ", ") + std::string("Ident_Number");
+  if (why.empty()) return {};
+  return "diag " + hex(d) + ": wrong " + why;
+}
+
+std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expected) {
+  if (!r.ok_with_data() || r.data.size() < 6)
+    return "expected Slave_Diag " + hex(expected) + ", got " + r.describe();
+  std::vector<std::uint8_t> got(r.data.begin(), r.data.begin() + 6);
+  std::vector<std::uint8_t> want(expected.begin(), expected.end());
+  if (r.data.size() > 6) {
+    got[0] &= static_cast<std::uint8_t>(~dp::kDiagExtDiag);
+    want[0] &= static_cast<std::uint8_t>(~dp::kDiagExtDiag);
+    got[2] &= 0x7F;
+    want[2] &= 0x7F;
+  }
+  if (got != want) return "expected diag " + hex(expected) + ", got " + hex(r.data);
+  return {};
+}
+
+std::unique_ptr<Session> open_session(TestContext& ctx, TestResult& r, std::optional<bus::Baud> baud) {
+  std::string err;
+  auto s = ctx.open(baud, err);
+  if (!s) fail(r, "cannot open a session: " + err);
+  return s;
+}
+
+bus::Ticks watchdog_time(const dp::SlaveParams& p) {
+  const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
+  return dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
 }
 
 void fail(TestResult& r, const std::string& why) {

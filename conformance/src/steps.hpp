@@ -14,6 +14,7 @@
 //   what went wrong, in words with the bytes.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -77,6 +78,28 @@ std::string expect_data(const Reply& r, std::span<const std::uint8_t> expected, 
 std::string expect_sc(const Reply& r);
 /// "" if `r` is RS, else what came.
 std::string expect_rs(const Reply& r);
+
+/// What a test expects of the 6 standard diagnosis octets (§D.4): the bits under each mask must
+/// equal the value; Master_Add and the ident are compared when set.
+struct DiagExpect {
+  std::uint8_t s1_mask = 0, s1 = 0;
+  std::uint8_t s2_mask = 0, s2 = 0;
+  std::optional<std::uint8_t> master;
+  std::optional<std::uint16_t> ident;
+};
+/// "" if `r` is diagnosis data meeting `e`, else what came (the octets in hex).
+std::string check_diag(const Reply& r, const DiagExpect& e);
+/// "" if `r` is exactly the 6 octets `expected` — where the reply is longer (extended
+/// diagnosis blocks follow) the Ext_Diag bit (octet 1 bit 3) and Ext_Diag_Overflow (octet 3
+/// bit 7) are not compared, the other 46 bits are.
+std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expected);
+
+/// Opens a session (main baud unless given); on failure fails `r` and returns nullptr.
+std::unique_ptr<Session> open_session(TestContext& ctx, TestResult& r,
+                                      std::optional<bus::Baud> baud = std::nullopt);
+/// The watchdog time of `p` (TWD = WD_Fact_1 × WD_Fact_2 × 10 ms, or × 1 ms with WD_Base_1ms in
+/// DPV1_Status_1 of a DP-V1 Set_Prm), in ticks.
+bus::Ticks watchdog_time(const dp::SlaveParams& p);
 
 /// Result helpers: set verdict + message (keep the first failure's message).
 void fail(TestResult& r, const std::string& why);

@@ -124,11 +124,14 @@ std::string load_gsd_file(const std::string& path, std::shared_ptr<const devices
 /// The shipped examples folder (the one the default scenario names), with a trailing '/'.
 std::string examples_dir() {
   const std::string_view t = default_scenario_text();
-  const std::string key = "/gsd/PBVB0A";
+  // Its dp_slave entries read `gsd: "<examples>/gsd/PBVB0A10.gsd"`.
+  const std::string_view key = "gsd: \"";
   const auto at = t.find(key);
   if (at != std::string_view::npos) {
-    const auto q = t.rfind('"', at);
-    if (q != std::string_view::npos) return std::string(t.substr(q + 1, at - q - 1)) + "/";
+    const auto from = at + key.size();
+    const auto end = t.find("/gsd/", from);
+    const auto quote = t.find('"', from);
+    if (end != std::string_view::npos && end < quote) return std::string(t.substr(from, end - from)) + "/";
   }
   return "examples/";
 }

@@ -68,9 +68,11 @@ Decisions (a program behind a pty has no virtual clock):
     fixed FDL address: after taking a new address the program would hear nothing addressed to
     it. It refuses Set_Slave_Add (RS); `--set-slave-add accept` takes the new address anyway
     (to see what the battery makes of that).
-  - Garbage on the line (octets that cannot start a telegram, a bad FCS, a wrong length) is
-    dropped and counted, the splitter resynchronises on the next octet; an incomplete telegram
-    whose rest does not come within --resync seconds is dropped. The program never exits on
+  - Garbage on the line (octets that cannot start a telegram, a bad FCS or end delimiter, LE
+    and LEr that differ) is dropped and counted: the splitter drops ONE octet and looks for a
+    telegram again from the next one, so a stray start delimiter cannot swallow a request; an
+    incomplete telegram whose rest does not come within --resync seconds loses its first octet
+    the same way. The program never exits on
     bad input; it ends on SIGINT/SIGTERM, after --max-time seconds, or when the pty's other
     side is gone, and then prints a summary (JSON) on stdout.
   - Opening the port: pending input is flushed (requests written before the program was
@@ -269,20 +271,27 @@ class Telegram:
     __slots__ = ("da", "sa", "fc", "dsap", "ssap", "data")
 
 
-def decode(frame):
-    """A request telegram, or an error string (a receiver's checks, §B)."""
+def frame_error(frame):
+    """The framing checks of a receiver (§B.1): "" if the octets are one intact telegram."""
     sd = frame[0]
     if sd in (SC, SD4):
-        return "not a request"  # acknowledgement or token: no business of a slave
+        return ""
     body = frame[4:-2] if sd == SD2 else frame[1:-2]
     if frame[-1] != ED:
         return "end delimiter"
     if sum(body) & 0xFF != frame[-2]:
         return "FCS"
-    if sd == SD1 and len(body) != 3 or sd == SD3 and len(body) != 11 or len(body) < 3:
-        return "length"
     if sd == SD2 and len(body) < 4:
         return "LE below 4"
+    return ""
+
+
+def decode(frame):
+    """A request telegram from an intact frame, or why it is none for a slave (§B)."""
+    sd = frame[0]
+    if sd in (SC, SD4):
+        return "not a request"  # acknowledgement or token: no business of a slave
+    body = frame[4:-2] if sd == SD2 else frame[1:-2]
     t = Telegram()
     da, sa, fc = body[0], body[1], body[2]
     t.da, t.sa, t.fc = da & 0x7F, sa & 0x7F, fc
@@ -817,6 +826,14 @@ def main():
                     first_at = now
                 break
             frame = bytes(buf[:n_len])
+            why = frame_error(frame)
+            if why:
+                # Not a telegram after all: drop its first octet only and look again, so a
+                # request that a stray start delimiter swallowed is still found.
+                station.counts["bad_telegrams"] += 1
+                log(f"dropped ({why}): {frame.hex(' ')}")
+                del buf[0]
+                continue
             del buf[:n_len]
             first_at = None
             log(f"rx {frame.hex(' ')}")

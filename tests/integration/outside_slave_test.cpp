@@ -5,15 +5,15 @@
 // and runs paced, the program opens the pty's symlink.
 //
 // Decisions:
-// - Baud and speed: 9.6 kbit/s at --speed 1/4. Two limits meet here. (1) The battery bounds
-//   every paced wait by TestBusOptions::paced_wait_limit (5 s of wall time), and its longest
-//   deliberate wait is the watchdog tests' TWD + 1 % = 1.01 s of virtual time (TWD = 10 x 10 x
-//   10 ms from the GSD defaults): the speed must be at least 1/4 or those waits are cut short.
-//   (2) At 1/4 only a slow baud leaves a program behind a pty room to answer: at 9.6 kbit/s
-//   min TSDR (11 bit times) is 4.6 ms of wall time, max TSDR (the GSD's 60) 25 ms and the slot
-//   time (100) 42 ms; at 1.5 Mbit/s the same 25 ms of wall time would need 1/2000, and then the
-//   watchdog tests could not run at all. The program waits min TSDR (scaled) before it writes
-//   a reply; the pty, Python and the scheduler must add less than ~20 ms.
+// - Baud and speed: 9.6 kbit/s at --speed 1/20. The program's reply must start within [min
+//   TSDR, max TSDR] = [11, 60] bit times (PBVB0A01 at 9.6k) and the tester waits the slot time
+//   TSL = 100 bit times: at 1/20 that is 23 ms, 125 ms and 208 ms of wall time, room for the
+//   pty, Python and a busy scheduler. Faster was tried: at 1/4 (TSL 42 ms of wall time) a machine
+//   with a load average of 10 on 2 cores made the program miss the slot time now and then. At
+//   1.5 Mbit/s the same wall times need 1/1000, and then every test's reset (10 ms of virtual
+//   idle, cut by the battery's 5 s bound of wall time per wait) costs 5 s: 116 s for 17 tests,
+//   against ~45 s for these 19 at 9.6k and 1/20. A run that misses replies only is repeated
+//   once (run_checked(); a real fault of the program fails both runs).
 // - Which tests: the battery's tests of the groups that exist (Start-up, Set_Prm, Chk_Cfg, Read
 //   services, FCB/FCV), without those whose verdict is not meaningful for this DUT:
 //   PRM-06/07/08 (the battery itself marks them timing_not_meaningful: watchdog expiry checked
@@ -22,7 +22,7 @@
 //   a fresh FDL state a model gets for every test and a program does not (the FCB state of the
 //   tester's address is what the previous FCB test left). FCB-01 comes first in a fresh program
 //   and is deterministic. See docs/outside-slave.md for the measured reasons.
-// - The run is the built `pbvbus conformance --pty PATH --speed 1/4 --baud 9.6k --json --junit`
+// - The run is the built `pbvbus conformance --pty PATH --speed 1/20 --baud 9.6k --json --junit`
 //   (skipped when bin/pbvbus is not built); the Python program is a child process started
 //   first (it waits for the symlink the battery makes) and ended with SIGTERM afterwards (it
 //   prints a JSON summary). The JSON report and the JUnit file are checked. Wall-clock bounds are
@@ -45,6 +45,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -65,6 +66,8 @@ constexpr const char* kPython = "/usr/bin/python3";
 const std::string kSlave = PBVBUS_SOURCE_DIR "/tests/integration/outside_slave.py";
 const std::string kGsd = PBVBUS_SOURCE_DIR "/examples/gsd/PBVB0A01.gsd";
 constexpr std::uint8_t kDut = 5;  // the slave's FDL address; the tester is 1 (TestBusOptions)
+constexpr const char* kSpeed = "1/20";
+constexpr const char* kBaud = "9.6k";
 
 /// The tests run against the program (see the header comment for those left out).
 const std::vector<std::string> kMeaningful = {
@@ -213,8 +216,8 @@ BatteryRun run_against_python(const std::string& name, const std::vector<std::st
                            std::to_string(::getpid());
   const std::string link = base + ".dut";
   std::vector<std::string> args = {kPython,    kSlave,   "--port",  link, "--address",
-                                   std::to_string(kDut), "--speed", "1/4", "--baud",
-                                   "9.6k",     "--gsd",  kGsd,      "--max-time", "600"};
+                                   std::to_string(kDut), "--speed", kSpeed, "--baud",
+                                   kBaud,      "--gsd",  kGsd,      "--max-time", "900"};
   args.insert(args.end(), extra.begin(), extra.end());
   Child slave = Child::spawn(args, base + ".slave");
   if (slave.pid <= 0) {
@@ -223,7 +226,7 @@ BatteryRun run_against_python(const std::string& name, const std::vector<std::st
   }
   r.junit_file = base + ".junit.xml";
   std::vector<std::string> cargs = {kBinary, "conformance", "--gsd", kGsd, "--address", std::to_string(kDut),
-                                    "--pty", link, "--speed", "1/4", "--baud", "9.6k",
+                                    "--pty", link, "--speed", kSpeed, "--baud", kBaud,
                                     "--junit", r.junit_file, "--json"};
   for (const auto& o : kMeaningful) {
     cargs.push_back("--only");
@@ -234,7 +237,7 @@ BatteryRun run_against_python(const std::string& name, const std::vector<std::st
     ADD_FAILURE() << "cannot start " << kBinary;
     return r;
   }
-  r.rc = battery.wait(600s);
+  r.rc = battery.wait(900s);
   r.slave_rc = slave.stop();
   r.report = flatten(battery.out_file);
   r.err = read_file(battery.err_file);
@@ -242,6 +245,36 @@ BatteryRun run_against_python(const std::string& name, const std::vector<std::st
   r.slave_err = read_file(slave.err_file);
   for (const auto& f : {battery.out_file, battery.err_file, slave.out_file, slave.err_file})
     std::remove(f.c_str());
+  return r;
+}
+
+/// Whether the run differs from `want` only by tests that failed for lack of a reply: a reply
+/// later than the slot time in wall time, which a loaded machine causes now and then (the
+/// program behind the pty was not scheduled in time; the slot time is 208 ms of wall time).
+bool only_missed_replies(const Flat& rep, const std::map<std::string, std::string>& want) {
+  bool any = false;
+  for (int i = 0; rep.count("tests." + std::to_string(i) + ".id"); ++i) {
+    const std::string t = "tests." + std::to_string(i) + ".";
+    const auto w = want.find(get(rep, t + "id"));
+    if (w != want.end() && w->second == get(rep, t + "verdict")) continue;
+    if (get(rep, t + "verdict") != "fail" || get(rep, t + "message").find("no reply") == std::string::npos)
+      return false;
+    any = true;
+  }
+  return any;
+}
+
+/// run_against_python(), once more when the first run missed replies only (see above); a real
+/// fault of the program shows in both runs. The retry is recorded as a test property.
+BatteryRun run_checked(const std::string& name, const std::vector<std::string>& extra,
+                       const std::map<std::string, std::string>& want) {
+  BatteryRun r = run_against_python(name, extra);
+  if (only_missed_replies(r.report, want)) {
+    std::cout << "[ retry    ] missed replies only (a loaded machine?): running again\n";
+    ::testing::Test::RecordProperty("retried_after_missed_replies", "1");
+    std::remove(r.junit_file.c_str());
+    r = run_against_python(name + "_retry", extra);
+  }
   return r;
 }
 
@@ -313,8 +346,8 @@ const std::map<std::string, std::string> kHonest = {
 void expect_verdicts(const Flat& rep, const std::map<std::string, std::string>& want) {
   EXPECT_EQ(get(rep, "dut_error"), "");
   EXPECT_EQ(get(rep, "dut.kind"), "pty");
-  EXPECT_EQ(get(rep, "dut.speed"), "1/4");
-  EXPECT_EQ(get(rep, "dut.baud"), "9.6k");
+  EXPECT_EQ(get(rep, "dut.speed"), kSpeed);
+  EXPECT_EQ(get(rep, "dut.baud"), kBaud);
   EXPECT_NE(get(rep, "timing_note"), "");  // a pty DUT: the report says why timing means little
   std::set<std::string> seen;
   for (int i = 0; rep.count("tests." + std::to_string(i) + ".id"); ++i) {
@@ -363,7 +396,7 @@ std::string missing_binary() {
 TEST(OutsideSlave, HonestPythonSlavePassesTheBatteryBehindAPty) {
   if (const auto why = missing_python(); !why.empty()) GTEST_SKIP() << why;
   if (const auto why = missing_binary(); !why.empty()) GTEST_SKIP() << why;
-  const BatteryRun r = run_against_python("honest", {});
+  const BatteryRun r = run_checked("honest", {}, kHonest);
   EXPECT_EQ(r.rc, 0) << r.err << verdicts(r.report);
   expect_verdicts(r.report, kHonest);
   EXPECT_EQ(get(r.report, "passed"), "true");
@@ -384,10 +417,10 @@ TEST(OutsideSlave, HonestPythonSlavePassesTheBatteryBehindAPty) {
 TEST(OutsideSlave, PythonSlaveAcceptingAWrongIdentIsCaughtByPrm01) {
   if (const auto why = missing_python(); !why.empty()) GTEST_SKIP() << why;
   if (const auto why = missing_binary(); !why.empty()) GTEST_SKIP() << why;
-  const BatteryRun r = run_against_python("break_ident", {"--break", "ident"});
-  EXPECT_EQ(r.rc, 1) << r.err << verdicts(r.report);
   std::map<std::string, std::string> want = kHonest;
   want["PRM-01"] = "fail";  // exactly the broken rule, everything else as before
+  const BatteryRun r = run_checked("break_ident", {"--break", "ident"}, want);
+  EXPECT_EQ(r.rc, 1) << r.err << verdicts(r.report);
   expect_verdicts(r.report, want);
   EXPECT_EQ(get(r.report, "passed"), "false");
   EXPECT_EQ(get(r.report, "totals.fail"), "1");

@@ -210,7 +210,8 @@ struct BatteryRun {
 };
 
 /// `pbvbus conformance --pty` (kMeaningful) against the Python slave with `extra` options.
-BatteryRun run_against_python(const std::string& name, const std::vector<std::string>& extra) {
+BatteryRun run_against_python(const std::string& name, const std::vector<std::string>& extra,
+                              const std::vector<std::string>& only = kMeaningful) {
   BatteryRun r;
   const std::string base = std::string(PBVBUS_BINARY_DIR) + "/outside_slave_" + name + "_" +
                            std::to_string(::getpid());
@@ -228,7 +229,7 @@ BatteryRun run_against_python(const std::string& name, const std::vector<std::st
   std::vector<std::string> cargs = {kBinary, "conformance", "--gsd", kGsd, "--address", std::to_string(kDut),
                                     "--pty", link, "--speed", kSpeed, "--baud", kBaud,
                                     "--junit", r.junit_file, "--json"};
-  for (const auto& o : kMeaningful) {
+  for (const auto& o : only) {
     cargs.push_back("--only");
     cargs.push_back(o);
   }
@@ -267,13 +268,14 @@ bool only_missed_replies(const Flat& rep, const std::map<std::string, std::strin
 /// run_against_python(), once more when the first run missed replies only (see above); a real
 /// fault of the program shows in both runs. The retry is recorded as a test property.
 BatteryRun run_checked(const std::string& name, const std::vector<std::string>& extra,
-                       const std::map<std::string, std::string>& want) {
-  BatteryRun r = run_against_python(name, extra);
+                       const std::map<std::string, std::string>& want,
+                       const std::vector<std::string>& only = kMeaningful) {
+  BatteryRun r = run_against_python(name, extra, only);
   if (only_missed_replies(r.report, want)) {
     std::cout << "[ retry    ] missed replies only (a loaded machine?): running again\n";
     ::testing::Test::RecordProperty("retried_after_missed_replies", "1");
     std::remove(r.junit_file.c_str());
-    r = run_against_python(name + "_retry", extra);
+    r = run_against_python(name + "_retry", extra, only);
   }
   return r;
 }
@@ -431,6 +433,24 @@ TEST(OutsideSlave, PythonSlaveAcceptingAWrongIdentIsCaughtByPrm01) {
   expect_prm01_evidence(r.report, kDiagWaitCfgOwned);
   EXPECT_EQ(junit_summary(r.junit_file), "testsuites 5 19 1 1 1 |PRM-01 Wrong Ident_Number refused");
   EXPECT_EQ(junit_schema_errors(r.junit_file), "");
+  std::remove(r.junit_file.c_str());
+  EXPECT_EQ(r.slave_rc, 0) << r.slave_err;
+}
+
+TEST(OutsideSlave, PythonSlaveExecutingRepeatsIsCaughtByFcb01) {
+  if (const auto why = missing_python(); !why.empty()) GTEST_SKIP() << why;
+  if (const auto why = missing_binary(); !why.empty()) GTEST_SKIP() << why;
+  // Only FCB-01, in a fresh program: its first Data_Exchange (FCV=1, FCB=1) is the program's
+  // first one, so the inputs (a counter of the Data_Exchanges executed) are 00 01:
+  //   68 05 05 68 01 05 08 00 01 0F 16   (SD2, DA 1, SA 5, FC 08 = DL; FCS 01+05+08+00+01 = 0x0F)
+  // and the repeat, executed although it must not be, counts on to 00 02:
+  //   68 05 05 68 01 05 08 00 02 10 16   (FCS 01+05+08+00+02 = 0x10)
+  const BatteryRun r = run_checked("break_fcb", {"--break", "fcb"}, {{"FCB-01", "fail"}}, {"FCB-01"});
+  EXPECT_EQ(r.rc, 1) << r.err << verdicts(r.report);
+  expect_verdicts(r.report, {{"FCB-01", "fail"}});
+  EXPECT_EQ(get(r.report, "tests.0.message"),
+            "repeat: expected the stored reply 68 05 05 68 01 05 08 00 01 0F 16, got 68 05 05 68 01 05 08 00 "
+            "02 10 16");
   std::remove(r.junit_file.c_str());
   EXPECT_EQ(r.slave_rc, 0) << r.slave_err;
 }

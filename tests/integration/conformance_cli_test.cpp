@@ -72,7 +72,9 @@ void expect_valid_junit(const std::string& path) {
     EXPECT_EQ(std::system(cmd.c_str()), 0) << path;
   }
   const std::string s = check_junit(path);
-  if (s != "skip") EXPECT_EQ(s.rfind("ok ", 0), 0u) << s;
+  if (s != "skip") {
+    EXPECT_EQ(s.rfind("ok ", 0), 0u) << s;
+  }
 }
 
 struct Model {

@@ -11,7 +11,7 @@
 //   pty, Python and a busy scheduler. Faster was tried: at 1/4 (TSL 42 ms of wall time) a machine
 //   with a load average of 10 on 2 cores made the program miss the slot time now and then. At
 //   1.5 Mbit/s the same wall times need 1/1000, and then every test's reset (10 ms of virtual
-//   idle, cut by the battery's 5 s bound of wall time per wait) costs 5 s: 116 s for 17 tests,
+//   idle) costs 10 s of wall time: 116 s for 17 tests even with the waits then cut at 5 s,
 //   against ~45 s for these 19 at 9.6k and 1/20. A run that misses replies only is repeated
 //   once (run_checked(); a real fault of the program fails both runs).
 // - Which tests: the battery's tests of the groups that exist (Start-up, Set_Prm, Chk_Cfg, Read
@@ -21,7 +21,8 @@
 //   FCV=1 frame instead of a first frame (FCV=0, FCB=1, protocol-facts.md §C.6) and so depend on
 //   a fresh FDL state a model gets for every test and a program does not (the FCB state of the
 //   tester's address is what the previous FCB test left). FCB-01 comes first in a fresh program
-//   and is deterministic. See docs/outside-slave.md for the measured reasons.
+//   and is deterministic. See docs/conformance.md, "An outside slave behind a pty", for the
+//   measured reasons.
 // - The run is the built `pbvbus conformance --pty PATH --speed 1/20 --baud 9.6k --json --junit`
 //   (skipped when bin/pbvbus is not built); the Python program is a child process started
 //   first (it waits for the symlink the battery makes) and ended with SIGTERM afterwards (it

@@ -75,6 +75,7 @@ Decisions (a program behind a pty has no virtual clock):
     the same way. The program never exits on
     bad input; it ends on SIGINT/SIGTERM, after --max-time seconds, or when the pty's other
     side is gone, and then prints a summary (JSON) on stdout.
+  - SIGHUP (a pty hanging up) ends it like SIGTERM.
   - Opening the port: pending input is flushed (requests written before the program was
     there are stale; their replies would come far too late).
 
@@ -767,7 +768,8 @@ def main():
     station = Station(slave, args.address, args.breaks, log)
 
     stop = []
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    # SIGHUP too: a pty whose other side goes away may hang up on whoever has it open.
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, lambda *_: stop.append(1))
 
     deadline = t0 + args.wait_port

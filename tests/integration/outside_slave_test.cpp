@@ -136,7 +136,8 @@ struct Child {
     return -1;
   }
   /// SIGTERM (the program prints its summary and exits), then waits up to `limit`; SIGKILL
-  /// after that. Returns the exit status, or -1 if it had to be killed.
+  /// after that. Returns the exit status, 128 + the signal that ended it, or -1 if it had to be
+  /// killed.
   int stop(std::chrono::seconds limit = 10s) {
     if (pid <= 0) return -1;
     ::kill(pid, SIGTERM);
@@ -145,6 +146,7 @@ struct Child {
     while (std::chrono::steady_clock::now() < until) {
       if (::waitpid(pid, &st, WNOHANG) == pid) {
         pid = -1;
+        if (WIFSIGNALED(st)) return 128 + WTERMSIG(st);
         return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
       }
       std::this_thread::sleep_for(10ms);

@@ -12,7 +12,7 @@
 //   with a load average of 10 on 2 cores made the program miss the slot time now and then. At
 //   1.5 Mbit/s the same wall times need 1/1000, and then every test's reset (10 ms of virtual
 //   idle) costs 10 s of wall time: 116 s for 17 tests even with the waits then cut at 5 s,
-//   against ~45 s for these 19 at 9.6k and 1/20. A run that misses replies only is repeated
+//   against ~70 s for these 19 at 9.6k and 1/20. A run that misses replies only is repeated
 //   once (run_checked(); a real fault of the program fails both runs).
 // - Which tests: the battery's tests of the groups that exist (Start-up, Set_Prm, Chk_Cfg, Read
 //   services, FCB/FCV), without those whose verdict is not meaningful for this DUT:

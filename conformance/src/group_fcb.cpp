@@ -39,18 +39,28 @@ bool outputs_are(TestResult& r, Session& s, const std::vector<std::uint8_t>& wan
   return !check(r, what, expect_data(rd_outp(s, "Rd_Outp from master 2", kReader), want));
 }
 
+/// Every test opens the FCB sequence with a first frame (FCV 0, FCB 1, §C.6): the slave must
+/// execute it and store FCB 1 for the tester whatever an earlier test left (an outside slave
+/// keeps its FCB memory across tests; a fresh model has none).
+bool first_frame(TestResult& r, Session& s, const std::vector<std::uint8_t>& out) {
+  data_exchange(s, out, "first frame: Data_Exchange FCV=0 FCB=1", std::nullopt, false, true);
+  return outputs_are(r, s, out, "the first frame is executed");
+}
+
 void repeat_not_executed(TestContext& ctx, TestResult& r) {
   std::unique_ptr<Session> s;
   if (!setup(ctx, r, s)) return;
+  const auto a0 = output_pattern(ctx.output_len(), 0x11);
   const auto a = output_pattern(ctx.output_len(), 0x01);
   const auto b = output_pattern(ctx.output_len(), 0x80);
-  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  if (!first_frame(r, *s, a0)) return;
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=0, outputs A", std::nullopt, true, false);
   const Exchange first = s->bus().transcript().back();
   if (!first.answered) {
-    fail(r, "Data_Exchange FCV=1 FCB=1: no reply");
+    fail(r, "Data_Exchange FCV=1 FCB=0: no reply");
     return;
   }
-  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=1 again (repeat), outputs B", std::nullopt, true, true);
+  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=0 again (repeat), outputs B", std::nullopt, true, false);
   const Exchange again = s->bus().transcript().back();
   if (!again.answered) {
     fail(r, "repeat: no reply");
@@ -66,11 +76,13 @@ void repeat_not_executed(TestContext& ctx, TestResult& r) {
 void toggle_executed(TestContext& ctx, TestResult& r) {
   std::unique_ptr<Session> s;
   if (!setup(ctx, r, s)) return;
+  const auto a0 = output_pattern(ctx.output_len(), 0x12);
   const auto a = output_pattern(ctx.output_len(), 0x02);
   const auto b = output_pattern(ctx.output_len(), 0x90);
-  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  if (!first_frame(r, *s, a0)) return;
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=0 (toggled), outputs A", std::nullopt, true, false);
   if (!outputs_are(r, *s, a, "outputs A taken")) return;
-  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=0 (toggled), outputs B", std::nullopt, true, false);
+  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=1 (toggled), outputs B", std::nullopt, true, true);
   outputs_are(r, *s, b, "after the toggled FCB the outputs are B");
 }
 
@@ -81,7 +93,7 @@ void restart_after_set_prm(TestContext& ctx, TestResult& r) {
   const auto b = output_pattern(ctx.output_len(), 0xA0);
   const auto c = output_pattern(ctx.output_len(), 0x40);
   const auto d = output_pattern(ctx.output_len(), 0xC0);
-  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  if (!first_frame(r, *s, a)) return;
   data_exchange(*s, a, "Data_Exchange FCV=1 FCB=0, outputs A", std::nullopt, true, false);
   // Re-parameterisation: Set_Prm + Chk_Cfg (the slave leaves data exchange and comes back).
   const auto prm = prm_du(ctx.params());

@@ -1,6 +1,6 @@
 // TestBus: the tester's line (test_bus.hpp). The tester is a plain bus::Device attached first on
-// the cable; every "send and wait" is a run of the scheduler (fast) or of the PacedRunner in
-// small slices (paced) until the reply has been delivered or the slot time has passed.
+// the cable; every "send and wait" is a run of the scheduler (fast) or of the PacedRunner
+// (paced) until the reply has been delivered or the slot time has passed.
 //
 // Decisions:
 // - The reply is the first frame heard whose START lies in [request end, request end + TSL]
@@ -11,12 +11,16 @@
 // - "Line free" = the end of the last frame on the line, whoever sent it (own transmissions
 //   included); a request starts TSYN bit times after it at the earliest. A frame that is still
 //   arriving when a request is due is awaited first.
-// - Paced: slices of about 1 ms of wall time (at least one bit time of virtual time); a wait may
-//   take the wall time its virtual span needs at the runner's speed plus paced_wait_limit, then
-//   it ends (as "no reply" for a request), never as a hang.
+// - Paced: each wait is one run of the PacedRunner (virtual time anchored once per wait, so a
+//   program's reply delay keeps its length in virtual time), ended early by the tester when it
+//   hears what the wait waits for; a wait may take the wall time its virtual span needs at the
+//   runner's speed plus paced_wait_limit, then it ends (as "no reply" for a request), never as
+//   a hang.
 
 #include <algorithm>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
+#include <functional>
 
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/conformance/test_bus.hpp"
@@ -75,6 +79,7 @@ class TestBus::Tester final : public bus::Device {
   void on_frame(const bus::RxFrame& f) override {
     heard.push_back({std::vector<std::uint8_t>(f.bytes.begin(), f.bytes.end()), f.start, f.end, f.flags});
     last_end = std::max(last_end, f.end);
+    if (on_heard) on_heard();
   }
   void on_timer(bus::Ticks) override {}
   const char* kind() const override { return "tester"; }
@@ -90,6 +95,7 @@ class TestBus::Tester final : public bus::Device {
 
   std::vector<Heard> heard;
   bus::Ticks last_end = 0;  // end of the last frame on the line (heard or sent)
+  std::function<void()> on_heard;  // paced waits: ends the run once its condition holds
   EventTap tap;
 };
 
@@ -140,21 +146,30 @@ void TestBus::run_until(bus::Ticks t, const std::function<bool()>& done) {
     }
     return;
   }
-  // Paced: slices of ~1 ms wall time, bounded by paced_wait_limit.
-  const bus::Speed sp = m_runner->speed();
-  const bus::Ticks slice = std::max<bus::Ticks>(
-      bus::ticks_per_bit(baud()), bus::kTicksPerMs * static_cast<bus::Ticks>(sp.num) /
-                                      static_cast<bus::Ticks>(std::max<std::uint32_t>(sp.den, 1)));
+  // Paced: ONE run of the PacedRunner up to t. Every run_until() re-anchors virtual time to the
+  // wall clock, so a run in slices would lose the wall time between slices and a program's reply
+  // delay would shrink in virtual time (seen: 11 bit times measured as 2..3 at 1/4). The wait's
+  // condition can only change when the tester hears a frame, so the tester stops the run there.
   // The wall bound is slack beyond the wall time the virtual wait takes at this speed: a long
-  // virtual wait (idle, watchdog) runs to its end; a runner that stalls gives up.
-  const bus::Ticks span = std::max<bus::Ticks>(0, t - m_sched.now());
+  // virtual wait (idle, watchdog) runs to its end; a runner that stalls gives up (a steady_timer
+  // on the runner's io_context stops it).
+  if (finished() || m_sched.now() >= t) return;
+  const bus::Speed sp = m_runner->speed();
+  const bus::Ticks span = t - m_sched.now();
   const auto wall_of_span = std::chrono::nanoseconds(
       bus::ticks_to_ns(span) / std::max<std::uint32_t>(sp.num, 1) * static_cast<std::int64_t>(sp.den));
-  const auto wall_end = std::chrono::steady_clock::now() + wall_of_span + m_opt.paced_wait_limit;
-  while (!finished() && m_sched.now() < t) {
-    if (std::chrono::steady_clock::now() >= wall_end) return;
-    m_runner->run_until(std::min(t, m_sched.now() + slice));
-  }
+  boost::asio::steady_timer guard(m_runner->io_context());
+  guard.expires_after(wall_of_span + m_opt.paced_wait_limit);
+  guard.async_wait([runner = m_runner.get()](const boost::system::error_code& ec) {
+    if (!ec) runner->stop();
+  });
+  if (done)
+    m_tester->on_heard = [&] {
+      if (done()) m_runner->stop();
+    };
+  m_runner->run_until(t);
+  m_tester->on_heard = nullptr;
+  guard.cancel();
 }
 
 void TestBus::drain_heard() {

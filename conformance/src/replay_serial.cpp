@@ -4,6 +4,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
@@ -177,6 +178,13 @@ std::optional<SerialPlayStats> play_to_serial(std::span<const std::uint8_t> data
     if (buf.empty()) break;
     pollfd p{fd, POLLOUT, 0};
     ::poll(&p, 1, 20);
+  }
+  // A created pty: give the reader the same time to take what the pty still holds, so that
+  // closing our side does not hang up on unread frames.
+  if (target.slave_fd() >= 0) {
+    int queued = 0;
+    while (Clock::now() < drain_until && ::ioctl(target.slave_fd(), FIONREAD, &queued) == 0 && queued > 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   st.octets_dropped += buf.size();
   st.wall_ms = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count();

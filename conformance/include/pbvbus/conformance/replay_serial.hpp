@@ -11,7 +11,8 @@
 //    (`speed` N/M as in PacedRunner: 1/10 plays ten times slower). A write never waits for the
 //    reader: the port is non-blocking, octets the port does not take wait in a bounded buffer
 //    (`max_buffer`); a frame that does not fit is dropped whole and counted. At the end the
-//    buffer gets `drain_ms` to go out; what is left then counts as dropped. So a reader that does
+//    buffer gets `drain_ms` to go out (with a created pty, also until the reader has read
+//    what the pty holds: FIONREAD on our slave handle); what is left then counts as dropped. So a reader that does
 //    not read makes the player finish on time with a count of dropped octets, never hang.
 //  - The port: open_serial_target() creates a pseudo-terminal (slave side in raw mode, kept open
 //    by the player so a reader may open and close it) and makes `link` a symbolic link to it
@@ -49,6 +50,8 @@ class SerialTarget {
   SerialTarget(const SerialTarget&) = delete;
   SerialTarget& operator=(const SerialTarget&) = delete;
   int fd() const { return m_fd; }
+  /// Our handle on a created pty's slave side (-1 for an opened path).
+  int slave_fd() const { return m_slave; }
   /// The device path (the pty's slave side, or the path opened).
   const std::string& path() const { return m_path; }
 

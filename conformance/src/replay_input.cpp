@@ -25,9 +25,12 @@ std::optional<bus::Baud> baud_of(std::uint64_t speed) {
   return std::nullopt;
 }
 
-/// ns → ticks (3.636 ticks per ns), rounded up; ns in [0, kMaxSpanNs].
-bus::Ticks ns_to_ticks(std::int64_t ns) {
-  return (ns / 1000) * 3636 + ((ns % 1000) * 3636 + 999) / 1000;
+/// ns → ticks, rounded to the nearest whole bit time of `baud`; ns in [0, kMaxSpanNs]. Split
+/// into whole seconds and the rest so that nothing overflows (rest · baud < 1.2e16).
+bus::Ticks ns_to_ticks(std::int64_t ns, bus::Baud baud) {
+  const std::int64_t b = static_cast<std::int64_t>(baud);
+  const std::int64_t bits = (ns / 1'000'000'000) * b + ((ns % 1'000'000'000) * b + 500'000'000) / 1'000'000'000;
+  return bus::bits_to_ticks(bits, baud);
 }
 
 std::string flag_reason(std::uint32_t flags) {
@@ -133,7 +136,7 @@ std::optional<ReplayInput> build_replay_input(std::span<const std::uint8_t> data
     // Relative time, checked before any arithmetic that could overflow.
     const bool ts_ok = r.ts_ns >= *first_ns && r.ts_ns - *first_ns <= kMaxSpanNs;
     const std::int64_t rel = ts_ok ? r.ts_ns - *first_ns : 0;
-    f.start = ns_to_ticks(rel);
+    f.start = rel;  // ns for now: the baud is known once the line's interface is
     if ((r.flags & pcapng::kFlagErrorMask) != 0) {
       f.unusable_reason = r.comment.empty() ? flag_reason(r.flags) : r.comment;
     } else if (r.orig_len > r.bytes.size()) {
@@ -179,6 +182,7 @@ std::optional<ReplayInput> build_replay_input(std::span<const std::uint8_t> data
   in.tsl = opts.tsl ? *opts.tsl : fdl::BusParams::defaults(*baud).tsl;
   const bus::Ticks bit = bus::ticks_per_bit(*baud);
   for (ReplayFrame& f : in.frames) {
+    f.start = ns_to_ticks(f.start, *baud);
     f.end = f.start + static_cast<bus::Ticks>(f.bytes.size()) * bus::kBitsPerChar * bit;
     if (f.unusable_reason.empty()) decode_into(f);
   }

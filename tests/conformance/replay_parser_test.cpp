@@ -6,6 +6,7 @@
 
 #include "../captures/capture_fixture.hpp"
 
+#include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/conformance/replay_input.hpp"
 
@@ -153,8 +154,12 @@ TEST(ReplayInputParser, SeededMutationsNeverCrash) {
       EXPECT_LT(f.offset, m.size());
       EXPECT_LE(f.start, f.end);
       EXPECT_EQ(f.role == ReplayRole::Unusable, !f.unusable_reason.empty());
-      if (f.reply >= 0) EXPECT_EQ(in->frames[static_cast<std::size_t>(f.reply)].request, static_cast<int>(k));
-      if (f.role != ReplayRole::Unusable) EXPECT_LE(f.du_offset + f.du_len, f.bytes.size());
+      if (f.reply >= 0) {
+        EXPECT_EQ(in->frames[static_cast<std::size_t>(f.reply)].request, static_cast<int>(k));
+      }
+      if (f.role != ReplayRole::Unusable) {
+        EXPECT_LE(f.du_offset + f.du_len, f.bytes.size());
+      }
     }
   }
   EXPECT_GT(ok, 500);

@@ -159,16 +159,16 @@ class ScriptedSlave final : public bus::Device {
   }
 };
 
-struct Run {
+struct Replayed {
   ReplayInput in;
   std::unique_ptr<Replayer> rp;
   ReplayResult res;
 };
 
-Run replay(const Bytes& file, std::deque<ScriptedSlave::Step> script, ReplayPacing pacing,
+Replayed replay(const Bytes& file, std::deque<ScriptedSlave::Step> script, ReplayPacing pacing,
            std::optional<std::uint8_t> station = {}, std::vector<ReplayMask> masks = {},
            bool answer_broadcast = false) {
-  Run r;
+  Replayed r;
   r.in = input_of(file);
   bus::Scheduler sched;
   bus::Line line(sched, "dp0", bus::Baud::k1_5M);
@@ -187,7 +187,7 @@ Run replay(const Bytes& file, std::deque<ScriptedSlave::Step> script, ReplayPaci
   return r;
 }
 
-std::deque<ScriptedSlave::Step> as_recorded() { return {{kDiagRes}, {kDxRes}, {kDxRes}}; }
+std::deque<ScriptedSlave::Step> as_recorded() { return {{kDiagRes, 11, {}}, {kDxRes, 11, {}}, {kDxRes, 11, {}}}; }
 
 std::vector<std::int64_t> sent_starts(const Replayer& rp) {
   std::vector<std::int64_t> v;
@@ -196,7 +196,7 @@ std::vector<std::int64_t> sent_starts(const Replayer& rp) {
 }
 
 TEST(Replayer, SameRepliesNoDifferenceFastPacing) {
-  const Run r = replay(recording(), as_recorded(), ReplayPacing::Fast);
+  const Replayed r = replay(recording(), as_recorded(), ReplayPacing::Fast);
   // Fast: first frame TSYN after power-on (33); token 3 octets ends 66, +33 -> Slave_Diag at
   // 99, ends 220, reply 231..385 (14 octets), +33 -> DX1 at 418, ends 539, reply 550..660,
   // +33 -> GC at 693, 13 octets ends 836, no reply expected: +33 -> DX2 at 869.
@@ -210,7 +210,7 @@ TEST(Replayer, SameRepliesNoDifferenceFastPacing) {
 }
 
 TEST(Replayer, AsRecordedPacingKeepsTheRecordedOffsets) {
-  const Run r = replay(recording(), as_recorded(), ReplayPacing::AsRecorded);
+  const Replayed r = replay(recording(), as_recorded(), ReplayPacing::AsRecorded);
   // t0 = 33; every frame at 33 + its recorded start: 0, 100, 500, 900, 1200.
   EXPECT_EQ(sent_starts(*r.rp), (std::vector<std::int64_t>{33, 133, 533, 933, 1233}));
   EXPECT_EQ(r.res.pacing_slips, 0u);
@@ -220,7 +220,7 @@ TEST(Replayer, AsRecordedPacingKeepsTheRecordedOffsets) {
 TEST(Replayer, LateReplyIsATimingDifferenceAndAPacingSlip) {
   auto script = as_recorded();
   script[1].tsdr = 200;  // > max TSDR 150, < TSL 300
-  const Run r = replay(recording(), script, ReplayPacing::AsRecorded);
+  const Replayed r = replay(recording(), script, ReplayPacing::AsRecorded);
   // DX1 at 533, ends 654; reply at 854, 10 octets, ends 964. GC wanted at 933: the line is
   // busy, it waits for TSYN after 964 -> 997 (one slip); DX2 at 1233 as recorded.
   EXPECT_EQ(sent_starts(*r.rp), (std::vector<std::int64_t>{33, 133, 533, 997, 1233}));
@@ -238,7 +238,7 @@ TEST(Replayer, LateReplyIsATimingDifferenceAndAPacingSlip) {
 TEST(Replayer, OtherDataNamesTheOctetsAndTheInputsMaskHidesThem) {
   auto script = as_recorded();
   script[1].reply = kDxRes3D;
-  Run r = replay(recording(), script, ReplayPacing::Fast);
+  Replayed r = replay(recording(), script, ReplayPacing::Fast);
   ASSERT_EQ(r.res.differences(), 1u);
   EXPECT_EQ(r.res.diffs[0].kind, DiffKind::OtherData);
   // Frame octet 7 is the DU's first (SD LE LEr SD DA SA FC DU), octet 8 the FCS.
@@ -271,7 +271,7 @@ TEST(Replayer, OtherFcMissingAndExtraReplies) {
   script[0].reply.clear();         // Slave_Diag: silent -> missing reply
   script[2].reply = kSc;           // DX2: SC instead of DL data -> other FC
   script[1].second = kDxRes;       // DX1: a second frame after the reply -> extra reply
-  const Run r = replay(recording(), script, ReplayPacing::Fast, {}, {}, /*answer_broadcast=*/true);
+  const Replayed r = replay(recording(), script, ReplayPacing::Fast, {}, {}, /*answer_broadcast=*/true);
   ASSERT_EQ(r.res.differences(), 4u) << replay_text(r.res);
   EXPECT_EQ(r.res.diffs[0].kind, DiffKind::MissingReply);
   EXPECT_EQ(r.res.diffs[0].service, "Slave_Diag");
@@ -289,7 +289,7 @@ TEST(Replayer, OtherFcMissingAndExtraReplies) {
 }
 
 TEST(Replayer, OneStationTargetSkipsTokensAndOtherTraffic) {
-  const Run r = replay(recording(), as_recorded(), ReplayPacing::Fast, 10);
+  const Replayed r = replay(recording(), as_recorded(), ReplayPacing::Fast, 10);
   EXPECT_EQ(r.res.tokens_replayed, 0u);
   EXPECT_EQ(r.res.requests_replayed, 4u);  // Slave_Diag, DX1, the broadcast, DX2
   EXPECT_EQ(r.res.differences(), 0u);
@@ -297,7 +297,7 @@ TEST(Replayer, OneStationTargetSkipsTokensAndOtherTraffic) {
 }
 
 TEST(Replayer, DamagedRecordedReplyIsListedNotCompared) {
-  const Run r = replay(recording(bus::kRxCollision), as_recorded(), ReplayPacing::Fast);
+  const Replayed r = replay(recording(bus::kRxCollision), as_recorded(), ReplayPacing::Fast);
   EXPECT_EQ(r.res.compared, 2u);
   EXPECT_EQ(r.res.not_compared_unusable, 1u);
   ASSERT_EQ(r.res.unusable.size(), 1u);

@@ -10,8 +10,10 @@
 //    (counted in `ignored_records`).
 //  - Timestamps are frame STARTS (pcapng_writer.hpp and design.md "Captures": the start bit of
 //    the first character), in ns. They are converted to ticks relative to the line's first
-//    frame (ticks = ns · 3.636, rounded up: the writer rounded the tick time down to ns, so the
-//    first tick at or after the ns is the recorded one whenever the tick was a whole ns step).
+//    frame, rounded to the nearest whole bit time: the writer rounded the tick time down to
+//    whole ns, which loses up to 3 ticks, and a bit time is at least 83 ns (12 Mbit/s), so the
+//    nearest bit time is the recorded one whenever frames start on bit times (every pbvbus
+//    capture; a hardware capture gets bit-time resolution, which is what replay compares in).
 //    A frame's end is its start + 11 bit times per captured octet.
 //  - A record is "unusable" (kept, with its reason, counted, never sent and never compared
 //    with) when: its epb_flags have a link-layer error bit (kFlagErrorMask; reason = the

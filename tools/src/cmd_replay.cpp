@@ -308,7 +308,8 @@ int run_pty(const ReplayArgs& ra, const cf::ReplayInput& in, std::ostream& out, 
     pty->attach_io(runner);
     line.start();
     const bus::Ticks cap = time_cap(in, rp);
-    const bus::Ticks slice = 10 * bus::kTicksPerMs;
+    // Short slices: at 1/1000 one virtual millisecond is a wall second.
+    const bus::Ticks slice = bus::kTicksPerMs;
     while (!rp.finished() && sched.now() < cap) runner.run_until(sched.now() + slice);
     pty->detach_io();
     cf::ReplayCompareOptions co;

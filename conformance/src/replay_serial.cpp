@@ -181,10 +181,16 @@ std::optional<SerialPlayStats> play_to_serial(std::span<const std::uint8_t> data
   }
   // A created pty: give the reader the same time to take what the pty still holds, so that
   // closing our side does not hang up on unread frames.
+  // Octets the master took may still be on their way into the slave's input queue (the kernel
+  // moves them in a work item), so the queue must stay empty for 50 ms, not just once.
   if (target.slave_fd() >= 0) {
-    int queued = 0;
-    while (Clock::now() < drain_until && ::ioctl(target.slave_fd(), FIONREAD, &queued) == 0 && queued > 0)
+    auto empty_since = Clock::now();
+    while (Clock::now() < drain_until && Clock::now() - empty_since < std::chrono::milliseconds(50)) {
+      int queued = 0;
+      if (::ioctl(target.slave_fd(), FIONREAD, &queued) != 0) break;
+      if (queued > 0) empty_since = Clock::now();
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
   }
   st.octets_dropped += buf.size();
   st.wall_ms = std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t0).count();

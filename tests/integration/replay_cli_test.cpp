@@ -285,6 +285,9 @@ TEST(ReplayCli, ToPtyDeliversTheFramesInOrder) {
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
   EXPECT_EQ(got.size(), expected.size());
   EXPECT_TRUE(got == expected);
+  std::size_t first = 0;
+  while (first < got.size() && first < expected.size() && got[first] == expected[first]) ++first;
+  EXPECT_EQ(first, expected.size()) << "first difference at octet " << first;
 }
 
 }  // namespace

@@ -164,6 +164,22 @@ class DpPlanner {
     sp.io = s.inputs();
     sp.tsdr = s.tsdr_bits();
     bool ok = true;
+    // A mutant (test-only, devices/slave_mutant.hpp): by name; never on a switched station.
+    if (!s.mutant().empty()) {
+      if (switched >= 0) {
+        error(m_rep, i, "mutant", -1, "a switched_station cannot be a mutant slave");
+        ok = false;
+      } else if (auto mu = devices::parse_slave_mutant(s.mutant())) {
+        sp.mutant = *mu;
+      } else {
+        std::string known;
+        for (const auto& info : devices::slave_mutants())
+          known += (known.empty() ? "" : ", ") + std::string(info.name);
+        error(m_rep, i, "mutant", -1,
+              "unknown mutant \"" + s.mutant() + "\" (known: " + known + ")");
+        ok = false;
+      }
+    }
     // The master: none = whoever parameterises it (a master outside pbvbus).
     int mi = -1;
     sp.master = dp::kNoMaster;

@@ -66,6 +66,7 @@ DpSlaveNode::DpSlaveNode(const DpSlavePlan& plan, const fdl::BusParams& params) 
   o.address = plan.address;
   o.bus_params = params;
   if (plan.tsdr != 0) o.tsdr = plan.tsdr;
+  o.mutant = plan.mutant;  // test-only (devices/slave_mutant.hpp)
   std::vector<devices::ModuleChoice> mods;
   for (std::size_t i : plan.gsd_modules) mods.push_back(devices::ModuleChoice::at(i));
   auto b = devices::SlaveModel::build(*plan.gsd, mods, o);

@@ -42,6 +42,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/devices/io_behaviour.hpp"
+#include "pbvbus/devices/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_config.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
@@ -87,6 +88,8 @@ struct DpSlavePlan {
   std::size_t outputs = 0;
   scenario::DpSlave::Inputs io = scenario::DpSlave::COUNTER;
   std::vector<DpIoPlan> io_behaviours;  ///< the `io` entries, in file order
+  /// Test-only: the `mutant` it was asked to be (devices/slave_mutant.hpp); none = conformant.
+  std::optional<devices::SlaveMutant> mutant;
   /// One interface of a switched_station (source = its index there, not a dp_slave's): the
   /// index into ScenarioPlan::switched and the side (0 = line A, 1 = line B); -1 otherwise.
   int switched = -1;

@@ -113,11 +113,12 @@ std::optional<bus::Speed> parse_speed(const std::string& v) {
   return bus::Speed{*n, *d};
 }
 
-/// Makes the planned slave a mutant; "" or why not. (Filled in once branch `mut` is merged.)
+/// Makes the planned slave a mutant (DpSlavePlan::mutant, as `dp_slave { mutant: ... }`
+/// would); "" or why not.
 std::string set_slave_mutant(DpSlavePlan& s, const std::string& name) {
-  (void)s;
-  (void)name;
-  return "mutant slaves are not built into this version";
+  if (s.switched >= 0) return "a switched station's interface cannot be a mutant";
+  s.mutant = devices::parse_slave_mutant(name);
+  return "";
 }
 
 /// "" on success, else the message.
@@ -160,7 +161,13 @@ std::string parse_args(const Args& args, ReplayArgs& out) {
       const auto colon = v ? v->find(':') : std::string::npos;
       auto n = colon != std::string::npos ? number<std::uint8_t>(v->substr(0, colon), 126) : std::nullopt;
       if (!n) return "--mutant needs ADDR:NAME, e.g. 4:tsdr_too_late";
-      out.mutants.emplace_back(*n, v->substr(colon + 1));
+      const std::string name = v->substr(colon + 1);
+      if (!devices::parse_slave_mutant(name)) {
+        std::string known;
+        for (const auto& m : devices::slave_mutants()) known += " " + std::string(m.name);
+        return "unknown mutant '" + name + "' (known:" + known + ")";
+      }
+      out.mutants.emplace_back(*n, name);
     } else if (a == "--paced-as-recorded" || a == "--fast") {
       const auto p = a == "--fast" ? cf::ReplayPacing::Fast : cf::ReplayPacing::AsRecorded;
       if (pacing_given && p != out.pacing) return "--paced-as-recorded and --fast exclude each other";

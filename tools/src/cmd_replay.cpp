@@ -64,7 +64,7 @@ constexpr const char* kUsage =
     "                       masters left out (the replayer takes the first one's place)\n"
     "  --station ADDR       replay only the requests to ADDR (and broadcasts); default: all\n"
     "                       frames, tokens included\n"
-    "  --mutant ADDR:NAME   make DP slave ADDR a mutant (see docs/conformance.md)\n"
+    "  --mutant ADDR:NAME   make DP slave ADDR a mutant (docs/mutants.md)\n"
     "  --pty PATH           the target is an outside slave behind a pty linked at PATH\n"
     "                       (needs --station); the run is paced at --speed (default 1/1000)\n"
     "  --to PTY             play the frames raw into a serial port: PTY an existing tty, or a\n"

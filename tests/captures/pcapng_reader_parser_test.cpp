@@ -124,6 +124,35 @@ TEST(PcapngReader, GarbageGetsAClearErrorWithTheOffset) {
   EXPECT_EQ(error_of(g), "offset 12: unsupported pcapng major version 2");
 }
 
+// Replay's input (issue 10): the four broken-file cases the fuzz target's seeds also hold.
+TEST(PcapngReader, ReplayInputCasesGetClearErrors) {
+  const Bytes f = sample_capture();
+  // An EPB claiming a captured length of 0xFFFFFFF0: an error, never a 4 GiB read or allocation
+  // (and no overflow in "28 + captured length").
+  Bytes g = f;
+  g[124 + 20] = 0xF0;
+  g[124 + 21] = 0xFF;
+  g[124 + 22] = 0xFF;
+  g[124 + 23] = 0xFF;
+  EXPECT_EQ(error_of(g), "offset 144: EPB captured length 4294967280 exceeds the block (44 octets)");
+  // A block cut inside its body (the first EPB, 44 octets long, ends after 20).
+  EXPECT_EQ(error_of(Bytes(f.begin(), f.begin() + 124 + 20)),
+            "offset 128: EPB block length 44 runs past the end of the file (20 octets left)");
+  // A block length that is not a multiple of 4 (EPB 45).
+  g = f;
+  g[124 + 4] = 45;
+  EXPECT_EQ(error_of(g), "offset 128: EPB block length 45 is below 12 or not a multiple of 4");
+  // An unknown block type at the end of the file, with consistent lengths, is skipped.
+  g = f;
+  const Bytes unknown = {0x0D, 0xF0, 0xAD, 0x0B, 0x10, 0x00, 0x00, 0x00,
+                         0xAA, 0xBB, 0xCC, 0xDD, 0x10, 0x00, 0x00, 0x00};
+  g.insert(g.end(), unknown.begin(), unknown.end());
+  PcapngError err;
+  auto cap = read_pcapng(g, err);
+  ASSERT_TRUE(cap) << err.to_string();
+  EXPECT_EQ(cap->records.size(), 3u);
+}
+
 TEST(PcapngReader, MissingFileIsAnError) {
   PcapngError err;
   EXPECT_FALSE(read_pcapng_file("/nonexistent/capture.pcapng", err));

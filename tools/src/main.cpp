@@ -22,6 +22,7 @@ const Command kCommands[] = {
     {"timing", pbvbus::tools::cmd_timing, "plan DP rotation and switchover times of a scenario"},
     {"gateway", pbvbus::tools::cmd_gateway, "print a scenario's gateway maps (Modbus registers, CAN PDOs)"},
     {"conformance", pbvbus::tools::cmd_conformance, "test a DP slave (model or program behind a pty) against the standard"},
+    {"replay", pbvbus::tools::cmd_replay, "replay a capture against a scenario's slaves or a pty; compare the replies"},
 };
 
 void usage(std::ostream& os) {

@@ -62,8 +62,20 @@ struct Simulation::Station {
   int switched = -1;  ///< index into ScenarioPlan::switched
 };
 
+namespace {
+/// Holds an omitted master's cable position (SimulationOptions::omit_masters): hears, says nothing.
+class InertDevice final : public bus::Device {
+ public:
+  void on_power_on(bus::Ticks) override {}
+  void on_frame(const bus::RxFrame&) override {}
+  void on_timer(bus::Ticks) override {}
+  const char* kind() const override { return "omitted master"; }
+};
+}  // namespace
+
 struct Simulation::LineState {
   std::unique_ptr<bus::Line> line;
+  std::vector<std::unique_ptr<bus::Device>> inert;  ///< omitted masters' places
   LineStats stats;
   std::string stats_probe;  ///< where the statistics tap listens ("station 1"), "" = whole line
   std::vector<Station> stations;  // cable order
@@ -142,7 +154,28 @@ void Simulation::build_line(std::size_t li) {
                                          splitmix64(m_seed ^ splitmix64(li + 1)));
   ls->line->set_index(static_cast<int>(li));
   ls->stations.reserve(pl.stations.size());
+  const bool extra_here = m_opts.extra_device != nullptr && m_opts.extra_line == pl.name;
+  bool extra_done = false;
   for (const PlanStation& ps : pl.stations) {
+    if (m_opts.omit_masters && (ps.kind == StationKind::Master || ps.kind == StationKind::DpMaster)) {
+      bool redundant_side = false;
+      if (ps.kind == StationKind::DpMaster) {
+        const auto it = std::find_if(m_plan.dp_masters.begin(), m_plan.dp_masters.end(),
+                                     [&](const DpMasterPlan& m) { return m.source == ps.source; });
+        const int mi = static_cast<int>(it - m_plan.dp_masters.begin());
+        for (auto& node : m_redundant) redundant_side |= node->side_of_master(mi) >= 0;
+      }
+      if (!redundant_side) {
+        if (extra_here && !extra_done) {
+          ls->line->attach(*m_opts.extra_device, m_opts.extra_label);
+          extra_done = true;
+        } else {
+          ls->inert.push_back(std::make_unique<InertDevice>());
+          ls->line->attach(*ls->inert.back(), "omitted master " + std::to_string(ps.address.value_or(0)));
+        }
+        continue;
+      }
+    }
     Station st;
     st.kind = ps.kind;
     st.address = ps.address.value_or(0);
@@ -244,6 +277,7 @@ void Simulation::build_line(std::size_t li) {
     }
     ls->stations.push_back(std::move(st));
   }
+  if (extra_here && !extra_done) ls->line->attach(*m_opts.extra_device, m_opts.extra_label);
   m_lines.push_back(std::move(ls));
 }
 

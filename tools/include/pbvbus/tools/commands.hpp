@@ -18,5 +18,7 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timing(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_gateway(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err);
+/// `pbvbus replay` (cmd_replay.cpp, docs/replay.md).
+int cmd_replay(const Args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace pbvbus::tools

@@ -59,6 +59,17 @@ struct SimulationOptions {
   /// capture_probes.hpp places them; `probe` is the default position.
   captures::PcapngWriter* capture = nullptr;
   ProbeDefault probe;
+  /// Replay (`pbvbus replay`, docs/replay.md): build no FDL masters and no DP masters (sides of
+  /// a redundant master system excepted); each takes its cable position with an inert device
+  /// (so fault positions and probes stay where the scenario put them), except the first master
+  /// of `extra_line`, whose position `extra_device` takes.
+  bool omit_masters = false;
+  /// One device from outside (not owned; must outlive the Simulation) attached to the line named
+  /// `extra_line` before the run: at its first omitted master's position, else after its last
+  /// station. Powered with the line. Ignored if no line has that name.
+  bus::Device* extra_device = nullptr;
+  std::string extra_line;
+  std::string extra_label = "replayer";
 };
 
 class Simulation {

@@ -52,6 +52,11 @@ struct Reply {
   fdl::ResponseStatus status{};
   std::vector<std::uint8_t> data;  ///< DU (Telegram)
   std::string error;               ///< why Bad
+  // Additions (cbat): the reply's addressing (Telegram), to check the mirror rule of §B.2.
+  std::uint8_t da = 0;
+  std::uint8_t sa = 0;
+  std::optional<std::uint8_t> dsap;
+  std::optional<std::uint8_t> ssap;
   bool ok_with_data() const;       ///< Telegram with status DL or DH
   bool rs() const;                 ///< Telegram with status RS
   std::string describe() const;    ///< "SC", "DL 02 05 00 ...", "no reply", "bad frame: ..."

@@ -49,6 +49,45 @@ std::string short_name(const GsdFile& gsd) {
   return std::filesystem::path(gsd.file_name()).filename().string();
 }
 
+/// The engine-level half of a mutant (the FDL ones map to None here).
+dp::EngineMutation engine_mutation(std::optional<SlaveMutant> m) {
+  using E = dp::EngineMutation;
+  if (!m) return E::None;
+  switch (*m) {
+    case SlaveMutant::TsdrTooLate:
+    case SlaveMutant::IgnoreMinTsdr:
+    case SlaveMutant::IgnoreFcb: return E::None;
+    case SlaveMutant::NoPrmReqBit: return E::NoPrmReqBit;
+    case SlaveMutant::AcceptWrongIdent: return E::AcceptWrongIdent;
+    case SlaveMutant::IgnoreWatchdog: return E::IgnoreWatchdog;
+    case SlaveMutant::TearConsistent: return E::TearConsistent;
+    case SlaveMutant::WrongGetCfg: return E::WrongGetCfg;
+    case SlaveMutant::IgnoreClearData: return E::IgnoreClearData;
+    case SlaveMutant::IgnoreLock: return E::IgnoreLock;
+    case SlaveMutant::AcceptWrongCfg: return E::AcceptWrongCfg;
+    case SlaveMutant::IgnoreFreeze: return E::IgnoreFreeze;
+    case SlaveMutant::IgnoreSync: return E::IgnoreSync;
+    case SlaveMutant::SlowSlaveInterval: return E::SlowSlaveInterval;
+    case SlaveMutant::KeepStateOnPowerCycle: return E::KeepStateOnPowerCycle;
+    case SlaveMutant::Dpv1BadIndexAccepted: return E::Dpv1BadIndexAccepted;
+    case SlaveMutant::RejectFailSafe: return E::RejectFailSafe;
+    case SlaveMutant::WrongDiagIdent: return E::WrongDiagIdent;
+  }
+  return E::None;
+}
+
+/// The FDL-level half of a mutant; `mutant_tsdr` is the delay tsdr_too_late answers at.
+fdl::PassiveMutation passive_mutation(std::optional<SlaveMutant> m, std::uint32_t mutant_tsdr) {
+  fdl::PassiveMutation p;
+  if (m == SlaveMutant::TsdrTooLate) p.fixed_tsdr = mutant_tsdr;
+  if (m == SlaveMutant::IgnoreMinTsdr) p.ignore_min_tsdr = true;
+  if (m == SlaveMutant::IgnoreFcb) p.ignore_fcb = true;
+  return p;
+}
+
+/// tsdr_too_late answers this far beyond the GSD's MaxTsdr.
+constexpr std::uint32_t kTooLateMargin = 20;
+
 std::string module_list_text(const GsdFile& gsd) {
   std::string s;
   for (std::size_t i = 0; i < gsd.modules().size(); ++i) {
@@ -190,7 +229,9 @@ SlaveSetup derive_slave_setup(const GsdFile& gsd, const std::vector<ModuleChoice
   }
 
   const auto max_tsdr = gsd.max_tsdr(bp.baud);
-  const std::uint32_t tsdr = options.tsdr.value_or(bp.min_tsdr);
+  const bool too_late = options.mutant == SlaveMutant::TsdrTooLate;
+  const std::uint32_t tsdr = too_late && max_tsdr ? *max_tsdr + kTooLateMargin
+                                                  : options.tsdr.value_or(bp.min_tsdr);
   if (!max_tsdr) {
     std::string sup;
     for (const auto& b : gsd.baud_rates()) sup += (sup.empty() ? "" : ", ") + std::string(bus::baud_name(b.baud));
@@ -200,7 +241,7 @@ SlaveSetup derive_slave_setup(const GsdFile& gsd, const std::vector<ModuleChoice
     if (tsdr < bp.min_tsdr)
       r.errors.push_back("TSDR " + std::to_string(tsdr) + " t_bit is below the min TSDR " +
                          std::to_string(bp.min_tsdr) + " t_bit");
-    if (tsdr > *max_tsdr)
+    if (tsdr > *max_tsdr && !too_late)  // the mutant bypasses exactly this bound
       r.errors.push_back("TSDR " + std::to_string(tsdr) + " t_bit is above the GSD's MaxTsdr_" +
                          std::string(bus::baud_name(bp.baud)) + " = " + std::to_string(*max_tsdr) +
                          " t_bit");
@@ -281,6 +322,7 @@ SlaveSetup derive_slave_setup(const GsdFile& gsd, const std::vector<ModuleChoice
   for (std::size_t i : chosen) cfg.modules.push_back({gsd.modules()[i].config, gsd.modules()[i].name});
   cfg.min_slave_interval = std::max<std::uint16_t>(1, sf.min_slave_intervall);
   cfg.max_diag_len = std::clamp<std::size_t>(sf.max_diag_data_len, dp::kStdDiagLen, dp::kMaxDiagLen);
+  cfg.mutation = engine_mutation(options.mutant);
   r.modules = std::move(chosen);
   r.user_prm = std::move(prm);
   r.tsdr = tsdr;
@@ -320,6 +362,8 @@ SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleCh
   m->m_port = std::make_unique<Port>(*m);
   m->m_station = std::make_unique<fdl::PassiveStation>(options.address, bp, *m->m_user, tsdr);
   m->m_station->bind(*m->m_port);
+  m->m_mutant = options.mutant;
+  if (options.mutant) m->m_station->set_mutation(passive_mutation(options.mutant, tsdr));
   std::size_t max_in = 0, max_out = 0;
   for (std::size_t k = 0; k < chosen.size(); ++k) {
     Module mod;

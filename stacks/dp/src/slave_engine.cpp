@@ -53,7 +53,7 @@ void SlaveEngine::apply_outputs() {
 }
 
 void SlaveEngine::snapshot_inputs(std::span<std::uint8_t> out) {
-  if (m_freeze_mode)
+  if (m_freeze_mode && !mutated(EngineMutation::IgnoreFreeze))
     std::copy_n(m_frozen.begin(), m_layout.inputs, out.begin());
   else
     m_app.m_image.read_all_inputs(out.first(m_layout.inputs));
@@ -91,7 +91,11 @@ void SlaveEngine::go_wait_prm() {
   m_dpv1 = {};
 }
 
-void SlaveEngine::on_power_on(bus::Ticks /*now*/) {
+void SlaveEngine::on_power_on(bus::Ticks now) {
+  if (mutated(EngineMutation::KeepStateOnPowerCycle)) {  // mutant: nothing is forgotten
+    if (m_wd_on) m_wd_deadline = now + m_wd_ticks;
+    return;
+  }
   m_prm_fault = m_cfg_fault = m_not_supported = false;
   m_cfg_fault_modules.clear();
   go_wait_prm();
@@ -103,7 +107,8 @@ void SlaveEngine::on_power_on(bus::Ticks /*now*/) {
 // --- time ---------------------------------------------------------------------------------------
 
 bus::Ticks SlaveEngine::next_deadline() const {
-  bus::Ticks t = m_wd_on ? m_wd_deadline : bus::kNever;
+  bus::Ticks t =
+      m_wd_on && !mutated(EngineMutation::IgnoreWatchdog) ? m_wd_deadline : bus::kNever;
   for (const auto& c : m_c2)
     if (c.st != C2Connection::St::Closed) t = std::min(t, c.deadline);
   return t;
@@ -112,7 +117,8 @@ bus::Ticks SlaveEngine::next_deadline() const {
 void SlaveEngine::on_time(bus::Ticks now) { check_timers(now); }
 
 void SlaveEngine::check_timers(bus::Ticks now) {
-  if (m_wd_on && now >= m_wd_deadline) {  // watchdog expiry (§D.8)
+  if (m_wd_on && now >= m_wd_deadline &&
+      !mutated(EngineMutation::IgnoreWatchdog)) {  // watchdog expiry (§D.8)
     ++m_stats.watchdog_expiries;
     go_wait_prm();
   }
@@ -145,7 +151,22 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
   if (!ind.dsap) {
     if (is_srd(ind.fn)) {
       ++m_stats.data_exchange;
-      handle_data_exchange(ind, reply);
+      if (mutated(EngineMutation::SlowSlaveInterval)) [[unlikely]] {
+        // Mutant: still busy with the last one; 10 x Min_Slave_Interval (100 us units).
+        const bus::Ticks busy =
+            10 * static_cast<bus::Ticks>(m_cfg.min_slave_interval) * (bus::kTicksPerMs / 10);
+        if (from_owner && m_last_dx_valid && ind.now - m_last_dx < busy) {
+          reply.none();
+          return;
+        }
+        handle_data_exchange(ind, reply);
+        if (from_owner && reply.kind != Reply::Kind::Status) {
+          m_last_dx = ind.now;
+          m_last_dx_valid = true;
+        }
+      } else {
+        handle_data_exchange(ind, reply);
+      }
     } else {
       ++m_stats.other;
     }
@@ -157,8 +178,15 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
       case kSapChkCfg: handle_chk_cfg(ind, reply); break;
       case kSapSlaveDiag: handle_slave_diag(ind, reply); break;
       case kSapGetCfg:
-        if (m_layout.cfg.empty()) reply.short_ack();
-        else reply.respond(ResponseStatus::DL, m_layout.cfg);
+        if (m_layout.cfg.empty()) {
+          reply.short_ack();
+        } else if (mutated(EngineMutation::WrongGetCfg)) {  // mutant: last octet + 1
+          std::vector<std::uint8_t> cfg = m_layout.cfg;
+          ++cfg.back();
+          reply.respond(ResponseStatus::DL, cfg);
+        } else {
+          reply.respond(ResponseStatus::DL, m_layout.cfg);
+        }
         break;
       case kSapGlobalControl: handle_global_control(ind, reply); break;
       case kSapSetSlaveAdd: handle_set_slave_add(ind, reply); break;
@@ -202,7 +230,8 @@ void SlaveEngine::count_request(std::uint8_t dsap) {
 void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
   if (m_state == SlaveState::PowerOn) return;  // RS
   reply.short_ack();
-  if (m_master != kNoMaster && ind.sa != m_master) return;  // locked by another master
+  if (m_master != kNoMaster && ind.sa != m_master && !mutated(EngineMutation::IgnoreLock))
+    return;  // locked by another master
 
   PrmView pv;
   if (!parse_prm(ind.data, pv)) {
@@ -240,7 +269,7 @@ void SlaveEngine::handle_set_prm(const Indication& ind, Reply& reply) {
   }
   bool fault = false;
   bool not_supported = false;
-  if (h.ident != m_cfg.ident) fault = true;
+  if (h.ident != m_cfg.ident && !mutated(EngineMutation::AcceptWrongIdent)) fault = true;
   if (h.wd_on() && (h.wd_fact_1 == 0 || h.wd_fact_2 == 0)) fault = true;
   if ((h.sync_req() && !f.sync) || (h.freeze_req() && !f.freeze)) not_supported = true;
   const std::size_t up = pv.user_prm.size();
@@ -329,6 +358,10 @@ void SlaveEngine::handle_chk_cfg(const Indication& ind, Reply& reply) {
       m_cfg_fault_span = std::max(m_cfg_fault_span, mod + 1);
     }
   }
+  if (!ok && mutated(EngineMutation::AcceptWrongCfg)) {  // mutant: any Chk_Cfg will do
+    ok = true;
+    m_cfg_fault_modules.clear();
+  }
   if (!ok) {
     ++m_stats.cfg_faults;
     go_wait_prm();
@@ -343,13 +376,16 @@ void SlaveEngine::handle_chk_cfg(const Indication& ind, Reply& reply) {
 
 void SlaveEngine::build_diag() {
   StandardDiag sd;
-  sd.ident = m_cfg.ident;
+  sd.ident = mutated(EngineMutation::WrongDiagIdent) ? static_cast<std::uint16_t>(m_cfg.ident + 1)
+                                                    : m_cfg.ident;
   sd.master_add = m_master;
   if (m_state != SlaveState::DataExch) sd.status_1 |= kDiagStationNotReady;
   if (m_cfg_fault) sd.status_1 |= kDiagCfgFault;
   if (m_not_supported) sd.status_1 |= kDiagNotSupported;
   if (m_prm_fault) sd.status_1 |= kDiagPrmFault;
-  if (m_state == SlaveState::PowerOn || m_state == SlaveState::WaitPrm) sd.status_2 |= kDiagPrmReq;
+  if ((m_state == SlaveState::PowerOn || m_state == SlaveState::WaitPrm) &&
+      !mutated(EngineMutation::NoPrmReqBit))
+    sd.status_2 |= kDiagPrmReq;
   if (m_wd_on) sd.status_2 |= kDiagWdOn;
   if (m_freeze_mode) sd.status_2 |= kDiagFreezeMode;
   if (m_sync_mode) sd.status_2 |= kDiagSyncMode;
@@ -406,8 +442,9 @@ void SlaveEngine::handle_data_exchange(const Indication& ind, Reply& reply) {
     std::copy(ind.data.begin(), ind.data.end(), m_rx_outputs.begin());
     std::copy(ind.data.begin(), ind.data.end(), m_last_rx.begin());
     m_fail_safe_zero = false;
-    if (!m_sync_mode && !m_clear) apply_outputs();
-  } else if (ind.data.empty() && m_cfg.features.fail_safe) {
+    if ((!m_sync_mode || mutated(EngineMutation::IgnoreSync)) && !m_clear) apply_outputs();
+  } else if (ind.data.empty() && m_cfg.features.fail_safe &&
+             !mutated(EngineMutation::RejectFailSafe)) {
     // Fail_Safe: the master in Clear sends no output data at all.
     m_fail_safe_zero = true;
     if (!m_sync_mode) set_outputs_safe();
@@ -416,6 +453,7 @@ void SlaveEngine::handle_data_exchange(const Indication& ind, Reply& reply) {
     return;  // RS: the slave has left data exchange
   }
   snapshot_inputs(m_inputs);
+  if (mutated(EngineMutation::TearConsistent)) [[unlikely]] tear_inputs();
   const std::uint32_t gen = m_app.m_diag_gen.load(std::memory_order_acquire);
   if (gen != m_seen_diag_gen) m_diag_pending = true;
   const ResponseStatus st = m_diag_pending ? ResponseStatus::DH : ResponseStatus::DL;
@@ -423,6 +461,18 @@ void SlaveEngine::handle_data_exchange(const Indication& ind, Reply& reply) {
     reply.short_ack();
   else
     reply.respond(st, {m_inputs.data(), m_layout.inputs});
+}
+
+void SlaveEngine::tear_inputs() {
+  for (const ModuleLayout& m : m_layout.modules) {
+    if (!m.consistent || m.in_len < 2) continue;
+    const std::size_t half = m.in_len / 2;
+    for (std::size_t i = m.in_offset; i < m.in_offset + m.in_len; ++i) {
+      const std::uint8_t now = m_inputs[i];
+      if (i < m.in_offset + half) m_inputs[i] = m_tear_prev[i];
+      m_tear_prev[i] = now;
+    }
+  }
 }
 
 void SlaveEngine::handle_rd_inp(Reply& reply) {
@@ -448,7 +498,7 @@ void SlaveEngine::handle_global_control(const Indication& ind, Reply& reply) {
   const std::uint8_t groups = ind.data[1];
   if (groups != 0 && (groups & m_group) == 0) return;  // not for our groups
 
-  const bool clear = (cmd & 0x02) != 0;
+  const bool clear = (cmd & 0x02) != 0 && !mutated(EngineMutation::IgnoreClearData);
   if (clear && !m_clear) set_outputs_safe();
   m_clear = clear;
 
@@ -515,6 +565,17 @@ void SlaveEngine::record_request(std::span<const std::uint8_t> pdu, std::uint8_t
       const auto it = m_app.m_write_handlers.find(record_key(rq.slot, rq.index));
       if (it != m_app.m_write_handlers.end()) wh = it->second;
     }
+  }
+  if (!rh && !wh && fn == kFnRead && rq.slot <= m_layout.modules.size() &&
+      mutated(EngineMutation::Dpv1BadIndexAccepted)) {
+    // Mutant: an unknown index reads as zeros instead of "invalid index".
+    std::array<std::uint8_t, 4 + kMaxRecordData> out{};
+    out[0] = fn;
+    out[1] = rq.slot;
+    out[2] = rq.index;
+    out[3] = rq.length;
+    reply.respond(ResponseStatus::DL, {out.data(), 4u + rq.length});
+    return;
   }
   if (!rh && !wh)
     return negative(rq.slot > m_layout.modules.size() ? dpv1_err::kInvalidSlot

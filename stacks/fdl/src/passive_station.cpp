@@ -11,6 +11,8 @@ PassiveStation::PassiveStation(std::uint8_t address, const BusParams& params, Re
 }
 
 std::uint32_t PassiveStation::response_delay() const {
+  if (m_mutation.fixed_tsdr) [[unlikely]]  // mutant tsdr_too_late: no max TSDR bound
+    return std::max(m_min_tsdr, *m_mutation.fixed_tsdr);
   if (m_own_tsdr == 0) return m_min_tsdr;
   return std::max(m_min_tsdr, std::min(m_own_tsdr, m_params.max_tsdr));
 }
@@ -35,7 +37,8 @@ void PassiveStation::on_power_off(bus::Ticks) {
 void PassiveStation::apply_pending() {
   if (!m_pending) return;
   if (m_pending_address) m_address = *m_pending_address;
-  if (m_pending_min_tsdr && *m_pending_min_tsdr != 0) m_min_tsdr = *m_pending_min_tsdr;
+  if (m_pending_min_tsdr && *m_pending_min_tsdr != 0 && !m_mutation.ignore_min_tsdr)
+    m_min_tsdr = *m_pending_min_tsdr;
   m_pending = false;
   m_pending_at = bus::kNever;
   m_pending_address.reset();
@@ -88,7 +91,8 @@ void PassiveStation::on_frame(const bus::RxFrame& frame) {
   }
 
   const bool answer = fn_expects_reply(fn) && t.da != kBroadcast;
-  if (answer && m_responder.check(t) == Responder::Check::Repeat) {
+  if (answer && m_responder.check(t) == Responder::Check::Repeat &&
+      !m_mutation.ignore_fcb) {
     ++m_stats.repeats;
     const Frame& f = m_responder.stored_reply(t.sa);
     if (!f.empty()) {

@@ -105,15 +105,33 @@ class TestBus {
     bus::Ticks start = 0;
     bus::Ticks end = 0;
     std::uint32_t flags = 0;
+    /// Set for a line event instead of a frame ("power off DUT", "cable cut", ...); then bytes
+    /// is empty and start = end = the event's time. (Addition by cbat.)
+    std::string event;
   };
   const std::vector<ExtraFrame>& extra_frames() const { return m_extra; }
   /// Index into transcript() for a test's evidence: since(mark()) = what it sent after.
   std::size_t mark() const { return m_transcript.size(); }
   std::span<const Exchange> since(std::size_t mark) const;
 
+  // --- additions (cbat) -------------------------------------------------------------------
+  /// Bit times of the line's baud in `ticks` (rounded down) and back.
+  std::int64_t bits(bus::Ticks ticks) const { return bus::ticks_to_bits(ticks, baud()); }
+  bus::Ticks ticks(std::int64_t bits) const { return bus::bits_to_ticks(bits, baud()); }
+  /// End of the last frame anyone sent on the line (the TSYN reference of the next request).
+  bus::Ticks line_free_at() const;
+  /// The attachment of the device under test (valid after attach_dut()).
+  bus::AttachmentId dut_attachment() const { return m_dut_att; }
+
  private:
   class Tester;
   void run_until(bus::Ticks t, const std::function<bool()>& done);
+  // Additions (cbat): the shared body of request()/send_no_reply(), and draining what the
+  // tester heard outside a reply window into extra_frames().
+  Exchange transmit(std::span<const std::uint8_t> telegram, std::string note,
+                    std::optional<bus::Ticks> not_before, bool expects_reply);
+  void settle();
+  void drain_heard();
 
   TestBusOptions m_opt;
   bus::Scheduler m_sched;

@@ -56,6 +56,9 @@
 //   device-related block as an alarm/status type. Back to RUN: the block is removed (its
 //   absence is MDL_STOP = 0) and Ext_Diag cleared; inputs follow the behaviours again. Each
 //   change makes the next Data_Exchange answer DH, so the master reads the new diagnosis.
+// - Mutants (SlaveModelOptions::mutant): tsdr_too_late, ignore_min_tsdr and ignore_fcb become an
+//   fdl::PassiveMutation on the station, the others a dp::EngineMutation in the SlaveConfig
+//   (derive_slave_setup). A mutant changes nothing else; SlaveModel::mutant() reports it.
 // - Time-based behaviours use absolute virtual time (tick 0 = line start), so values at a given
 //   time are known in advance and survive power cycles.
 
@@ -71,6 +74,7 @@
 #include "pbvbus/devices/gsd.hpp"
 #include "pbvbus/devices/io_behaviour.hpp"
 #include "pbvbus/devices/slave_fault.hpp"
+#include "pbvbus/devices/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
@@ -93,6 +97,10 @@ struct SlaveModelOptions {
   fdl::BusParams bus_params;  ///< the line's parameters (baud, min TSDR)
   std::optional<std::uint32_t> tsdr;  ///< own station delay in t_bit; unset = bus min TSDR
   std::string name;           ///< for reports; default "<Model_Name> @<address>"
+  /// Test-only: a mutant that breaks one rule on purpose (slave_mutant.hpp, docs/mutants.md).
+  /// tsdr_too_late replaces `tsdr` by the GSD's MaxTsdr at the line's baud + 20 t_bit and skips
+  /// the MaxTsdr bound check; the others leave the setup as it is.
+  std::optional<SlaveMutant> mutant;
 };
 
 class SlaveModel;
@@ -170,6 +178,8 @@ class SlaveModel final : public bus::Device {
   std::size_t gsd_module(std::size_t m) const { return m_modules[m].gsd_index; }
   /// The User_Prm_Data the slave expects (all parameters at their defaults).
   const GsdBytes& default_user_prm() const { return m_default_prm; }
+  /// The mutant this model was built with (test-only), if any.
+  std::optional<SlaveMutant> mutant() const { return m_mutant; }
 
   // --- I/O behaviours (before start or on the bus thread). Errors: empty string = ok.
   /// Replaces module m's behaviours by one covering all its input octets.
@@ -223,6 +233,7 @@ class SlaveModel final : public bus::Device {
   GsdBytes m_default_prm;
   bool m_dpv1_pull_plug = false;
   bool m_dpv1 = false;
+  std::optional<SlaveMutant> m_mutant;
   std::unique_ptr<dp::SlaveEngine> m_engine;
   std::unique_ptr<User> m_user;
   std::unique_ptr<Port> m_port;

@@ -71,6 +71,27 @@ enum class PrmCmdResult : std::uint8_t {
 /// Called on the bus thread inside the Set_Prm, after every other check has passed.
 using PrmCmdHandler = std::function<PrmCmdResult(const PrmCmdView&)>;
 
+/// Test-only: breaks one rule on purpose (devices/slave_mutant.hpp, docs/mutants.md). Each value
+/// is checked at the one place its rule lives in SlaveEngine; None is the conformant slave.
+enum class EngineMutation : std::uint8_t {
+  None,
+  NoPrmReqBit,            ///< Slave_Diag in Power_On/Wait_Prm lacks Prm_Req (octet 2 bit 0)
+  AcceptWrongIdent,       ///< Set_Prm with another Ident_Number is accepted
+  IgnoreWatchdog,         ///< the watchdog never expires (WD_On is still reported)
+  TearConsistent,         ///< Data_Exchange: a consistent module's first half from the previous image
+  WrongGetCfg,            ///< Get_Cfg: the last octet of the real configuration + 1
+  IgnoreClearData,        ///< Global_Control Clear_Data has no effect on the outputs
+  IgnoreLock,             ///< Set_Prm from another master accepted while locked
+  AcceptWrongCfg,         ///< a Chk_Cfg that does not match is accepted
+  IgnoreFreeze,           ///< Freeze acknowledged (Freeze_Mode) but the inputs are not frozen
+  IgnoreSync,             ///< Sync acknowledged (Sync_Mode) but outputs are applied at once
+  SlowSlaveInterval,      ///< Data_Exchange < 10 x Min_Slave_Interval after the last one: no answer
+  KeepStateOnPowerCycle,  ///< on_power_on keeps the parameterisation and the state
+  Dpv1BadIndexAccepted,   ///< MSAC_C1 Read of an unknown index answers zero data, not 80 B0 00
+  RejectFailSafe,         ///< zero-length Data_Exchange refused (RS) although Fail_Safe
+  WrongDiagIdent,         ///< Slave_Diag octets 5..6 = Ident_Number + 1
+};
+
 struct SlaveConfig {
   std::uint16_t ident = 0;
   SlaveFeatures features;
@@ -84,6 +105,8 @@ struct SlaveConfig {
   std::vector<SlaveModule> modules;  ///< the real configuration, in Get_Cfg order
   std::uint16_t min_slave_interval = 1;  ///< 100 us units (GSD Min_Slave_Intervall)
   std::size_t max_diag_len = 244;        ///< GSD Max_Diag_Data_Len (6..244)
+  /// test-only: breaks one rule on purpose (devices/slave_mutant.hpp); default none.
+  EngineMutation mutation = EngineMutation::None;
 };
 
 /// Where a module's data sits in the Data_Exchange telegrams.

@@ -70,6 +70,18 @@
 //   counting the requests it got an answer to sees the same numbers). Counters run from
 //   construction; power cycles do not reset them.
 //
+// - Mutations (SlaveConfig::mutation, test-only; devices/slave_mutant.hpp, docs/mutants.md):
+//   each breaks one rule at the one place that rule is implemented here and leaves the rest
+//   alone. Notable choices: IgnoreWatchdog still reports WD_On (only the expiry is gone) and
+//   never asks for a timer; IgnoreFreeze/IgnoreSync still set Freeze_Mode/Sync_Mode in the
+//   diagnosis; KeepStateOnPowerCycle also restarts the watchdog at power-on (so the kept state
+//   survives a power-off longer than the watchdog); SlowSlaveInterval measures from the last
+//   Data_Exchange it answered (an ignored request does not make the ASIC busy) and stays silent
+//   (Reply::None; an FCB repeat of it is silent too); TearConsistent swaps the first half
+//   (in_len / 2 octets) of each consistent module with the image of the previous
+//   Data_Exchange; Dpv1BadIndexAccepted answers a Read of an unknown index in an existing slot
+//   with the requested length of zero octets (Writes and unknown slots keep their error).
+//
 // Performance: the Data_Exchange path does not allocate (fixed buffers; Reply::data keeps its
 // capacity when the station reuses its Reply).
 
@@ -197,6 +209,9 @@ class SlaveEngine final : public fdl::ResponderUser {
   void apply_outputs();
   void snapshot_inputs(std::span<std::uint8_t> out);
   void build_diag();
+  bool mutated(EngineMutation m) const { return m_cfg.mutation == m; }
+  /// TearConsistent: the first half of every consistent module from the previous image.
+  void tear_inputs();
 
   SlaveConfig m_cfg;
   SlaveLayout m_layout;
@@ -236,6 +251,10 @@ class SlaveEngine final : public fdl::ResponderUser {
   std::vector<C2Connection> m_c2;
   std::uint32_t m_next_record_id = 1;
   SlaveStats m_stats;
+  // Mutations only (test-only; see SlaveConfig::mutation).
+  std::array<std::uint8_t, kMaxIoLen> m_tear_prev{};  ///< TearConsistent: the previous image
+  bus::Ticks m_last_dx = 0;                          ///< SlowSlaveInterval: last answered one
+  bool m_last_dx_valid = false;
 
 };
 

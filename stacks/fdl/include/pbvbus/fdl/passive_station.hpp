@@ -18,6 +18,10 @@
 //    (immediately if there is no reply). The address survives a power cycle (real slaves keep a
 //    Set_Slave_Add address in non-volatile memory); min TSDR does not.
 //  - No heap allocation per frame: the Reply handed to the user is a member, reused.
+//  - Mutations (PassiveMutation, test-only: devices/slave_mutant.hpp, docs/mutants.md) each
+//    break one of the rules above on purpose: a fixed reply delay outside the [min TSDR,
+//    max TSDR] bounds (only a larger requested min TSDR still wins), a requested min TSDR not
+//    applied, or FCB repeats executed as new requests (their FCB is still stored).
 
 #include <cstdint>
 #include <optional>
@@ -36,6 +40,16 @@ struct PassiveStats {
   std::uint64_t fdl_status = 0;       ///< Request FDL Status answered
   std::uint64_t dropped_errors = 0;   ///< frames with error flags or decode errors
   std::uint64_t dropped_tsyn = 0;     ///< requests after less than TSYN idle
+};
+
+/// Test-only: breaks one rule on purpose (devices/slave_mutant.hpp). Default: conformant.
+struct PassiveMutation {
+  /// tsdr_too_late: reply after exactly this many t_bit (or the requested min TSDR if larger),
+  /// NOT clamped to max TSDR.
+  std::optional<std::uint32_t> fixed_tsdr;
+  bool ignore_min_tsdr = false;  ///< ignore_min_tsdr: Reply::new_min_tsdr is never applied
+  bool ignore_fcb = false;       ///< ignore_fcb: an FCB repeat goes to the user as a new request
+  bool any() const { return fixed_tsdr || ignore_min_tsdr || ignore_fcb; }
 };
 
 class PassiveStation final : public bus::Device {
@@ -66,6 +80,9 @@ class PassiveStation final : public bus::Device {
   std::uint32_t response_delay() const;
   const BusParams& params() const { return m_params; }
   const PassiveStats& stats() const { return m_stats; }
+  /// Test-only (mutant slaves): breaks one FDL rule on purpose; see PassiveMutation.
+  void set_mutation(const PassiveMutation& m) { m_mutation = m; }
+  const PassiveMutation& mutation() const { return m_mutation; }
 
  private:
   void apply_pending();
@@ -84,6 +101,7 @@ class PassiveStation final : public bus::Device {
   std::optional<std::uint8_t> m_pending_address;
   std::optional<std::uint32_t> m_pending_min_tsdr;
   PassiveStats m_stats;
+  PassiveMutation m_mutation;
   bool m_powered = false;
 };
 

@@ -1,0 +1,121 @@
+// Group "Chk_Cfg" (CFG-nn): the configuration check (protocol-facts §D.3, §D.4, §D.8).
+//
+// Decisions:
+// - Chk_Cfg is answered SC; a mismatch shows as Cfg_Fault (diag octet 1 bit 2) with Station_
+//   Not_Ready, and the slave goes back to Wait_Prm (Prm_Req), so Data_Exchange gets RS.
+// - "One identifier changed": the first identifier octet with its lowest bit flipped (a general
+//   identifier then has another length; a special one another count) — the same length, other
+//   meaning. "Wrong length": the last octet dropped, or an identifier 0x10 added to a one-octet
+//   configuration.
+// - Chk_Cfg in Wait_Prm: refused means the slave does not reach Data_Exch — RS, or SC without
+//   effect (the diagnosis still shows Prm_Req and Not_Ready); either passes.
+
+#include "groups.hpp"
+#include "pbvbus/dp/diagnosis.hpp"
+#include "steps.hpp"
+
+namespace pbvbus::conformance::detail {
+
+namespace {
+
+using devices::SlaveMutant;
+
+constexpr const char* kGroup = "Chk_Cfg";
+
+std::uint16_t ident(TestContext& ctx) { return ctx.spec().gsd->ident_number(); }
+
+void right_config(TestContext& ctx, TestResult& r) {
+  auto s = open_session(ctx, r);
+  if (!s) return;
+  const auto prm = prm_du(ctx.params());
+  if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm)))) return;
+  const auto cfg = cfg_du(ctx.params());
+  if (check(r, "Chk_Cfg with the real configuration", expect_sc(chk_cfg(*s, cfg)))) return;
+  DiagExpect e;
+  e.s1_mask = dp::kDiagStationNotReady | dp::kDiagCfgFault | dp::kDiagPrmFault;
+  e.s1 = 0;
+  e.s2_mask = dp::kDiagPrmReq;
+  e.s2 = 0;
+  e.master = tester_address(*s);
+  e.ident = ident(ctx);
+  check(r, "Slave_Diag (Data_Exch)", check_diag(slave_diag(*s), e));
+}
+
+void expect_cfg_fault(TestContext& ctx, TestResult& r, const std::vector<std::uint8_t>& cfg, const std::string& what) {
+  auto s = open_session(ctx, r);
+  if (!s) return;
+  const auto prm = prm_du(ctx.params());
+  if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm)))) return;
+  if (check(r, "Chk_Cfg, " + what, expect_sc(chk_cfg(*s, cfg, "Chk_Cfg, " + what)))) return;
+  DiagExpect e;
+  e.s1_mask = dp::kDiagStationNotReady | dp::kDiagCfgFault;
+  e.s1 = dp::kDiagStationNotReady | dp::kDiagCfgFault;
+  e.s2_mask = dp::kDiagPrmReq | dp::kDiagAlways1;
+  e.s2 = dp::kDiagPrmReq | dp::kDiagAlways1;
+  e.ident = ident(ctx);
+  if (check(r, "Slave_Diag after Chk_Cfg with " + what + " (Cfg_Fault, back to Wait_Prm)",
+            check_diag(slave_diag(*s), e)))
+    return;
+  const auto out = output_pattern(ctx.output_len(), 0x0F);
+  check(r, "Data_Exchange after the refused Chk_Cfg", expect_rs(data_exchange(*s, out)));
+}
+
+void wrong_identifier(TestContext& ctx, TestResult& r) {
+  auto cfg = cfg_du(ctx.params());
+  if (cfg.empty()) {
+    not_applicable(r, "the configuration is empty");
+    return;
+  }
+  cfg[0] = static_cast<std::uint8_t>(cfg[0] ^ 0x01);
+  expect_cfg_fault(ctx, r, cfg, "one identifier changed");
+}
+
+void wrong_length(TestContext& ctx, TestResult& r) {
+  auto cfg = cfg_du(ctx.params());
+  if (cfg.size() > 1) cfg.pop_back();
+  else cfg.push_back(0x10);
+  expect_cfg_fault(ctx, r, cfg, "wrong length");
+}
+
+void chk_cfg_in_wait_prm(TestContext& ctx, TestResult& r) {
+  auto s = open_session(ctx, r);
+  if (!s) return;
+  const auto cfg = cfg_du(ctx.params());
+  const Reply c = chk_cfg(*s, cfg, "Chk_Cfg in Wait_Prm");
+  if (!c.rs() && c.kind != Reply::Kind::Sc) {
+    fail(r, "Chk_Cfg in Wait_Prm: expected RS (or SC without effect), got " + c.describe());
+    return;
+  }
+  DiagExpect e;
+  e.s1_mask = dp::kDiagStationNotReady;
+  e.s1 = dp::kDiagStationNotReady;
+  e.s2_mask = dp::kDiagPrmReq;
+  e.s2 = dp::kDiagPrmReq;
+  e.ident = ident(ctx);
+  if (check(r, "Slave_Diag (still Wait_Prm)", check_diag(slave_diag(*s), e))) return;
+  const auto out = output_pattern(ctx.output_len(), 0x3C);
+  check(r, "Data_Exchange", expect_rs(data_exchange(*s, out)));
+}
+
+}  // namespace
+
+void add_chk_cfg_tests(std::vector<TestCase>& out) {
+  out.push_back({"CFG-01", kGroup, "Right configuration accepted",
+                 "Chk_Cfg with the slave's real configuration (the GSD modules' identifiers in order) "
+                 "after a good Set_Prm brings it to Data_Exch (§D.3, §D.8)",
+                 right_config, {}});
+  out.push_back({"CFG-02", kGroup, "Wrong identifier refused",
+                 "Chk_Cfg with one identifier changed sets Cfg_Fault (diag octet 1 bit 2) and the "
+                 "slave goes back to Wait_Prm (§D.3, §D.8)",
+                 wrong_identifier, {SlaveMutant::AcceptWrongCfg}});
+  out.push_back({"CFG-03", kGroup, "Wrong configuration length refused",
+                 "Chk_Cfg with more or fewer identifier octets than the real configuration sets "
+                 "Cfg_Fault (§D.3)",
+                 wrong_length, {SlaveMutant::AcceptWrongCfg}});
+  out.push_back({"CFG-04", kGroup, "Chk_Cfg in Wait_Prm refused",
+                 "Before a Set_Prm, Chk_Cfg does not bring the slave to data exchange (Wait_Prm accepts "
+                 "only Set_Prm, Slave_Diag, Get_Cfg, Set_Slave_Add; §D.8)",
+                 chk_cfg_in_wait_prm, {}});
+}
+
+}  // namespace pbvbus::conformance::detail

@@ -1,0 +1,118 @@
+// Group "FCB/FCV" (FCB-nn): frame count bit handling of the slave's FDL layer (protocol-facts
+// §C.6) on Data_Exchange.
+//
+// Decisions:
+// - Whether a repeated Data_Exchange was executed is seen through Rd_Outp (the outputs last
+//   taken), read by ANOTHER master (address 2): FCBs are kept per source address (§C.6), so the
+//   reads do not disturb the tester's FCB sequence. The repeat's reply must also be the stored
+//   reply, byte for byte.
+// - A slave without outputs cannot show whether it took them: n/a.
+// - "Restart after Set_Prm": after re-parameterisation the master starts again with a first
+//   frame (FCV 0, FCB 1); the slave must execute it and store its FCB, so the next frame with
+//   FCB 0 is new (even though the last frame before Set_Prm also had FCB 0) and a repeat of that
+//   one is again a repeat.
+
+#include "groups.hpp"
+#include "steps.hpp"
+
+namespace pbvbus::conformance::detail {
+
+namespace {
+
+using devices::SlaveMutant;
+
+constexpr const char* kGroup = "FCB/FCV";
+constexpr std::uint8_t kReader = 2;
+
+bool setup(TestContext& ctx, TestResult& r, std::unique_ptr<Session>& s) {
+  if (ctx.output_len() == 0) {
+    not_applicable(r, "the configuration has no outputs: a repeat cannot be told from a new request");
+    return false;
+  }
+  s = open_session(ctx, r);
+  if (!s) return false;
+  return !check(r, "start-up", start_up(*s, ctx));
+}
+
+/// Rd_Outp by master 2 must show `want`.
+bool outputs_are(TestResult& r, Session& s, const std::vector<std::uint8_t>& want, const std::string& what) {
+  return !check(r, what, expect_data(rd_outp(s, "Rd_Outp from master 2", kReader), want));
+}
+
+void repeat_not_executed(TestContext& ctx, TestResult& r) {
+  std::unique_ptr<Session> s;
+  if (!setup(ctx, r, s)) return;
+  const auto a = output_pattern(ctx.output_len(), 0x01);
+  const auto b = output_pattern(ctx.output_len(), 0x80);
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  const Exchange first = s->bus().transcript().back();
+  if (!first.answered) {
+    fail(r, "Data_Exchange FCV=1 FCB=1: no reply");
+    return;
+  }
+  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=1 again (repeat), outputs B", std::nullopt, true, true);
+  const Exchange again = s->bus().transcript().back();
+  if (!again.answered) {
+    fail(r, "repeat: no reply");
+    return;
+  }
+  if (again.response != first.response) {
+    fail(r, "repeat: expected the stored reply " + hex(first.response) + ", got " + hex(again.response));
+    return;
+  }
+  outputs_are(r, *s, a, "after the repeat the outputs are still A (the repeat was not executed)");
+}
+
+void toggle_executed(TestContext& ctx, TestResult& r) {
+  std::unique_ptr<Session> s;
+  if (!setup(ctx, r, s)) return;
+  const auto a = output_pattern(ctx.output_len(), 0x02);
+  const auto b = output_pattern(ctx.output_len(), 0x90);
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  if (!outputs_are(r, *s, a, "outputs A taken")) return;
+  data_exchange(*s, b, "Data_Exchange FCV=1 FCB=0 (toggled), outputs B", std::nullopt, true, false);
+  outputs_are(r, *s, b, "after the toggled FCB the outputs are B");
+}
+
+void restart_after_set_prm(TestContext& ctx, TestResult& r) {
+  std::unique_ptr<Session> s;
+  if (!setup(ctx, r, s)) return;
+  const auto a = output_pattern(ctx.output_len(), 0x03);
+  const auto b = output_pattern(ctx.output_len(), 0xA0);
+  const auto c = output_pattern(ctx.output_len(), 0x40);
+  const auto d = output_pattern(ctx.output_len(), 0xC0);
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=1, outputs A", std::nullopt, true, true);
+  data_exchange(*s, a, "Data_Exchange FCV=1 FCB=0, outputs A", std::nullopt, true, false);
+  // Re-parameterisation: Set_Prm + Chk_Cfg (the slave leaves data exchange and comes back).
+  const auto prm = prm_du(ctx.params());
+  if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm, "Set_Prm (re-parameterisation)")))) return;
+  const auto cfg = cfg_du(ctx.params());
+  if (check(r, "Chk_Cfg", expect_sc(chk_cfg(*s, cfg, "Chk_Cfg (re-parameterisation)")))) return;
+  data_exchange(*s, b, "first frame after Set_Prm: FCV=0 FCB=1, outputs B", std::nullopt, false, true);
+  if (!outputs_are(r, *s, b, "first frame after Set_Prm executed (outputs B)")) return;
+  data_exchange(*s, c, "Data_Exchange FCV=1 FCB=0, outputs C (new: toggled from the first frame)",
+                std::nullopt, true, false);
+  if (!outputs_are(r, *s, c, "FCB 0 after the first frame is new (outputs C)")) return;
+  data_exchange(*s, d, "Data_Exchange FCV=1 FCB=0 again (repeat), outputs D", std::nullopt, true, false);
+  outputs_are(r, *s, c, "the repeat is not executed (outputs still C)");
+}
+
+}  // namespace
+
+void add_fcb_tests(std::vector<TestCase>& out) {
+  out.push_back({"FCB-01", kGroup, "Repeat not executed",
+                 "A Data_Exchange with FCV=1 and the same FCB as the previous one from that master is "
+                 "a repeat: the slave resends its stored reply and does not take the new outputs "
+                 "(IEC 61158-4-3 frame count bit; §C.6)",
+                 repeat_not_executed, {SlaveMutant::IgnoreFcb}});
+  out.push_back({"FCB-02", kGroup, "Toggled FCB executed",
+                 "A Data_Exchange with FCV=1 and the FCB toggled is a new request: its outputs are "
+                 "taken (§C.6)",
+                 toggle_executed, {}});
+  out.push_back({"FCB-03", kGroup, "FCB restart after Set_Prm",
+                 "After re-parameterisation the first frame (FCV=0, FCB=1) is executed and starts the "
+                 "FCB sequence again: the next toggled frame is new, its repeat is not (§C.6)",
+                 restart_after_set_prm, {SlaveMutant::IgnoreFcb}});
+}
+
+}  // namespace pbvbus::conformance::detail

@@ -1,0 +1,184 @@
+// The DP services as the battery sends them (steps.hpp).
+
+#include "steps.hpp"
+
+#include <cstdio>
+
+#include "pbvbus/dp/diagnosis.hpp"
+#include "pbvbus/dp/prm.hpp"
+#include "pbvbus/dp/sap.hpp"
+
+namespace pbvbus::conformance::detail {
+
+std::string hex(std::span<const std::uint8_t> b) {
+  std::string s;
+  char buf[4];
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%02X", b[i]);
+    if (i) s += ' ';
+    s += buf;
+  }
+  return s;
+}
+
+std::uint8_t tester_address(Session& s) { return s.bus().options().tester_address; }
+
+Reply service(Session& s, std::optional<std::uint8_t> dsap, std::span<const std::uint8_t> du,
+              std::string note, std::optional<std::uint8_t> sa, bool fcv, bool fcb) {
+  const std::uint8_t from = sa.value_or(tester_address(s));
+  std::optional<std::uint8_t> ssap;
+  if (dsap) ssap = dp::kSapMs0;
+  const auto t = srd(s.dut_address(), from, dsap, ssap, du, fcv, fcb);
+  return reply_of(s.bus().request(t, std::move(note)));
+}
+
+Reply slave_diag(Session& s, std::string note, std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapSlaveDiag, {}, std::move(note), sa);
+}
+Reply set_prm(Session& s, std::span<const std::uint8_t> du, std::string note,
+              std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapSetPrm, du, std::move(note), sa);
+}
+Reply chk_cfg(Session& s, std::span<const std::uint8_t> du, std::string note,
+              std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapChkCfg, du, std::move(note), sa);
+}
+Reply get_cfg(Session& s, std::string note, std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapGetCfg, {}, std::move(note), sa);
+}
+Reply rd_inp(Session& s, std::string note, std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapRdInp, {}, std::move(note), sa);
+}
+Reply rd_outp(Session& s, std::string note, std::optional<std::uint8_t> sa) {
+  return service(s, dp::kSapRdOutp, {}, std::move(note), sa);
+}
+Reply data_exchange(Session& s, std::span<const std::uint8_t> outputs, std::string note,
+                    std::optional<std::uint8_t> sa, bool fcv, bool fcb) {
+  return service(s, std::nullopt, outputs, std::move(note), sa, fcv, fcb);
+}
+
+void global_control(Session& s, std::uint8_t control, std::uint8_t group_select, std::string note,
+                    std::uint8_t da, std::optional<std::uint8_t> sa) {
+  const std::uint8_t du[2] = {control, group_select};
+  const auto t = sdn(da, sa.value_or(tester_address(s)), dp::kSapGlobalControl, dp::kSapMs0, du);
+  s.bus().send_no_reply(t, std::move(note));
+}
+
+std::vector<std::uint8_t> prm_du(const dp::SlaveParams& p) { return p.set_prm_du(); }
+std::vector<std::uint8_t> cfg_du(const dp::SlaveParams& p) { return p.chk_cfg_du(); }
+
+std::string start_up(Session& s, TestContext& ctx, const std::optional<dp::SlaveParams>& params) {
+  const dp::SlaveParams& p = params ? *params : ctx.params();
+  const Reply d0 = slave_diag(s, "start-up: Slave_Diag");
+  if (!d0.ok_with_data()) return "Slave_Diag before Set_Prm: " + d0.describe();
+  const auto prm = prm_du(p);
+  const Reply r1 = set_prm(s, prm, "start-up: Set_Prm");
+  if (r1.kind != Reply::Kind::Sc) return "Set_Prm: expected SC, got " + r1.describe();
+  const auto cfg = cfg_du(p);
+  const Reply r2 = chk_cfg(s, cfg, "start-up: Chk_Cfg");
+  if (r2.kind != Reply::Kind::Sc) return "Chk_Cfg: expected SC, got " + r2.describe();
+  const Reply d1 = slave_diag(s, "start-up: Slave_Diag after Chk_Cfg");
+  if (!d1.ok_with_data() || d1.data.size() < 6) return "Slave_Diag after Chk_Cfg: " + d1.describe();
+  // Ready for data exchange (§D.4, S1): no Non_Existent/Not_Ready/Cfg_Fault/Prm_Fault, no Prm_Req.
+  const std::uint8_t bad1 = dp::kDiagStationNonExistent | dp::kDiagStationNotReady |
+                            dp::kDiagCfgFault | dp::kDiagPrmFault;
+  if ((d1.data[0] & bad1) != 0 || (d1.data[1] & dp::kDiagPrmReq) != 0)
+    return "not ready for data exchange after start-up: diag " + hex(d1.data);
+  return {};
+}
+
+std::vector<std::uint8_t> output_pattern(std::size_t len, std::uint8_t seed) {
+  std::vector<std::uint8_t> v(len);
+  for (std::size_t i = 0; i < len; ++i)
+    v[i] = static_cast<std::uint8_t>(seed + 0x11 * (i + 1));
+  if (len > 0 && v[0] == 0) v[0] = 0x5A;
+  return v;
+}
+
+std::vector<std::uint8_t> expected_diag(std::uint8_t status1, std::uint8_t status2,
+                                        std::uint8_t status3, std::uint8_t master_add,
+                                        std::uint16_t ident) {
+  return {status1, status2, status3, master_add, static_cast<std::uint8_t>(ident >> 8),
+          static_cast<std::uint8_t>(ident & 0xFF)};
+}
+
+std::string expect_data(const Reply& r, std::span<const std::uint8_t> expected, bool exact) {
+  if (!r.ok_with_data()) return "expected DL/DH " + hex(expected) + ", got " + r.describe();
+  const bool same = exact ? (r.data.size() == expected.size() &&
+                             std::equal(expected.begin(), expected.end(), r.data.begin()))
+                          : (r.data.size() >= expected.size() &&
+                             std::equal(expected.begin(), expected.end(), r.data.begin()));
+  if (!same) return "expected " + hex(expected) + (exact ? "" : " ...") + ", got " + hex(r.data);
+  return {};
+}
+
+std::string expect_sc(const Reply& r) {
+  return r.kind == Reply::Kind::Sc ? std::string{} : "expected SC, got " + r.describe();
+}
+
+std::string expect_rs(const Reply& r) {
+  return r.rs() ? std::string{} : "expected RS, got " + r.describe();
+}
+
+std::string check_diag(const Reply& r, const DiagExpect& e) {
+  if (!r.ok_with_data() || r.data.size() < 6)
+    return "expected Slave_Diag data (6+ octets), got " + r.describe();
+  const auto& d = r.data;
+  std::string why;
+  if ((d[0] & e.s1_mask) != e.s1) why += "Station_Status_1 bits " + hex(std::span(d).first(1));
+  if ((d[1] & e.s2_mask) != e.s2) why += (why.empty() ? "" : ", ") + std::string("Station_Status_2");
+  if (e.master && d[3] != *e.master) why += (why.empty() ? "" : ", ") + std::string("Master_Add");
+  if (e.ident && (d[4] != (*e.ident >> 8) || d[5] != (*e.ident & 0xFF)))
+    why += (why.empty() ? "" : ", ") + std::string("Ident_Number");
+  if (why.empty()) return {};
+  return "diag " + hex(d) + ": wrong " + why;
+}
+
+std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expected) {
+  if (!r.ok_with_data() || r.data.size() < 6)
+    return "expected Slave_Diag " + hex(expected) + ", got " + r.describe();
+  std::vector<std::uint8_t> got(r.data.begin(), r.data.begin() + 6);
+  std::vector<std::uint8_t> want(expected.begin(), expected.end());
+  if (r.data.size() > 6) {
+    got[0] &= static_cast<std::uint8_t>(~dp::kDiagExtDiag);
+    want[0] &= static_cast<std::uint8_t>(~dp::kDiagExtDiag);
+    got[2] &= 0x7F;
+    want[2] &= 0x7F;
+  }
+  if (got != want) return "expected diag " + hex(expected) + ", got " + hex(r.data);
+  return {};
+}
+
+std::unique_ptr<Session> open_session(TestContext& ctx, TestResult& r, std::optional<bus::Baud> baud) {
+  std::string err;
+  auto s = ctx.open(baud, err);
+  if (!s) fail(r, "cannot open a session: " + err);
+  return s;
+}
+
+bus::Ticks watchdog_time(const dp::SlaveParams& p) {
+  const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
+  return dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
+}
+
+void fail(TestResult& r, const std::string& why) {
+  if (r.verdict != Verdict::Fail) {
+    r.verdict = Verdict::Fail;
+    r.message = why;
+  }
+}
+
+void not_applicable(TestResult& r, const std::string& why) {
+  if (r.verdict == Verdict::Pass) {
+    r.verdict = Verdict::NotApplicable;
+    r.message = why;
+  }
+}
+
+bool check(TestResult& r, const std::string& what, const std::string& why) {
+  if (why.empty()) return false;
+  fail(r, what + ": " + why);
+  return true;
+}
+
+}  // namespace pbvbus::conformance::detail

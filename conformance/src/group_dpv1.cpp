@@ -6,7 +6,9 @@
 //
 // Decisions:
 // - The whole group is n/a unless the GSD says DPV1_Slave = 1.
-// - Set_Prm carries the GSD-assembled User_Prm_Data with DPV1_Enable (DPV1_Status_1 bit 7) set.
+// - Set_Prm carries the GSD-assembled User_Prm_Data with DPV1_Enable (DPV1_Status_1 bit 7) set;
+//   V1-05's DP-V0 mode clears DPV1_Enable and DPV1_Status_2 (alarm enables, Check_Cfg_Mode),
+//   which only mean something with DPV1_Enable.
 // - A known record: the GSD names no data records and the shipped models register none, so V1-02
 //   is white box — it registers a read handler for slot 1, index 1 answering `AB CD` on the
 //   model's application and reads it; n/a for an outside slave.
@@ -47,8 +49,12 @@ dp::SlaveParams dpv1_params(const TestContext& ctx, bool enable = true) {
   if (p.user_prm.size() < 3) p.user_prm.resize(3, 0);
   if (enable)
     p.user_prm[0] |= dp::kDpv1Enable;
-  else
+  else {
+    // DP-V0 compatibility mode: the alarm enables and Check_Cfg_Mode of DPV1_Status_2 belong to
+    // DP-V1 and go with it (a slave refuses them without DPV1_Enable).
     p.user_prm[0] &= static_cast<std::uint8_t>(~dp::kDpv1Enable);
+    p.user_prm[1] = 0;
+  }
   return p;
 }
 

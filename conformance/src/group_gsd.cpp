@@ -51,7 +51,7 @@ void diag_ident(TestContext& ctx, TestResult& res) {
   run.pass("Slave_Diag carries Ident_Number " + hex(ident_octets(want)) + " before and after the start-up");
 }
 
-void get_cfg(TestContext& ctx, TestResult& res) {
+void get_cfg_is_gsd_cfg(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   std::string why;
@@ -227,7 +227,7 @@ void add_gsd_tests(std::vector<TestCase>& out) {
       "GSD-02", kGroup, "Get_Cfg = the modules' identifiers",
       "Get_Cfg returns the real configuration: the identifiers of the configured GSD modules "
       "(PI 2.122 Module; protocol-facts.md §D.3, §I.1)",
-      {SlaveMutant::WrongGetCfg}, get_cfg));
+      {SlaveMutant::WrongGetCfg}, get_cfg_is_gsd_cfg));
   out.push_back(make_case(
       "GSD-03", kGroup, "Data_Exchange lengths",
       "Data_Exchange takes as many output octets and returns as many input octets as the "

@@ -7,17 +7,6 @@
 
 namespace pbvbus::conformance::detail {
 
-std::string hex(std::span<const std::uint8_t> bytes) {
-  std::string s;
-  s.reserve(bytes.size() * 3);
-  char buf[4];
-  for (std::size_t i = 0; i < bytes.size(); ++i) {
-    std::snprintf(buf, sizeof buf, i == 0 ? "%02X" : " %02X", bytes[i]);
-    s += buf;
-  }
-  return s;
-}
-
 std::optional<dp::StandardDiag> standard_diag(const Reply& r) {
   if (!r.ok_with_data()) return std::nullopt;
   dp::StandardDiag d;

@@ -30,14 +30,12 @@
 #include <vector>
 
 #include "groups.hpp"
+#include "steps.hpp"  // hex()
 #include "pbvbus/conformance/battery.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
 #include "pbvbus/dp/master.hpp"
 
 namespace pbvbus::conformance::detail {
-
-/// "68 05 05 68 ..." (upper-case hex, space separated).
-std::string hex(std::span<const std::uint8_t> bytes);
 
 /// The standard part of a Slave_Diag answer, if it is a telegram with at least six octets.
 std::optional<dp::StandardDiag> standard_diag(const Reply& r);

@@ -28,13 +28,14 @@ TEST(GroupGlobalControl, ClearDataTelegramsOnTheWire) {
   ASSERT_NE(t, nullptr) << describe(r);
   ASSERT_EQ(t->verdict, Verdict::Pass) << t->message;
   // Global_Control Clear_Data, broadcast SDN from the tester (1) to 127:
-  //   SD2 LE LEr SD2 | DA = 127|EXT = FF | SA = 1|EXT = 81 | FC = SDN low 44 (groups.hpp: sdn() is
-  //   low priority; FCV = FCB = 0) | DSAP 3A (58) | SSAP 3E (62) | 02 00 | FCS | ED
-  //   LE = DA SA FC DSAP SSAP + 2 = 7; FCS = FF+81+44+3A+3E+02+00 = 0x23E -> 3E.
+  //   SD2 LE LEr SD2 | DA = 127|EXT = FF | SA = 1|EXT = 81 | FC = SDN high 46 (FCV = FCB = 0,
+  //   §B.4) | DSAP 3A (58) | SSAP 3E (62) | 02 00 | FCS | ED
+  //   LE = DA SA FC DSAP SSAP + 2 = 7; FCS = FF+81+46+3A+3E+02+00 = 0x240 -> 40
+  //   (protocol-facts.md Appendix 1 has the same frame).
   const Exchange* gc = find_exchange(*t, "Clear_Data (02 00)");
   ASSERT_NE(gc, nullptr);
-  EXPECT_EQ(gc->request, (std::vector<std::uint8_t>{0x68, 0x07, 0x07, 0x68, 0xFF, 0x81, 0x44, 0x3A,
-                                                    0x3E, 0x02, 0x00, 0x3E, 0x16}));
+  EXPECT_EQ(gc->request, (std::vector<std::uint8_t>{0x68, 0x07, 0x07, 0x68, 0xFF, 0x81, 0x46, 0x3A,
+                                                    0x3E, 0x02, 0x00, 0x40, 0x16}));
   EXPECT_FALSE(gc->expects_reply);
   EXPECT_FALSE(gc->answered);
   // Data_Exchange with outputs A5 A5 to slave 3, SRD high with FCV = 0 (4D), default SAP:

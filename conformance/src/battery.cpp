@@ -125,6 +125,10 @@ class ContextBase : public TestContext {
     return true;
   }
   bus::Baud baud() const { return m_baud; }
+  /// The tester's Data_Exchange spacing: 10 × Min_Slave_Interval (100 µs units), see steps.hpp.
+  bus::Ticks dx_interval() const {
+    return 10 * static_cast<bus::Ticks>(m_params.min_slave_interval) * (bus::kTicksPerMs / 10);
+  }
 
  protected:
   EvidenceSink* m_sink = nullptr;
@@ -157,6 +161,7 @@ class ModelContext final : public ContextBase {
     }
     TestBusOptions to;
     to.params = *params;
+    to.dx_interval = dx_interval();
     return std::make_unique<ModelSession>(std::move(built.model), to, m_sink);
   }
 };
@@ -205,6 +210,7 @@ class OutsideContext final : public ContextBase {
     TestBusOptions to;
     to.params = *params;
     to.paced = m_spec->speed;
+    to.dx_interval = dx_interval();
     try {
       m_bus = std::make_unique<TestBus>(to);
       bus::PtyStation::Options po;

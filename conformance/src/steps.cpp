@@ -52,9 +52,31 @@ Reply rd_inp(Session& s, std::string note, std::optional<std::uint8_t> sa) {
 Reply rd_outp(Session& s, std::string note, std::optional<std::uint8_t> sa) {
   return service(s, dp::kSapRdOutp, {}, std::move(note), sa);
 }
+namespace {
+/// A Data_Exchange request (SRD without address extension) from `sa`.
+bool is_data_exchange_from(const Exchange& e, std::uint8_t sa) {
+  fdl::Telegram t;
+  if (fdl::decode(e.request, t) != fdl::DecodeError::None || !t.is_request()) return false;
+  const auto fn = fdl::fc_request_fn(t.fc);
+  return t.sa == sa && !t.dsap && (fn == fdl::RequestFn::SrdHigh || fn == fdl::RequestFn::SrdLow);
+}
+}  // namespace
+
 Reply data_exchange(Session& s, std::span<const std::uint8_t> outputs, std::string note,
                     std::optional<std::uint8_t> sa, bool fcv, bool fcb) {
-  return service(s, std::nullopt, outputs, std::move(note), sa, fcv, fcb);
+  const std::uint8_t from = sa.value_or(tester_address(s));
+  std::optional<bus::Ticks> not_before;
+  const bus::Ticks interval = s.bus().options().dx_interval;
+  if (interval > 0) {
+    const auto& t = s.bus().transcript();
+    for (auto it = t.rbegin(); it != t.rend(); ++it)
+      if (is_data_exchange_from(*it, from)) {
+        not_before = it->request_end + interval;
+        break;
+      }
+  }
+  const auto req = srd(s.dut_address(), from, std::nullopt, std::nullopt, outputs, fcv, fcb);
+  return reply_of(s.bus().request(req, std::move(note), not_before));
 }
 
 void global_control(Session& s, std::uint8_t control, std::uint8_t group_select, std::string note,

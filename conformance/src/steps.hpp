@@ -9,6 +9,10 @@
 //   a conformant slave executes every such frame (§C.6), so the tests do not depend on FCB
 //   bookkeeping they do not check.
 // - `sa` = the tester's address unless a test plays another master.
+// - Data_Exchange polls of one master are spaced by TestBusOptions::dx_interval, which the
+//   battery sets to 10 × the GSD's Min_Slave_Intervall: a relaxed DP cycle (a master with ten
+//   such slaves), so that only the Timing group's Min_Slave_Interval test depends on how fast
+//   the slave may be polled.
 // - start_up() is what a class-1 master does (§D.9): Slave_Diag, Set_Prm, Chk_Cfg, Slave_Diag;
 //   it returns "" when the last diagnosis says "ready for data exchange" (S1's rule, §D.4), else
 //   what went wrong, in words with the bytes.
@@ -45,7 +49,8 @@ Reply chk_cfg(Session& s, std::span<const std::uint8_t> du, std::string note = "
 Reply get_cfg(Session& s, std::string note = "Get_Cfg", std::optional<std::uint8_t> sa = std::nullopt);
 Reply rd_inp(Session& s, std::string note = "Rd_Inp", std::optional<std::uint8_t> sa = std::nullopt);
 Reply rd_outp(Session& s, std::string note = "Rd_Outp", std::optional<std::uint8_t> sa = std::nullopt);
-/// Data_Exchange (default SAP, no DSAP/SSAP) with `outputs`.
+/// Data_Exchange (default SAP, no DSAP/SSAP) with `outputs`; at least
+/// TestBusOptions::dx_interval after the end of the previous Data_Exchange from the same master.
 Reply data_exchange(Session& s, std::span<const std::uint8_t> outputs,
                     std::string note = "Data_Exchange", std::optional<std::uint8_t> sa = std::nullopt,
                     bool fcv = false, bool fcb = false);

@@ -176,6 +176,7 @@ Exchange TestBus::transmit(std::span<const std::uint8_t> telegram, std::string n
   e.expects_reply = expects_reply;
   e.sender = source_of(telegram);
   e.note = std::move(note);
+  e.baud = baud();
   if (telegram.empty()) {
     // Nothing to send (a request the codec refused): recorded, never answered.
     e.request_start = e.request_end = now();

@@ -129,3 +129,38 @@ TEST(Battery, RunsAtAnotherSupportedBaud) {
 
 }  // namespace
 }  // namespace pbvbus::conformance
+
+namespace pbvbus::conformance {
+namespace {
+
+// Each mutant (devices/slave_mutant.hpp) fails exactly the tests of cbat's groups that name it in
+// their targets, and no other: a mutant aimed at another group's rule passes all of these.
+TEST(Battery, EachMutantFailsExactlyItsTargetedTests) {
+  BatteryOptions o;
+  o.only = kCbatGroups;
+  std::string report;
+  for (const auto& info : devices::slave_mutants()) {
+    DutSpec s = spec_0a01();
+    s.mutant = info.mutant;
+    const BatteryReport rep = run_battery(s, o);
+    ASSERT_TRUE(rep.dut_error.empty()) << info.name << ": " << rep.dut_error;
+    std::set<std::string> failed, targeted;
+    for (const auto& r : rep.results)
+      if (r.verdict == Verdict::Fail) failed.insert(r.id);
+    for (const auto& t : all_tests()) {
+      if (std::find(kCbatGroups.begin(), kCbatGroups.end(), t.group) == kCbatGroups.end()) continue;
+      if (std::find(t.targets.begin(), t.targets.end(), info.mutant) != t.targets.end()) targeted.insert(t.id);
+    }
+    if (failed != targeted) {
+      report += std::string(info.name) + ": failed {";
+      for (const auto& id : failed) report += " " + id;
+      report += " } targeted {";
+      for (const auto& id : targeted) report += " " + id;
+      report += " }\n";
+    }
+  }
+  EXPECT_EQ(report, "");
+}
+
+}  // namespace
+}  // namespace pbvbus::conformance

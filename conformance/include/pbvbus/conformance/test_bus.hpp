@@ -49,6 +49,7 @@ struct Exchange {
   std::int64_t tsdr_bits = -1;        ///< idle bit times request end → reply start; -1 = none
   std::uint8_t sender = 0;            ///< FDL address the tester used as SA
   std::string note;                   ///< what the test meant by it ("Set_Prm, wrong ident")
+  bus::Baud baud = bus::Baud::k1_5M;  ///< (addition by cbat) the line's baud: times → bit times
 };
 
 /// One line's worth of bus: who may talk and how fast.
@@ -61,6 +62,10 @@ struct TestBusOptions {
   /// Wall-clock bound of one paced wait (a stalled outside program must not hang the suite).
   std::chrono::milliseconds paced_wait_limit{5000};
   std::uint64_t seed = 1;
+  /// (Addition by cbat.) The tester's Data_Exchange poll interval: the battery's step helpers
+  /// (conformance/src/steps.hpp data_exchange) start a Data_Exchange of the tester's own
+  /// address no earlier than this after the end of its previous one. 0 = back to back.
+  bus::Ticks dx_interval = 0;
 };
 
 class TestBus {

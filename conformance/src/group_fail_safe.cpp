@@ -10,7 +10,7 @@
 //   the slave still in Data_Exch and — white box — its applied outputs zero.
 // - FS-02: a Data_Exchange whose output length is neither the configured one nor (with Fail_Safe)
 //   zero is a parameterisation error: the slave refuses it (no data answer) and goes to Wait_Prm
-//   (Prm_Req in the next diagnosis), outputs safe (white box).
+//   (Station_Not_Ready and Master_Add FF in the next diagnosis), outputs safe (white box).
 
 #include <string>
 
@@ -76,9 +76,9 @@ void wrong_output_length(TestContext& ctx, TestResult& res) {
                     std::to_string(ctx.output_len()) + " was answered " + r.describe());
   const auto d = run.diag(why, "Slave_Diag after the wrong length");
   if (!d) return run.fail(why);
-  if ((d->status_2 & dp::kDiagPrmReq) == 0)
+  if (!wait_prm_diag(*d))
     return run.fail("after the wrong output length the diagnosis " + hex(d->encode()) +
-                    " lacks Prm_Req (the slave must return to Wait_Prm)");
+                    " is not that of a slave in Wait_Prm (Station_Not_Ready, Master_Add FF)");
   if (run.model()) {
     const auto got = applied_outputs(*run.model());
     const std::vector<std::uint8_t> zero(got.size(), 0);

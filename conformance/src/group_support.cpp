@@ -134,7 +134,24 @@ Exchange Run::rd_outp(std::string note, std::optional<std::uint8_t> sa) {
 
 Exchange Run::data_exchange(std::span<const std::uint8_t> outputs, std::string note,
                             std::optional<bus::Ticks> not_before, std::optional<std::uint8_t> sa) {
-  const auto t = srd(m_dut, sa.value_or(m_tester), std::nullopt, std::nullopt, outputs);
+  const std::uint8_t from = sa.value_or(m_tester);
+  const bus::Ticks interval = bus().options().dx_interval;
+  if (!not_before && interval > 0) {
+    // The battery's relaxed DP cycle (steps.hpp): no earlier than dx_interval after the end of
+    // this master's previous Data_Exchange.
+    const auto& t = bus().transcript();
+    for (auto it = t.rbegin(); it != t.rend(); ++it) {
+      fdl::Telegram tg;
+      if (fdl::decode(it->request, tg) != fdl::DecodeError::None) continue;
+      const auto fn = fdl::fc_request_fn(tg.fc);
+      if (tg.sa == from && !tg.dsap &&
+          (fn == fdl::RequestFn::SrdHigh || fn == fdl::RequestFn::SrdLow)) {
+        not_before = it->request_end + interval;
+        break;
+      }
+    }
+  }
+  const auto t = srd(m_dut, from, std::nullopt, std::nullopt, outputs);
   return bus().request(t, std::move(note), not_before);
 }
 
@@ -152,6 +169,16 @@ Exchange Run::set_slave_add(std::uint8_t da, std::uint8_t new_address, std::uint
                               static_cast<std::uint8_t>(no_add_chg ? 1 : 0)};
   const auto t = srd(da, m_tester, dp::kSapSetSlaveAdd, dp::kSapMs0, du);
   return bus().request(t, std::move(note));
+}
+
+Exchange Run::service(std::uint8_t dsap, std::span<const std::uint8_t> du, std::string note,
+                      std::optional<bus::Ticks> not_before) {
+  const auto t = srd(m_dut, m_tester, dsap, dp::kSapMs0, du);
+  return bus().request(t, std::move(note), not_before);
+}
+
+bool wait_prm_diag(const dp::StandardDiag& d) {
+  return (d.status_1 & dp::kDiagStationNotReady) != 0 && d.master_add == dp::kNoMaster;
 }
 
 Exchange Run::c1(std::uint8_t dsap, std::span<const std::uint8_t> pdu, std::string note) {

@@ -8,6 +8,10 @@
 // fail() or na() and returns.
 //
 // Decisions (also in docs/conformance.md, "Groups (cgrp)"):
+// - Data_Exchange polls are spaced like cbat's steps.hpp: no earlier than
+//   TestBusOptions::dx_interval (10 x Min_Slave_Intervall) after the end of the same master's
+//   previous Data_Exchange, unless the test gives its own start time (TIM-02, TIM-03): so only
+//   the Timing group depends on how fast the slave may be polled.
 // - Every request of these groups goes with FCV = 0 (Data_Exchange included): the responder
 //   executes each one as a new request (§C.6: FCV = 0 means "FCB not valid"), so no verdict here
 //   can hinge on the FCB state, which is the FCB/FCV group's business.
@@ -34,6 +38,7 @@
 #include "pbvbus/conformance/battery.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
 #include "pbvbus/dp/master.hpp"
+#include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::conformance::detail {
 
@@ -42,6 +47,11 @@ std::optional<dp::StandardDiag> standard_diag(const Reply& r);
 /// Ready for data exchange as a master judges it (§D.4): octet 1 & (0x01|0x02|0x04|0x40) = 0 and
 /// octet 2 Prm_Req = 0.
 bool diag_ready(const dp::StandardDiag& d);
+
+/// Back in Wait_Prm as the other groups judge it: Station_Not_Ready and no master (octet 4 FF).
+/// Prm_Req and the ident are the Start-up and GSD groups' rules (so that their mutants fail
+/// there, not here), except where a test says otherwise.
+bool wait_prm_diag(const dp::StandardDiag& d);
 
 /// White box: the outputs the model's application holds now (what drives the process), in
 /// Data_Exchange order.
@@ -93,6 +103,9 @@ class Run {
   Exchange data_exchange(std::span<const std::uint8_t> outputs, std::string note = "Data_Exchange",
                          std::optional<bus::Ticks> not_before = {},
                          std::optional<std::uint8_t> sa = {});
+  /// Any other DP-V0 service (SRD from SSAP 62 to `dsap`) from the tester, at `not_before`.
+  Exchange service(std::uint8_t dsap, std::span<const std::uint8_t> du, std::string note,
+                   std::optional<bus::Ticks> not_before = {});
   /// Broadcast Global_Control (SDN to 127, DSAP 58, SSAP 62) from the tester.
   Exchange global_control(std::uint8_t control_command, std::uint8_t group_select,
                           std::string note = "Global_Control");

@@ -14,8 +14,8 @@
 // - TIM-02 polls Data_Exchange 20 times with request starts Min_Slave_Intervall (GSD, 100 us)
 //   apart, or the shortest the line allows when one message cycle is longer than that (the
 //   message says which); every poll must be answered with the inputs.
-// - TIM-03 sends Slave_Diag and Data_Exchange requests exactly TSYN = 33 bit times after the end
-//   of the slave's previous reply (TestBus never sends earlier); each must be answered.
+// - TIM-03 sends Slave_Diag, Get_Cfg and Rd_Inp requests exactly TSYN = 33 bit times after the
+//   end of the slave's previous reply (TestBus never sends earlier); each must be answered.
 // - For an outside slave (paced behind a pty) the results are marked timing_not_meaningful.
 
 #include <algorithm>
@@ -123,15 +123,19 @@ void tsyn(TestContext& ctx, TestResult& res) {
   if (!run) return;
   std::string why;
   if (!run.start_up(why)) return run.fail(why);
-  const auto out = run.outputs(0x00);
-  Exchange prev = run.data_exchange(out, "Data_Exchange");
+  // Slave_Diag, Get_Cfg and Rd_Inp in turn (no Data_Exchange: how fast the slave may be polled
+  // is TIM-02's rule), each 33 bit times after the end of the previous reply.
+  const struct {
+    std::uint8_t sap;
+    const char* name;
+  } services[] = {{60, "Slave_Diag"}, {59, "Get_Cfg"}, {56, "Rd_Inp"}};
+  Exchange prev = run.service(60, {}, "Slave_Diag");
   std::int64_t worst = 0;
   for (int i = 0; i < 6; ++i) {
     if (!prev.answered) return run.fail(prev.note + " was not answered");
     const bus::Ticks at = prev.response_end + run.bits(fdl::BusParams::kTsyn);
-    Exchange e = i % 2 == 0 ? run.bus().request(srd(run.dut(), run.tester(), 60, 62, {}),
-                                                "Slave_Diag after 33 bit times of idle", at)
-                            : run.data_exchange(out, "Data_Exchange after 33 bit times of idle", at);
+    const auto& sv = services[i % 3];
+    Exchange e = run.service(sv.sap, {}, std::string(sv.name) + " after 33 bit times of idle", at);
     const std::int64_t idle = bus::ticks_to_bits(e.request_start - prev.response_end, run.bus().baud());
     worst = std::max(worst, idle);
     const Reply r = reply_of(e);

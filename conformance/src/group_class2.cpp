@@ -144,7 +144,7 @@ void add_class2_tests(std::vector<TestCase>& out) {
       "While another master owns the slave, a class-2 master gets Slave_Diag (Master_Add = the "
       "owner), Get_Cfg, Rd_Inp and Rd_Outp answered (IEC 61158-6 DP; protocol-facts.md §D.8 "
       "Locking, §D.4, §D.7)",
-      {}, reads_while_locked));
+      {SlaveMutant::WrongGetCfg}, reads_while_locked));
   out.push_back(make_case(
       "C2-02", kGroup, "Class-2 Set_Prm has no effect while locked",
       "A Set_Prm or Chk_Cfg from a master other than the owner has no effect on a locked slave; "

@@ -12,6 +12,7 @@
 //   after the tester's watchdog (100 ms for C2-04) has expired, the class-2 master's own start-up
 //   succeeds and Master_Add = 2.
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

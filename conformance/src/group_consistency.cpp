@@ -17,6 +17,7 @@
 //   outputs: each Data_Exchange sends the cycle number in every word of it, and the outputs the
 //   model applies must show one cycle's value in all words.
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

@@ -24,6 +24,7 @@
 //   the alarm gone from the next diagnosis; a second, now unmatched Alarm_Ack must get
 //   `DC 80 B5 xx` (access, state conflict; slave_engine.hpp).
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

@@ -12,6 +12,7 @@
 //   zero is a parameterisation error: the slave refuses it (no data answer) and goes to Wait_Prm
 //   (Station_Not_Ready and Master_Add FF in the next diagnosis), outputs safe (white box).
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

@@ -18,6 +18,7 @@
 // - Sync/Freeze: Set_Prm with Sync_Req (Freeze_Req) is accepted when the GSD supports it and
 //   answered with Not_Supported when it does not.
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

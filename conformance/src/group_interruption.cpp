@@ -16,6 +16,7 @@
 // - "Outputs safe" is white box (the model's applied outputs read zero); for an outside slave
 //   that part is skipped and the message says so.
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

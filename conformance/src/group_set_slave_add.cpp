@@ -13,6 +13,7 @@
 //   ADD-02 (No_Add_Chg, which only a reset undoes) is n/a for it. A refusal test that finds the
 //   outside slave moved anyway tries to move it back.
 
+#include <algorithm>
 #include <string>
 
 #include "group_support.hpp"

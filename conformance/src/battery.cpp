@@ -53,6 +53,7 @@ std::optional<fdl::BusParams> params_at(const devices::GsdFile& gsd, bus::Baud b
 
 bus::Baud main_baud(const DutSpec& spec) {
   if (spec.baud) return *spec.baud;
+  if (!spec.gsd) return bus::Baud::k1_5M;
   const auto& rates = spec.gsd->baud_rates();
   std::optional<bus::Baud> best;
   for (const auto& r : rates)
@@ -274,6 +275,8 @@ bool selected(const TestCase& t, const BatteryOptions& o) {
 }
 
 }  // namespace
+
+bus::Baud dut_main_baud(const DutSpec& spec) { return main_baud(spec); }
 
 const std::vector<TestCase>& all_tests() {
   static const std::vector<TestCase> tests = [] {

@@ -11,7 +11,8 @@
 //   say otherwise). The slave is checked 1 % of TWD (at least 1 ms) before and after the expiry,
 //   counted from the end of the owner's last request (the frame that restarted the watchdog):
 //   each check on a fresh session, because the checking Slave_Diag from the owner would itself
-//   restart the watchdog.
+//   restart the watchdog. An outside slave gets WD_Fact 1 × 1 (10 ms): paced at 1/1000 one
+//   virtual second would take over 16 minutes of wall time.
 // - Min TSDR: Set_Prm with min TSDR 60 (or the line's max TSDR − 1 if that is lower); every reply
 //   after it (Chk_Cfg, Slave_Diag, Data_Exchange) must start at least that many bit times after
 //   its request.
@@ -216,9 +217,17 @@ Reply after_silence(TestContext& ctx, TestResult& r, Session& s, const dp::Slave
 
 bus::Ticks margin(bus::Ticks twd) { return std::max<bus::Ticks>(bus::kTicksPerMs, twd / 100); }
 
+/// The Set_Prm of the watchdog tests: the battery's, or for an outside slave (paced, where one
+/// virtual second is many wall seconds) the shortest watchdog, WD_Fact 1 × 1 (10 ms).
+dp::SlaveParams watchdog_params(TestContext& ctx) {
+  dp::SlaveParams p = ctx.params();
+  if (ctx.outside()) p.wd_fact_1 = p.wd_fact_2 = 1;
+  return p;
+}
+
 void watchdog_expiry(TestContext& ctx, TestResult& r) {
   r.timing_not_meaningful = ctx.outside();
-  dp::SlaveParams p = ctx.params();
+  dp::SlaveParams p = watchdog_params(ctx);
   p.station_status = static_cast<std::uint8_t>(p.station_status | dp::kPrmWdOn | dp::kPrmLockReq);
   const bus::Ticks twd = watchdog_time(p);
   {
@@ -238,7 +247,7 @@ void watchdog_expiry(TestContext& ctx, TestResult& r) {
 
 void watchdog_off(TestContext& ctx, TestResult& r) {
   r.timing_not_meaningful = ctx.outside();
-  dp::SlaveParams p = ctx.params();
+  dp::SlaveParams p = watchdog_params(ctx);
   const bus::Ticks twd = watchdog_time(p);
   p.station_status = static_cast<std::uint8_t>((p.station_status | dp::kPrmLockReq) & ~dp::kPrmWdOn);
   auto s = open_session(ctx, r);

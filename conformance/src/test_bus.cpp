@@ -11,9 +11,9 @@
 // - "Line free" = the end of the last frame on the line, whoever sent it (own transmissions
 //   included); a request starts TSYN bit times after it at the earliest. A frame that is still
 //   arriving when a request is due is awaited first.
-// - Paced: slices of about 1 ms of wall time (at least one bit time of virtual time), the whole
-//   wait bounded by paced_wait_limit of wall time; a wait cut off by the bound ends as "no
-//   reply", never as a hang.
+// - Paced: slices of about 1 ms of wall time (at least one bit time of virtual time); a wait may
+//   take the wall time its virtual span needs at the runner's speed plus paced_wait_limit, then
+//   it ends (as "no reply" for a request), never as a hang.
 
 #include <algorithm>
 #include <chrono>
@@ -145,7 +145,12 @@ void TestBus::run_until(bus::Ticks t, const std::function<bool()>& done) {
   const bus::Ticks slice = std::max<bus::Ticks>(
       bus::ticks_per_bit(baud()), bus::kTicksPerMs * static_cast<bus::Ticks>(sp.num) /
                                       static_cast<bus::Ticks>(std::max<std::uint32_t>(sp.den, 1)));
-  const auto wall_end = std::chrono::steady_clock::now() + m_opt.paced_wait_limit;
+  // The wall bound is slack beyond the wall time the virtual wait takes at this speed: a long
+  // virtual wait (idle, watchdog) runs to its end; a runner that stalls gives up.
+  const bus::Ticks span = std::max<bus::Ticks>(0, t - m_sched.now());
+  const auto wall_of_span = std::chrono::nanoseconds(
+      bus::ticks_to_ns(span) / std::max<std::uint32_t>(sp.num, 1) * static_cast<std::int64_t>(sp.den));
+  const auto wall_end = std::chrono::steady_clock::now() + wall_of_span + m_opt.paced_wait_limit;
   while (!finished() && m_sched.now() < t) {
     if (std::chrono::steady_clock::now() >= wall_end) return;
     m_runner->run_until(std::min(t, m_sched.now() + slice));

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -160,6 +162,46 @@ TEST(Battery, EachMutantFailsExactlyItsTargetedTests) {
     }
   }
   EXPECT_EQ(report, "");
+}
+
+}  // namespace
+}  // namespace pbvbus::conformance
+
+namespace pbvbus::conformance {
+namespace {
+
+// An outside DUT whose program never answers: every request times out within TSL of virtual
+// time (paced at 1/1 here), the tests fail with "no reply" — no hang, no abort — and the pty
+// link exists during the run and is removed afterwards.
+TEST(Battery, SilentPtyDutFailsWithoutHanging) {
+  DutSpec s = spec_0a01();
+  const std::string link = std::string(PBVBUS_BINARY_DIR) + "/battery_test_pty";
+  std::filesystem::remove(link);
+  s.pty_path = link;
+  s.speed = {1, 1};
+  BatteryOptions o;
+  o.only = {"STA-01", "PRM-08"};
+  const BatteryReport rep = run_battery(s, o);
+  ASSERT_TRUE(rep.dut_error.empty()) << rep.dut_error;
+  ASSERT_EQ(rep.results.size(), 2u);
+  EXPECT_EQ(rep.results[0].verdict, Verdict::Fail);
+  EXPECT_NE(rep.results[0].message.find("no reply"), std::string::npos) << rep.results[0].message;
+  // The reset (unlocking Set_Prm) is part of the evidence: 2 exchanges.
+  ASSERT_EQ(rep.results[0].evidence.size(), 2u);
+  EXPECT_EQ(rep.results[0].evidence[0].note, "reset: Set_Prm Unlock_Req");
+  EXPECT_FALSE(rep.results[0].timing_not_meaningful);
+  EXPECT_TRUE(rep.results[1].timing_not_meaningful);
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(link)));
+}
+
+TEST(Battery, PtyDutNeverOverwritesAFile) {
+  DutSpec s = spec_0a01();
+  const std::string file = std::string(PBVBUS_BINARY_DIR) + "/battery_test_not_a_link";
+  std::ofstream(file) << "x";
+  s.pty_path = file;
+  const BatteryReport rep = run_battery(s);
+  EXPECT_NE(rep.dut_error.find("cannot create"), std::string::npos) << rep.dut_error;
+  EXPECT_TRUE(std::filesystem::exists(file));  // never overwritten
 }
 
 }  // namespace

@@ -207,17 +207,16 @@ TEST(TestBus, PacedExchangeHasTheSameVirtualTiming) {
   EXPECT_EQ(rig.bits(e.request_end), 99);
 }
 
-TEST(TestBus, PacedWaitIsBoundedByWallTime) {
-  // One virtual second takes 10^6 s of wall time: the slot time could never pass; the wait
-  // limit (20 ms) ends the call as "no reply" instead of hanging.
+TEST(TestBus, PacedWaitForAnAbsentStationEndsAtTheSlotTime) {
+  // At 1/1000 the slot time (300 bit times at 1.5 Mbit/s = 200 us virtual) takes 0.2 s of wall
+  // time; the call returns with virtual time exactly TSL after the request's end.
   TestBusOptions o = fast_options();
-  o.paced = bus::Speed{1, 1'000'000};
-  o.paced_wait_limit = std::chrono::milliseconds(20);
-  o.params.tsl = 16'000;
+  o.paced = bus::Speed{1, 1000};
   Rig rig(o);
   const auto t0 = std::chrono::steady_clock::now();
   const Exchange e = rig.bus->request(kFdlStatus9);
   EXPECT_FALSE(e.answered);
+  EXPECT_EQ(rig.bus->now(), e.request_end + bus::bits_to_ticks(300, bus::Baud::k1_5M));
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(30));  // generous bound
 }
 

@@ -21,6 +21,7 @@ const Command kCommands[] = {
     {"timeline", pbvbus::tools::cmd_timeline, "draw a capture as an interactive HTML page or an SVG"},
     {"timing", pbvbus::tools::cmd_timing, "plan DP rotation and switchover times of a scenario"},
     {"gateway", pbvbus::tools::cmd_gateway, "print a scenario's gateway maps (Modbus registers, CAN PDOs)"},
+    {"conformance", pbvbus::tools::cmd_conformance, "test a DP slave (model or program behind a pty) against the standard"},
 };
 
 void usage(std::ostream& os) {

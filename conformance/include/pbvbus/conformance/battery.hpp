@@ -126,4 +126,8 @@ struct BatteryReport {
 /// Runs the battery. Never throws on a bad DUT: a DUT that cannot be built is dut_error.
 BatteryReport run_battery(const DutSpec& spec, const BatteryOptions& options = {});
 
+/// (Addition by cbat.) The main baud of a DUT: spec.baud, else the highest rate its GSD supports
+/// up to 1.5 Mbit/s, else the GSD's lowest rate (1.5 Mbit/s without a GSD).
+bus::Baud dut_main_baud(const DutSpec& spec);
+
 }  // namespace pbvbus::conformance

@@ -17,5 +17,6 @@ int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_timing(const Args& args, std::ostream& out, std::ostream& err);
 int cmd_gateway(const Args& args, std::ostream& out, std::ostream& err);
+int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err);
 
 }  // namespace pbvbus::tools

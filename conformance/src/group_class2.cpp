@@ -9,13 +9,14 @@
 //   (Master_Add) and data exchange with the tester stay, and a Data_Exchange from the class-2
 //   master is refused.
 // - "Takes control": after the tester's Set_Prm with Unlock_Req (§D.2: Lock 0, Unlock 1), or
-//   after the tester's watchdog (100 ms for C2-04) has expired, the class-2 master's own start-up
-//   succeeds and Master_Add = 2.
+//   after the tester's watchdog (C2-04: 100 ms, 10 ms for an outside slave) has expired, the
+//   class-2 master's own start-up succeeds and Master_Add = 2.
 
 #include <algorithm>
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -44,12 +45,14 @@ void reads_while_locked(TestContext& ctx, TestResult& res) {
   const auto d = run.diag(why, "class 2: Slave_Diag", kClass2Master);
   if (!d) return run.fail("class 2: " + why);
   if (d->master_add != run.tester())
-    return run.fail("class 2: Slave_Diag octet 4 (Master_Add) = " + hex(std::vector<std::uint8_t>{d->master_add}) +
-                    ", expected the owner " + std::to_string(run.tester()));
+    return run.fail("class 2: Slave_Diag octet 4 (Master_Add) = " +
+                    hex(std::vector<std::uint8_t>{d->master_add}) + ", expected the owner " +
+                    std::to_string(run.tester()));
   const Reply cfg = reply_of(run.get_cfg("class 2: Get_Cfg", kClass2Master));
   const auto want_cfg = ctx.params().chk_cfg_du();
   if (!cfg.ok_with_data() || cfg.data != want_cfg)
-    return run.fail("class 2: Get_Cfg answered " + cfg.describe() + ", expected DL " + hex(want_cfg));
+    return run.fail("class 2: Get_Cfg answered " + cfg.describe() + ", expected DL " +
+                    hex(want_cfg));
   const Reply in = reply_of(run.rd_inp("class 2: Rd_Inp", kClass2Master));
   const bool in_ok = ctx.input_len() == 0 ? in.kind == Reply::Kind::Sc
                                           : in.ok_with_data() && in.data.size() == ctx.input_len();
@@ -60,7 +63,8 @@ void reads_while_locked(TestContext& ctx, TestResult& res) {
   const bool out_ok = ctx.output_len() == 0 ? outp.kind == Reply::Kind::Sc
                                             : outp.ok_with_data() && outp.data == out;
   if (!out_ok)
-    return run.fail("class 2: Rd_Outp answered " + outp.describe() + ", expected the owner's outputs " + hex(out));
+    return run.fail("class 2: Rd_Outp answered " + outp.describe() +
+                    ", expected the owner's outputs " + hex(out));
   run.pass("the class-2 master read Slave_Diag (Master_Add " + std::to_string(run.tester()) +
            "), Get_Cfg, Rd_Inp and Rd_Outp of the locked slave");
 }
@@ -81,12 +85,14 @@ void foreign_set_prm(TestContext& ctx, TestResult& res) {
                     " and data exchange)");
   const Reply dx = reply_of(run.data_exchange(run.outputs(0x00), "tester: Data_Exchange"));
   if (!data_answer(ctx, dx))
-    return run.fail("after the foreign Set_Prm the tester's Data_Exchange answered " + dx.describe());
-  const Reply dx2 = reply_of(run.data_exchange(run.outputs(0x00), "class 2: Data_Exchange", std::nullopt,
-                                               kClass2Master));
+    return run.fail("after the foreign Set_Prm the tester's Data_Exchange answered " +
+                    dx.describe());
+  const Reply dx2 = reply_of(
+      run.data_exchange(run.outputs(0x00), "class 2: Data_Exchange", std::nullopt, kClass2Master));
   if (dx2.ok_with_data() || dx2.kind == Reply::Kind::Sc)
-    return run.fail("the class-2 master's Data_Exchange to a slave locked by the tester was answered " +
-                    dx2.describe());
+    return run.fail(
+        "the class-2 master's Data_Exchange to a slave locked by the tester was answered " +
+        dx2.describe());
   run.pass("the class-2 master's Set_Prm and Chk_Cfg had no effect: Master_Add stayed " +
            std::to_string(run.tester()) + ", its Data_Exchange got " + dx2.describe());
 }
@@ -95,19 +101,23 @@ void foreign_set_prm(TestContext& ctx, TestResult& res) {
 void class2_takes_over(Run& run, const std::string& after) {
   std::string why;
   const auto p2 = class2_params(run.ctx());
-  if (!run.start_up(why, &p2, kClass2Master)) return run.fail("class 2 after " + after + ": " + why);
+  if (!run.start_up(why, &p2, kClass2Master))
+    return run.fail("class 2 after " + after + ": " + why);
   const auto d = run.diag(why, "class 2: Slave_Diag", kClass2Master);
   if (!d) return run.fail(why);
   if (d->master_add != kClass2Master)
     return run.fail("after the class-2 master's start-up Master_Add = " +
                     hex(std::vector<std::uint8_t>{d->master_add}) + ", expected 02");
-  const Reply dx = reply_of(run.data_exchange(run.outputs(0x00), "class 2: Data_Exchange", std::nullopt,
-                                              kClass2Master));
-  if (!data_answer(run.ctx(), dx)) return run.fail("class 2: Data_Exchange answered " + dx.describe());
-  const Reply dx1 = reply_of(run.data_exchange(run.outputs(0x00), "tester: Data_Exchange (no longer owner)"));
+  const Reply dx = reply_of(
+      run.data_exchange(run.outputs(0x00), "class 2: Data_Exchange", std::nullopt, kClass2Master));
+  if (!data_answer(run.ctx(), dx))
+    return run.fail("class 2: Data_Exchange answered " + dx.describe());
+  const Reply dx1 =
+      reply_of(run.data_exchange(run.outputs(0x00), "tester: Data_Exchange (no longer owner)"));
   if (dx1.ok_with_data() || dx1.kind == Reply::Kind::Sc)
     return run.fail("the former owner's Data_Exchange was still answered " + dx1.describe());
-  run.pass("after " + after + " the class-2 master's Set_Prm and Chk_Cfg succeeded, Master_Add = 2");
+  run.pass("after " + after +
+           " the class-2 master's Set_Prm and Chk_Cfg succeeded, Master_Add = 2");
 }
 
 void takes_control_after_unlock(TestContext& ctx, TestResult& res) {
@@ -127,7 +137,8 @@ void takes_control_after_watchdog(TestContext& ctx, TestResult& res) {
   dp::SlaveParams p = ctx.params();
   p.station_status |= dp::kPrmWdOn;
   const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
-  p.wd_fact_1 = base_1ms ? 100 : 10;
+  // 100 ms (10 ms for a paced outside slave, as in the Interruption group).
+  p.wd_fact_1 = static_cast<std::uint8_t>((base_1ms ? 10 : 1) * (ctx.outside() ? 1 : 10));
   p.wd_fact_2 = 1;
   const bus::Ticks twd = dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
   std::string why;
@@ -154,7 +165,8 @@ void add_class2_tests(std::vector<TestCase>& out) {
   out.push_back(make_case(
       "C2-03", kGroup, "Class 2 takes control after unlock",
       "After the owner's Set_Prm with Unlock_Req the slave accepts another master's Set_Prm and "
-      "Chk_Cfg; Master_Add becomes that master (IEC 61158-6 DP; protocol-facts.md §D.2 Lock/Unlock, "
+      "Chk_Cfg; Master_Add becomes that master (IEC 61158-6 DP; protocol-facts.md §D.2 "
+      "Lock/Unlock, "
       "§D.8)",
       {}, takes_control_after_unlock));
   out.push_back(make_case(

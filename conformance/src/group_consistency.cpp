@@ -51,8 +51,9 @@ void consistent_module(TestContext& ctx, TestResult& res) {
     if (!out_mod && ml.out_len >= 2) out_mod = m;
   }
   if (!in_mod && !out_mod)
-    return run.na("the configuration has no module consistent over its whole length with two or "
-                  "more octets");
+    return run.na(
+        "the configuration has no module consistent over its whole length with two or "
+        "more octets");
   std::size_t in_w = 0;
   if (in_mod) {
     const auto& ml = app.module(*in_mod);
@@ -70,7 +71,8 @@ void consistent_module(TestContext& ctx, TestResult& res) {
     if (out_mod) {
       const auto& ml = app.module(*out_mod);
       for (std::size_t o = 0; o < ml.out_len; ++o)
-        out[ml.out_offset + o] = static_cast<std::uint8_t>(o % 2 == 0 && ml.out_len % 2 == 0 ? c >> 8 : c);
+        out[ml.out_offset + o] =
+            static_cast<std::uint8_t>(o % 2 == 0 && ml.out_len % 2 == 0 ? c >> 8 : c);
     }
     const Reply r = reply_of(run.data_exchange(out, "Data_Exchange " + std::to_string(c + 1)));
     if (in_mod) {
@@ -91,13 +93,15 @@ void consistent_module(TestContext& ctx, TestResult& res) {
       app.read_outputs(*out_mod, got);
       const std::span<const std::uint8_t> sent(out.data() + ml.out_offset, ml.out_len);
       if (!std::equal(got.begin(), got.end(), sent.begin(), sent.end()))
-        return run.fail("Data_Exchange " + std::to_string(c + 1) + ": the consistent output module " +
-                        std::to_string(*out_mod) + " applied " + hex(got) + " after receiving " + hex(sent));
+        return run.fail("Data_Exchange " + std::to_string(c + 1) +
+                        ": the consistent output module " + std::to_string(*out_mod) + " applied " +
+                        hex(got) + " after receiving " + hex(sent));
     }
   }
   std::string what;
   if (in_mod) what = "input module " + std::to_string(*in_mod);
-  if (out_mod) what += std::string(what.empty() ? "" : " and ") + "output module " + std::to_string(*out_mod);
+  if (out_mod)
+    what += std::string(what.empty() ? "" : " and ") + "output module " + std::to_string(*out_mod);
   run.pass("over " + std::to_string(kCycles) + " Data_Exchanges the consistent " + what +
            " always showed one cycle's value in every word");
 }

@@ -28,6 +28,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/dpv1_pdu.hpp"
 #include "pbvbus/dp/prm.hpp"
 #include "pbvbus/dp/sap.hpp"
@@ -87,9 +88,11 @@ void dpv1_start_up(TestContext& ctx, TestResult& res) {
 void read_known(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp) return run.na("the GSD says C1_Read_Write_supp = 0");
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return run.na("the GSD says C1_Read_Write_supp = 0");
   if (!run.model())
-    return run.na("the GSD names no data record, so the battery knows none to read on an outside slave");
+    return run.na(
+        "the GSD names no data record, so the battery knows none to read on an outside slave");
   run.model()->application().on_read(1, 1, [](const dp::RecordCall&, std::span<std::uint8_t> out) {
     const std::uint8_t v[2] = {0xAB, 0xCD};
     const std::size_t n = std::min<std::size_t>(out.size(), 2);
@@ -98,20 +101,24 @@ void read_known(TestContext& ctx, TestResult& res) {
   });
   if (!start_dpv1(run, dpv1_params(ctx))) return;
   const std::uint8_t rq[4] = {dp::kFnRead, 0x01, 0x01, 0x40};
-  const Reply r = reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Read slot 1 index 1 length 64"));
+  const Reply r =
+      reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Read slot 1 index 1 length 64"));
   const std::vector<std::uint8_t> want = {0x5E, 0x01, 0x01, 0x02, 0xAB, 0xCD};
   if (!r.ok_with_data() || r.data != want)
-    return run.fail("MSAC_C1 Read of slot 1 index 1 answered " + r.describe() + ", expected DL " + hex(want));
+    return run.fail("MSAC_C1 Read of slot 1 index 1 answered " + r.describe() + ", expected DL " +
+                    hex(want));
   run.pass("MSAC_C1 Read of a known record answered " + hex(want));
 }
 
 void read_unknown_index(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp) return run.na("the GSD says C1_Read_Write_supp = 0");
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return run.na("the GSD says C1_Read_Write_supp = 0");
   if (!start_dpv1(run, dpv1_params(ctx))) return;
   const std::uint8_t rq[4] = {dp::kFnRead, 0x00, 0xFE, 0x10};
-  const Reply r = reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Read slot 0 index 254 (unknown)"));
+  const Reply r =
+      reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Read slot 0 index 254 (unknown)"));
   if (!negative(r, dp::kFnRead, dp::dpv1_err::kInvalidIndex))
     return run.fail("MSAC_C1 Read of an unknown index answered " + r.describe() +
                     ", expected the negative response DL DE 80 B0 xx (invalid index)");
@@ -121,10 +128,12 @@ void read_unknown_index(TestContext& ctx, TestResult& res) {
 void write_wrong_length(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp) return run.na("the GSD says C1_Read_Write_supp = 0");
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return run.na("the GSD says C1_Read_Write_supp = 0");
   if (!start_dpv1(run, dpv1_params(ctx))) return;
   const std::uint8_t rq[6] = {dp::kFnWrite, 0x00, 0xFE, 0x04, 0xAA, 0xBB};
-  const Reply r = reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Write, Length 4 with 2 octets"));
+  const Reply r =
+      reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Write, Length 4 with 2 octets"));
   if (!negative(r, dp::kFnWrite, dp::dpv1_err::kWriteLengthError))
     return run.fail("MSAC_C1 Write whose Length (4) disagrees with its data (2 octets) answered " +
                     r.describe() + ", expected DL DF 80 B1 xx (write length error)");
@@ -134,20 +143,21 @@ void write_wrong_length(TestContext& ctx, TestResult& res) {
 void not_enabled(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp) return run.na("the GSD says C1_Read_Write_supp = 0");
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return run.na("the GSD says C1_Read_Write_supp = 0");
   const auto p = dpv1_params(ctx, false);
   std::string why;
   if (!run.start_up(why, &p)) return run.fail("Set_Prm without DPV1_Enable (DP-V0 mode): " + why);
   const std::uint8_t rq[4] = {dp::kFnRead, 0x00, 0x01, 0x10};
   const Reply r = reply_of(run.c1(dp::kSapC1ReadWrite, rq, "MSAC_C1 Read without DPV1_Enable"));
   if (!r.rs())
-    return run.fail("MSAC_C1 Read to a slave parameterised without DPV1_Enable answered " + r.describe() +
-                    ", expected RS (SAP 51 not activated)");
+    return run.fail("MSAC_C1 Read to a slave parameterised without DPV1_Enable answered " +
+                    r.describe() + ", expected RS (SAP 51 not activated)");
   const std::uint8_t wr[5] = {dp::kFnWrite, 0x00, 0x01, 0x01, 0x00};
   const Reply w = reply_of(run.c1(dp::kSapC1ReadWrite, wr, "MSAC_C1 Write without DPV1_Enable"));
   if (!w.rs())
-    return run.fail("MSAC_C1 Write to a slave parameterised without DPV1_Enable answered " + w.describe() +
-                    ", expected RS");
+    return run.fail("MSAC_C1 Write to a slave parameterised without DPV1_Enable answered " +
+                    w.describe() + ", expected RS");
   run.pass("MSAC_C1 Read and Write without DPV1_Enable were answered RS");
 }
 
@@ -166,7 +176,8 @@ std::optional<std::pair<std::uint8_t, std::uint8_t>> find_alarm(std::span<const 
 void alarm_ack(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().process_alarm_supp) return run.na("the GSD says Process_Alarm_supp = 0");
+  if (!ctx.spec().gsd->dpv1().process_alarm_supp)
+    return run.na("the GSD says Process_Alarm_supp = 0");
   if (!run.model())
     return run.na("an outside slave cannot be made to raise an alarm on demand (white box only)");
   auto p = dpv1_params(ctx);
@@ -181,12 +192,14 @@ void alarm_ack(TestContext& ctx, TestResult& res) {
   const Reply dg = reply_of(run.slave_diag("Slave_Diag with the alarm"));
   if (!dg.ok_with_data()) return run.fail("Slave_Diag answered " + dg.describe());
   const auto al = find_alarm(dg.data, 0x02);
-  if (!al) return run.fail("the diagnosis " + hex(dg.data) + " carries no process alarm block (type 02)");
+  if (!al)
+    return run.fail("the diagnosis " + hex(dg.data) + " carries no process alarm block (type 02)");
   const std::uint8_t ack[4] = {dp::kFnAlarmAck, al->first, 0x02, al->second};
   const Reply r = reply_of(run.c1(dp::kSapC1Alarm, ack, "Alarm_Ack"));
   const std::vector<std::uint8_t> echo(ack, ack + 4);
   if (!r.ok_with_data() || r.data != echo)
-    return run.fail("Alarm_Ack " + hex(echo) + " answered " + r.describe() + ", expected the echo " + hex(echo));
+    return run.fail("Alarm_Ack " + hex(echo) + " answered " + r.describe() +
+                    ", expected the echo " + hex(echo));
   const Reply dg2 = reply_of(run.slave_diag("Slave_Diag after Alarm_Ack"));
   if (!dg2.ok_with_data()) return run.fail("Slave_Diag answered " + dg2.describe());
   if (find_alarm(dg2.data, 0x02))
@@ -224,11 +237,11 @@ void add_dpv1_tests(std::vector<TestCase>& out) {
       "MSAC_C1 Write whose Length disagrees with the data is answered `DF 80 B1 xx` (write length "
       "error) (IEC 61158-6 DP-V1; protocol-facts.md §E.2, §E.3)",
       {}, write_wrong_length));
-  out.push_back(make_case(
-      "V1-05", kGroup, "MSAC_C1 without DPV1_Enable refused",
-      "MSAC_C1 is open only when Set_Prm set DPV1_Enable; otherwise Read/Write get RS "
-      "(IEC 61158-6 DP-V1; protocol-facts.md §D.2 DPV1_Status_1, docs/dp-slave.md)",
-      {}, not_enabled));
+  out.push_back(
+      make_case("V1-05", kGroup, "MSAC_C1 without DPV1_Enable refused",
+                "MSAC_C1 is open only when Set_Prm set DPV1_Enable; otherwise Read/Write get RS "
+                "(IEC 61158-6 DP-V1; protocol-facts.md §D.2 DPV1_Status_1, docs/dp-slave.md)",
+                {}, not_enabled));
   out.push_back(make_case(
       "V1-06", kGroup, "Alarm and Alarm_Ack",
       "An enabled alarm makes the owner's Data_Exchange answer DH and appears in the diagnosis "

@@ -26,8 +26,9 @@ void zero_length_outputs(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   if (!ctx.spec().gsd->slave_features().fail_safe)
-    return run.na("the GSD says Fail_Safe = 0: a Data_Exchange without output data is not part of "
-                  "this slave's contract");
+    return run.na(
+        "the GSD says Fail_Safe = 0: a Data_Exchange without output data is not part of "
+        "this slave's contract");
   if (ctx.output_len() == 0)
     return run.na("the configuration has no outputs: every Data_Exchange is zero-length already");
   std::string why;
@@ -40,8 +41,9 @@ void zero_length_outputs(TestContext& ctx, TestResult& res) {
   const bool ok = ctx.input_len() == 0 ? r0.kind == Reply::Kind::Sc
                                        : r0.ok_with_data() && r0.data.size() == ctx.input_len();
   if (!ok)
-    return run.fail("a Data_Exchange without output data (Fail_Safe = 1) answered " + r0.describe() +
-                    ", expected the " + std::to_string(ctx.input_len()) + " input octets");
+    return run.fail("a Data_Exchange without output data (Fail_Safe = 1) answered " +
+                    r0.describe() + ", expected the " + std::to_string(ctx.input_len()) +
+                    " input octets");
   if (run.model()) {
     const auto got = applied_outputs(*run.model());
     const std::vector<std::uint8_t> zero(got.size(), 0);
@@ -69,9 +71,9 @@ void wrong_output_length(TestContext& ctx, TestResult& res) {
   if (!(r1.ok_with_data() || (r1.kind == Reply::Kind::Sc && ctx.input_len() == 0)))
     return run.fail("Data_Exchange with the right length answered " + r1.describe());
   const std::vector<std::uint8_t> wrong(n, 0x5A);
-  const Reply r = reply_of(run.data_exchange(
-      wrong, "Data_Exchange with " + std::to_string(n) + " output octets (configured " +
-                 std::to_string(ctx.output_len()) + ")"));
+  const Reply r = reply_of(run.data_exchange(wrong, "Data_Exchange with " + std::to_string(n) +
+                                                        " output octets (configured " +
+                                                        std::to_string(ctx.output_len()) + ")"));
   if (r.ok_with_data() || r.kind == Reply::Kind::Sc)
     return run.fail("a Data_Exchange with " + std::to_string(n) + " output octets instead of " +
                     std::to_string(ctx.output_len()) + " was answered " + r.describe());
@@ -85,19 +87,21 @@ void wrong_output_length(TestContext& ctx, TestResult& res) {
     const std::vector<std::uint8_t> zero(got.size(), 0);
     if (got != zero) return run.fail("after the wrong output length: " + outputs_text(got, zero));
   }
-  run.pass("the wrong output length was refused (" + r.describe() + ") and the slave went to Wait_Prm");
+  run.pass("the wrong output length was refused (" + r.describe() +
+           ") and the slave went to Wait_Prm");
 }
 
 }  // namespace
 
 void add_fail_safe_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
-  out.push_back(make_case(
-      "FS-01", kGroup, "Data_Exchange without output data (Fail_Safe)",
-      "A slave with GSD Fail_Safe = 1 accepts, in the master's Clear state, Data_Exchange with zero "
-      "output octets: it answers with its inputs and sets its outputs to the safe state "
-      "(IEC 61158-6 DP; protocol-facts.md §D.8 Fail_Safe, §D.9 Output_Clear)",
-      {SlaveMutant::RejectFailSafe}, zero_length_outputs));
+  out.push_back(
+      make_case("FS-01", kGroup, "Data_Exchange without output data (Fail_Safe)",
+                "A slave with GSD Fail_Safe = 1 accepts, in the master's Clear state, "
+                "Data_Exchange with zero "
+                "output octets: it answers with its inputs and sets its outputs to the safe state "
+                "(IEC 61158-6 DP; protocol-facts.md §D.8 Fail_Safe, §D.9 Output_Clear)",
+                {SlaveMutant::RejectFailSafe}, zero_length_outputs));
   out.push_back(make_case(
       "FS-02", kGroup, "Wrong output length",
       "A Data_Exchange whose output length differs from the configuration is refused and the slave "

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -35,8 +36,9 @@ constexpr std::uint8_t kSync = 0x20;
 /// Common precondition of the white-box output tests.
 bool need_model_outputs(Run& run) {
   if (!run.model()) {
-    run.na("what the slave applies to its outputs is not visible on the bus (an outside slave); "
-           "Rd_Outp shows the received outputs, not the applied ones");
+    run.na(
+        "what the slave applies to its outputs is not visible on the bus (an outside slave); "
+        "Rd_Outp shows the received outputs, not the applied ones");
     return false;
   }
   if (run.ctx().output_len() == 0) {
@@ -78,8 +80,9 @@ void clear_data(TestContext& ctx, TestResult& res) {
   run.global_control(0x00, 0x00, "Global_Control Operate (00 00)");
   if (!exchange_ok(run, a, "outputs A5 in Operate again")) return;
   if (!outputs_are(run, a, "after Operate (00 00) and a new Data_Exchange")) return;
-  run.pass("Clear_Data set the applied outputs to 00 and held them through a Data_Exchange; "
-           "Operate released them");
+  run.pass(
+      "Clear_Data set the applied outputs to 00 and held them through a Data_Exchange; "
+      "Operate released them");
 }
 
 void sync_unsync(TestContext& ctx, TestResult& res) {
@@ -98,13 +101,15 @@ void sync_unsync(TestContext& ctx, TestResult& res) {
   if (!outputs_are(run, a, "before the first Sync")) return;
   run.global_control(kSync, 0x00, "Global_Control Sync (20 00)");
   if (!exchange_ok(run, b, "outputs 22 after Sync")) return;
-  if (!outputs_are(run, a, "after Sync and a Data_Exchange with 22 (must be held until the next "
-                           "Sync)"))
+  if (!outputs_are(run, a,
+                   "after Sync and a Data_Exchange with 22 (must be held until the next "
+                   "Sync)"))
     return;
   if (auto dg = run.diag(why, "Slave_Diag in sync mode"); !dg) {
     return run.fail(why);
   } else if ((dg->status_2 & dp::kDiagSyncMode) == 0) {
-    return run.fail("the diagnosis after Sync lacks Sync_Mode (octet 2 bit 5): " + hex(dg->encode()));
+    return run.fail("the diagnosis after Sync lacks Sync_Mode (octet 2 bit 5): " +
+                    hex(dg->encode()));
   }
   run.global_control(kSync, 0x00, "Global_Control Sync (20 00) again");
   if (!outputs_are(run, b, "after the second Sync (latches 22)")) return;
@@ -113,8 +118,9 @@ void sync_unsync(TestContext& ctx, TestResult& res) {
   run.global_control(kUnsync, 0x00, "Global_Control Unsync (10 00)");
   if (!exchange_ok(run, d, "outputs 44 after Unsync")) return;
   if (!outputs_are(run, d, "after Unsync and a Data_Exchange with 44 (immediate output)")) return;
-  run.pass("Sync latched the outputs, later outputs were held until the next Sync, Unsync "
-           "returned to immediate output");
+  run.pass(
+      "Sync latched the outputs, later outputs were held until the next Sync, Unsync "
+      "returned to immediate output");
 }
 
 /// The inputs of `n` Data_Exchanges (empty vector for an SC answer); nullopt = a Fail was set.
@@ -162,8 +168,9 @@ void freeze_unfreeze(TestContext& ctx, TestResult& res) {
   const auto live = inputs_of(run, 4, "inputs before Freeze");
   if (!live) return;
   if (all_equal(*live))
-    return run.na("the inputs did not change over four Data_Exchanges without Freeze, so frozen "
-                  "inputs cannot be told from live ones");
+    return run.na(
+        "the inputs did not change over four Data_Exchanges without Freeze, so frozen "
+        "inputs cannot be told from live ones");
   run.global_control(kFreeze, 0x00, "Global_Control Freeze (08 00)");
   const auto frozen = inputs_of(run, 4, "inputs after Freeze");
   if (!frozen) return;
@@ -198,8 +205,9 @@ void group_select(TestContext& ctx, TestResult& res) {
   if (!exchange_ok(run, a, "outputs 5A")) return;
   if (!outputs_are(run, a, "in Operate")) return;
   run.global_control(kClearData, 0x02, "Global_Control Clear_Data to group 2 (02 02)");
-  if (!outputs_are(run, a, "after Clear_Data to group 2 only (the slave is in group 1: must be "
-                           "ignored)"))
+  if (!outputs_are(run, a,
+                   "after Clear_Data to group 2 only (the slave is in group 1: must be "
+                   "ignored)"))
     return;
   run.global_control(kClearData, 0x01, "Global_Control Clear_Data to group 1 (02 01)");
   if (!outputs_are(run, zero, "after Clear_Data to its own group 1")) return;
@@ -221,8 +229,9 @@ void sync_freeze_not_enabled(TestContext& ctx, TestResult& res) {
   if (!exchange_ok(run, a, "outputs 11")) return;
   run.global_control(kSync | kFreeze, 0x00, "Global_Control Sync+Freeze (28 00), not enabled");
   if (!exchange_ok(run, b, "outputs 22")) return;
-  if (!outputs_are(run, b, "after Sync without Sync_Req in Set_Prm (must be ignored: immediate "
-                           "output)"))
+  if (!outputs_are(run, b,
+                   "after Sync without Sync_Req in Set_Prm (must be ignored: immediate "
+                   "output)"))
     return;
   if (ctx.input_len() > 0) {
     const auto in = inputs_of(run, 3, "inputs after Freeze without Freeze_Req");
@@ -234,8 +243,10 @@ void sync_freeze_not_enabled(TestContext& ctx, TestResult& res) {
   if (auto dg = run.diag(why, "Slave_Diag"); !dg) {
     return run.fail(why);
   } else if ((dg->status_2 & (dp::kDiagSyncMode | dp::kDiagFreezeMode)) != 0) {
-    return run.fail("the diagnosis shows Sync_Mode/Freeze_Mode although Set_Prm did not enable "
-                    "them: " + hex(dg->encode()));
+    return run.fail(
+        "the diagnosis shows Sync_Mode/Freeze_Mode although Set_Prm did not enable "
+        "them: " +
+        hex(dg->encode()));
   }
   run.pass("Sync and Freeze without Sync_Req/Freeze_Req in Set_Prm had no effect");
 }
@@ -262,8 +273,10 @@ void sync_freeze_unsupported(TestContext& ctx, TestResult& res) {
   const auto dg = run.diag(why, "Slave_Diag after Set_Prm");
   if (!dg) return run.fail(why);
   if ((dg->status_1 & dp::kDiagNotSupported) == 0)
-    return run.fail("Set_Prm with " + asked + " that the GSD does not support: the diagnosis lacks "
-                    "Not_Supported (octet 1 bit 4): " + hex(dg->encode()));
+    return run.fail("Set_Prm with " + asked +
+                    " that the GSD does not support: the diagnosis lacks "
+                    "Not_Supported (octet 1 bit 4): " +
+                    hex(dg->encode()));
   run.pass("Set_Prm with " + asked + " gave Not_Supported in the diagnosis: " + hex(dg->encode()));
 }
 

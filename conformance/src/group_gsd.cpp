@@ -22,6 +22,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -41,15 +42,20 @@ void diag_ident(TestContext& ctx, TestResult& res) {
   auto d = run.diag(why, "Slave_Diag in Wait_Prm");
   if (!d) return run.fail(why);
   if (d->ident != want)
-    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) + " in Wait_Prm, the GSD "
-                    "says Ident_Number " + hex(ident_octets(want)));
+    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) +
+                    " in Wait_Prm, the GSD "
+                    "says Ident_Number " +
+                    hex(ident_octets(want)));
   if (!run.start_up(why)) return run.fail(why);
   d = run.diag(why, "Slave_Diag in Data_Exch");
   if (!d) return run.fail(why);
   if (d->ident != want)
-    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) + " in Data_Exch, the GSD "
-                    "says Ident_Number " + hex(ident_octets(want)));
-  run.pass("Slave_Diag carries Ident_Number " + hex(ident_octets(want)) + " before and after the start-up");
+    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) +
+                    " in Data_Exch, the GSD "
+                    "says Ident_Number " +
+                    hex(ident_octets(want)));
+  run.pass("Slave_Diag carries Ident_Number " + hex(ident_octets(want)) +
+           " before and after the start-up");
 }
 
 void get_cfg_is_gsd_cfg(TestContext& ctx, TestResult& res) {
@@ -73,8 +79,8 @@ void io_lengths(TestContext& ctx, TestResult& res) {
   std::string why;
   if (!run.start_up(why)) return run.fail(why);
   const std::vector<std::uint8_t> out(len->output_len, 0);
-  const Reply r = reply_of(run.data_exchange(out, "Data_Exchange with " + std::to_string(len->output_len) +
-                                                      " output octets"));
+  const Reply r = reply_of(run.data_exchange(
+      out, "Data_Exchange with " + std::to_string(len->output_len) + " output octets"));
   const bool ok = len->input_len == 0 ? r.kind == Reply::Kind::Sc
                                       : r.ok_with_data() && r.data.size() == len->input_len;
   if (!ok)
@@ -110,19 +116,23 @@ void user_prm_len(TestContext& ctx, TestResult& res) {
   if (!longer_ok) {
     dp::SlaveParams p = ctx.params();
     p.user_prm.push_back(0x00);
-    const auto f = prm_fault_after(run, p, "Set_Prm with " + std::to_string(n + 1) + " User_Prm_Data octets");
+    const auto f =
+        prm_fault_after(run, p, "Set_Prm with " + std::to_string(n + 1) + " User_Prm_Data octets");
     if (!f) return;
-    if (!*f) return run.fail("Set_Prm with " + std::to_string(n + 1) + " User_Prm_Data octets (GSD: " +
-                             std::to_string(n) + ") gave no Prm_Fault");
+    if (!*f)
+      return run.fail("Set_Prm with " + std::to_string(n + 1) +
+                      " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
     msg += ", " + std::to_string(n + 1) + " refused";
   }
   if (n > 0) {
     dp::SlaveParams p = ctx.params();
     p.user_prm.pop_back();
-    const auto f = prm_fault_after(run, p, "Set_Prm with " + std::to_string(n - 1) + " User_Prm_Data octets");
+    const auto f =
+        prm_fault_after(run, p, "Set_Prm with " + std::to_string(n - 1) + " User_Prm_Data octets");
     if (!f) return;
-    if (!*f) return run.fail("Set_Prm with " + std::to_string(n - 1) + " User_Prm_Data octets (GSD: " +
-                             std::to_string(n) + ") gave no Prm_Fault");
+    if (!*f)
+      return run.fail("Set_Prm with " + std::to_string(n - 1) +
+                      " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
     msg += ", " + std::to_string(n - 1) + " refused";
   }
   run.pass(msg + " (Prm_Fault)");
@@ -174,13 +184,15 @@ void dpv1_prm(TestContext& ctx, TestResult& res) {
   if (ctx.spec().gsd->dpv1().dpv1_slave) {
     if (p.user_prm.size() < 3) p.user_prm.resize(3, 0);
     p.user_prm[0] |= dp::kDpv1Enable;
-    if (!run.start_up(why, &p)) return run.fail("DPV1_Slave = 1 but Set_Prm with DPV1_Enable: " + why);
+    if (!run.start_up(why, &p))
+      return run.fail("DPV1_Slave = 1 but Set_Prm with DPV1_Enable: " + why);
     return run.pass("DPV1_Slave = 1: Set_Prm with DPV1_Enable accepted");
   }
   p.user_prm.insert(p.user_prm.begin(), {dp::kDpv1Enable, 0x00, 0x00});
   const auto f = prm_fault_after(run, p, "Set_Prm led by DPV1_Status 80 00 00");
   if (!f) return;
-  if (!*f) return run.fail("DPV1_Slave = 0 but a Set_Prm led by DPV1_Status 80 00 00 gave no Prm_Fault");
+  if (!*f)
+    return run.fail("DPV1_Slave = 0 but a Set_Prm led by DPV1_Status 80 00 00 gave no Prm_Fault");
   run.pass("DPV1_Slave = 0: a Set_Prm led by DPV1_Status 80 00 00 was refused (Prm_Fault)");
 }
 
@@ -210,7 +222,8 @@ void sync_freeze(TestContext& ctx, TestResult& res) {
     if (!c.supp && !ns)
       return run.fail(std::string("the GSD does not support it, but Set_Prm with ") + c.name +
                       " gave no Not_Supported: " + hex(d->encode()));
-    msg += std::string(msg.empty() ? "" : "; ") + c.name + (c.supp ? " accepted" : " Not_Supported");
+    msg +=
+        std::string(msg.empty() ? "" : "; ") + c.name + (c.supp ? " accepted" : " Not_Supported");
   }
   run.pass(msg + ", as the GSD says");
 }
@@ -229,11 +242,11 @@ void add_gsd_tests(std::vector<TestCase>& out) {
       "Get_Cfg returns the real configuration: the identifiers of the configured GSD modules "
       "(PI 2.122 Module; protocol-facts.md §D.3, §I.1)",
       {SlaveMutant::WrongGetCfg}, get_cfg_is_gsd_cfg));
-  out.push_back(make_case(
-      "GSD-03", kGroup, "Data_Exchange lengths",
-      "Data_Exchange takes as many output octets and returns as many input octets as the "
-      "configuration identifiers add up to (protocol-facts.md §D.3, §D.7)",
-      {}, io_lengths));
+  out.push_back(
+      make_case("GSD-03", kGroup, "Data_Exchange lengths",
+                "Data_Exchange takes as many output octets and returns as many input octets as the "
+                "configuration identifiers add up to (protocol-facts.md §D.3, §D.7)",
+                {}, io_lengths));
   out.push_back(make_case(
       "GSD-04", kGroup, "User_Prm_Data length",
       "The slave accepts exactly the User_Prm_Data the GSD assembles (User_Prm_Data_Len plus the "
@@ -245,11 +258,11 @@ void add_gsd_tests(std::vector<TestCase>& out) {
       "No diagnosis is longer than the GSD's Max_Diag_Data_Len (PI 2.122; protocol-facts.md §I.2, "
       "§D.4 Ext_Diag_Overflow)",
       {}, max_diag_len));
-  out.push_back(make_case(
-      "GSD-06", kGroup, "DP-V1 Set_Prm iff DPV1_Slave",
-      "A Set_Prm with DPV1_Status (DPV1_Enable) is accepted exactly when the GSD says "
-      "DPV1_Slave = 1 (PI 2.122; protocol-facts.md §D.2, §I.2)",
-      {}, dpv1_prm));
+  out.push_back(
+      make_case("GSD-06", kGroup, "DP-V1 Set_Prm iff DPV1_Slave",
+                "A Set_Prm with DPV1_Status (DPV1_Enable) is accepted exactly when the GSD says "
+                "DPV1_Slave = 1 (PI 2.122; protocol-facts.md §D.2, §I.2)",
+                {}, dpv1_prm));
   out.push_back(make_case(
       "GSD-07", kGroup, "Sync/Freeze iff supported",
       "Set_Prm with Sync_Req/Freeze_Req is accepted when the GSD says Sync_Mode_supp/"

@@ -5,8 +5,9 @@
 //
 // Decisions:
 // - These tests parameterise the watchdog at 100 ms (WD_Fact_1 = 10, WD_Fact_2 = 1, base 10 ms;
-//   1 ms base if the GSD-assembled DPV1_Status_1 asks for it, then 10 ms): short enough that a
-//   paced outside slave is not kept waiting for seconds, long against a message cycle.
+//   with WD_Base_1ms in the GSD-assembled DPV1_Status_1: 100 x 1 x 1 ms), long against a message
+//   cycle. An outside slave gets 10 ms (WD_Fact 1 x 1, as cbat's watchdog tests): paced at 1/1000
+//   the 150 ms wait would take 150 s of wall time, the 10 ms one 15 s.
 // - "Longer than the watchdog" = 1.5 × TWD of silence, "shorter" = 0.5 × TWD.
 // - After a watchdog expiry or a power cycle the slave must be in Wait_Prm: Slave_Diag octet 1
 //   has Station_Not_Ready, octet 4 (Master_Add) is FF, and Data_Exchange is not answered with
@@ -20,6 +21,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -27,12 +29,12 @@ namespace {
 
 constexpr const char* kGroup = "Interruption";
 
-/// The context's parameters with a 100 ms watchdog.
+/// The context's parameters with a 100 ms watchdog (10 ms for an outside slave).
 dp::SlaveParams with_short_watchdog(const TestContext& ctx, bus::Ticks& twd) {
   dp::SlaveParams p = ctx.params();
   p.station_status |= dp::kPrmWdOn;
   const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
-  p.wd_fact_1 = base_1ms ? 100 : 10;
+  p.wd_fact_1 = static_cast<std::uint8_t>((base_1ms ? 10 : 1) * (ctx.outside() ? 1 : 10));
   p.wd_fact_2 = 1;
   twd = dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
   return p;
@@ -55,13 +57,15 @@ bool in_wait_prm(Run& run, const std::string& when, std::vector<std::uint8_t>* d
     diag6->assign(b.begin(), b.end());
   }
   if (!wait_prm_diag(*d)) {
-    run.fail(when + ": the diagnosis " + hex(d->encode()) +
-             " is not that of a slave in Wait_Prm (octet 1 Station_Not_Ready, octet 4 FF expected)");
+    run.fail(
+        when + ": the diagnosis " + hex(d->encode()) +
+        " is not that of a slave in Wait_Prm (octet 1 Station_Not_Ready, octet 4 FF expected)");
     return false;
   }
   const Reply dx = reply_of(run.data_exchange(run.outputs(0x00), "Data_Exchange " + when));
   if (dx.ok_with_data() || dx.kind == Reply::Kind::Sc) {
-    run.fail(when + ": Data_Exchange was answered " + dx.describe() + " (must be refused in Wait_Prm)");
+    run.fail(when + ": Data_Exchange was answered " + dx.describe() +
+             " (must be refused in Wait_Prm)");
     return false;
   }
   return true;
@@ -105,8 +109,10 @@ void long_interruption(TestContext& ctx, TestResult& res) {
   if (!outputs_safe(run, "after the watchdog expired")) return;
   std::string why;
   if (!run.start_up(why, &p)) return run.fail("fresh start-up after the interruption: " + why);
-  const Reply r = reply_of(run.data_exchange(run.outputs(0x0F), "Data_Exchange after the new start-up"));
-  if (!data_answer(ctx, r)) return run.fail("Data_Exchange after the new start-up answered " + r.describe());
+  const Reply r =
+      reply_of(run.data_exchange(run.outputs(0x0F), "Data_Exchange after the new start-up"));
+  if (!data_answer(ctx, r))
+    return run.fail("Data_Exchange after the new start-up answered " + r.describe());
   run.pass("after " + std::to_string(bus::ticks_to_us(twd + twd / 2) / 1000) +
            " ms without bus (TWD " + std::to_string(bus::ticks_to_us(twd) / 1000) +
            " ms) the slave was in Wait_Prm; a fresh start-up succeeded");
@@ -150,7 +156,8 @@ void dut_power_cycle(TestContext& ctx, TestResult& res) {
   std::vector<std::uint8_t> masked(d6.begin(), d6.begin() + 4);
   masked[0] &= static_cast<std::uint8_t>(~dp::kDiagExtDiag);
   if (masked != want)
-    return run.fail("after power off/on the diagnosis reads " + hex(d6) + ", expected 02 05 00 FF ..");
+    return run.fail("after power off/on the diagnosis reads " + hex(d6) +
+                    ", expected 02 05 00 FF ..");
   if (!outputs_safe(run, "after power off/on")) return;
   run.pass(std::string("after power off/on the slave was in Wait_Prm (") + hex(d6) + ")" +
            (run.model() ? " with its outputs safe" : "; outputs not visible (outside slave)"));
@@ -164,7 +171,8 @@ void master_power_off(TestContext& ctx, TestResult& res) {
   if (!operate(run, p, 0x3C)) return;
   if (run.model() && ctx.output_len() > 0) {
     const auto got = applied_outputs(*run.model());
-    if (got != run.outputs(0x3C)) return run.fail("before the master's power-off: " + outputs_text(got, run.outputs(0x3C)));
+    if (got != run.outputs(0x3C))
+      return run.fail("before the master's power-off: " + outputs_text(got, run.outputs(0x3C)));
   }
   run.bus().idle(twd + twd / 2);  // the master is off: nothing on the line
   if (!outputs_safe(run, "1.5 x TWD after the master went silent")) return;
@@ -194,11 +202,11 @@ void add_interruption_tests(std::vector<TestCase>& out) {
       "`02 05 00 FF idH idL`, its outputs safe (IEC 61158-6 DP slave state machine; "
       "protocol-facts.md §D.8, §D.4)",
       {SlaveMutant::KeepStateOnPowerCycle}, dut_power_cycle));
-  out.push_back(make_case(
-      "INT-04", kGroup, "Power off of the master",
-      "When the master goes silent the watchdog expires: outputs safe, back to Wait_Prm "
-      "(IEC 61158-6 DP response monitoring; protocol-facts.md §D.8)",
-      {SlaveMutant::IgnoreWatchdog}, master_power_off));
+  out.push_back(
+      make_case("INT-04", kGroup, "Power off of the master",
+                "When the master goes silent the watchdog expires: outputs safe, back to Wait_Prm "
+                "(IEC 61158-6 DP response monitoring; protocol-facts.md §D.8)",
+                {SlaveMutant::IgnoreWatchdog}, master_power_off));
 }
 
 }  // namespace pbvbus::conformance::detail

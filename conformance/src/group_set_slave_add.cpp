@@ -17,6 +17,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -24,7 +25,9 @@ namespace {
 
 constexpr const char* kGroup = "Set_Slave_Add";
 
-std::uint8_t other_address(std::uint8_t a) { return a == 100 ? 101 : 100; }
+std::uint8_t other_address(std::uint8_t a) {
+  return a == 100 ? 101 : 100;
+}
 
 bool supported(Run& run) {
   if (!run.ctx().spec().gsd->slave_features().set_slave_add_supp) {
@@ -45,7 +48,8 @@ bool answers_at(Run& run, std::uint8_t addr, const std::string& note) {
 
 /// After a refusal test: an outside slave that moved anyway is moved back.
 void restore(Run& run, std::uint8_t from, std::uint8_t to) {
-  if (!run.model()) run.set_slave_add(from, to, run.ctx().params().ident, false, "restore the address");
+  if (!run.model())
+    run.set_slave_add(from, to, run.ctx().params().ident, false, "restore the address");
 }
 
 void new_address_taken(TestContext& ctx, TestResult& res) {
@@ -56,7 +60,8 @@ void new_address_taken(TestContext& ctx, TestResult& res) {
   const std::string to = " (" + std::to_string(old_a) + " -> " + std::to_string(new_a) + ")";
   const Reply r = reply_of(run.set_slave_add(old_a, new_a, ident, false, "Set_Slave_Add" + to));
   if (r.kind != Reply::Kind::Sc)
-    return run.fail("Set_Slave_Add" + to + " in Wait_Prm answered " + r.describe() + " instead of SC");
+    return run.fail("Set_Slave_Add" + to + " in Wait_Prm answered " + r.describe() +
+                    " instead of SC");
   if (!answers_at(run, new_a, "Slave_Diag at the new address"))
     return run.fail("no diagnosis at the new address " + std::to_string(new_a));
   if (answers_at(run, old_a, "Slave_Diag at the old address"))
@@ -71,8 +76,8 @@ void new_address_taken(TestContext& ctx, TestResult& res) {
   run.set_prm(p.set_prm_du(), "Set_Prm with Unlock_Req (back to Wait_Prm)");
   const Reply back = reply_of(run.set_slave_add(new_a, old_a, ident, false, "Set_Slave_Add back"));
   if (back.kind != Reply::Kind::Sc)
-    return run.fail("Set_Slave_Add back to " + std::to_string(old_a) + " after No_Add_Chg = 0 answered " +
-                    back.describe() + " instead of SC");
+    return run.fail("Set_Slave_Add back to " + std::to_string(old_a) +
+                    " after No_Add_Chg = 0 answered " + back.describe() + " instead of SC");
   run.set_dut(old_a);
   if (!answers_at(run, old_a, "Slave_Diag at the original address"))
     return run.fail("no diagnosis at the original address after changing back");
@@ -84,18 +89,21 @@ void no_add_chg(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   if (!run.model())
-    return run.na("No_Add_Chg can be undone only by a reset of the device: an outside slave would "
-                  "stay at another address for the rest of the run");
+    return run.na(
+        "No_Add_Chg can be undone only by a reset of the device: an outside slave would "
+        "stay at another address for the rest of the run");
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
   const std::uint8_t third = old_a == 102 ? 103 : 102;
   const std::uint16_t ident = ctx.params().ident;
-  const Reply r = reply_of(run.set_slave_add(old_a, new_a, ident, true, "Set_Slave_Add, No_Add_Chg = 1"));
+  const Reply r =
+      reply_of(run.set_slave_add(old_a, new_a, ident, true, "Set_Slave_Add, No_Add_Chg = 1"));
   if (r.kind != Reply::Kind::Sc)
-    return run.fail("Set_Slave_Add with No_Add_Chg = 1 answered " + r.describe() + " instead of SC");
+    return run.fail("Set_Slave_Add with No_Add_Chg = 1 answered " + r.describe() +
+                    " instead of SC");
   if (!answers_at(run, new_a, "Slave_Diag at the new address"))
     return run.fail("no diagnosis at the new address " + std::to_string(new_a));
-  const Reply r2 =
-      reply_of(run.set_slave_add(new_a, third, ident, false, "second Set_Slave_Add (after No_Add_Chg)"));
+  const Reply r2 = reply_of(
+      run.set_slave_add(new_a, third, ident, false, "second Set_Slave_Add (after No_Add_Chg)"));
   if (r2.kind == Reply::Kind::Sc)
     return run.fail("a second Set_Slave_Add after No_Add_Chg = 1 was acknowledged (SC)");
   if (answers_at(run, third, "Slave_Diag at the refused address"))
@@ -110,16 +118,19 @@ void wrong_ident(TestContext& ctx, TestResult& res) {
   if (!run || !supported(run)) return;
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
   const std::uint16_t wrong = static_cast<std::uint16_t>(ctx.params().ident ^ 0x5555);
-  const Reply r = reply_of(run.set_slave_add(old_a, new_a, wrong, false, "Set_Slave_Add, wrong ident"));
+  const Reply r =
+      reply_of(run.set_slave_add(old_a, new_a, wrong, false, "Set_Slave_Add, wrong ident"));
   const bool moved = answers_at(run, new_a, "Slave_Diag at the new address");
   if (moved) restore(run, new_a, old_a);
-  if (r.kind == Reply::Kind::Sc) return run.fail("Set_Slave_Add with a wrong Ident_Number was acknowledged (SC)");
-  if (moved) return run.fail("the slave answers at " + std::to_string(new_a) + " after a wrong ident");
+  if (r.kind == Reply::Kind::Sc)
+    return run.fail("Set_Slave_Add with a wrong Ident_Number was acknowledged (SC)");
+  if (moved)
+    return run.fail("the slave answers at " + std::to_string(new_a) + " after a wrong ident");
   if (!answers_at(run, old_a, "Slave_Diag at the old address"))
     return run.fail("the slave no longer answers at " + std::to_string(old_a));
-  run.pass("Set_Slave_Add with Ident_Number " + hex(std::vector<std::uint8_t>{
-                                                    static_cast<std::uint8_t>(wrong >> 8),
-                                                    static_cast<std::uint8_t>(wrong & 0xFF)}) +
+  run.pass("Set_Slave_Add with Ident_Number " +
+           hex(std::vector<std::uint8_t>{static_cast<std::uint8_t>(wrong >> 8),
+                                         static_cast<std::uint8_t>(wrong & 0xFF)}) +
            " refused (" + r.describe() + "), address kept");
 }
 
@@ -133,12 +144,18 @@ void in_data_exchange(TestContext& ctx, TestResult& res) {
       run.set_slave_add(old_a, new_a, ctx.params().ident, false, "Set_Slave_Add in Data_Exch"));
   const bool moved = answers_at(run, new_a, "Slave_Diag at the new address");
   if (moved) restore(run, new_a, old_a);
-  if (r.kind == Reply::Kind::Sc) return run.fail("Set_Slave_Add in Data_Exch was acknowledged (SC)");
-  if (moved) return run.fail("the slave answers at " + std::to_string(new_a) + " after Set_Slave_Add in Data_Exch");
-  const Reply dx = reply_of(run.data_exchange(run.outputs(0x00), "Data_Exchange at the old address"));
+  if (r.kind == Reply::Kind::Sc)
+    return run.fail("Set_Slave_Add in Data_Exch was acknowledged (SC)");
+  if (moved)
+    return run.fail("the slave answers at " + std::to_string(new_a) +
+                    " after Set_Slave_Add in Data_Exch");
+  const Reply dx =
+      reply_of(run.data_exchange(run.outputs(0x00), "Data_Exchange at the old address"));
   if (!dx.ok_with_data() && !(dx.kind == Reply::Kind::Sc && ctx.input_len() == 0))
-    return run.fail("after the refused Set_Slave_Add the slave is not in Data_Exch: Data_Exchange "
-                    "answered " + dx.describe());
+    return run.fail(
+        "after the refused Set_Slave_Add the slave is not in Data_Exch: Data_Exchange "
+        "answered " +
+        dx.describe());
   run.pass("Set_Slave_Add in Data_Exch refused (" + r.describe() + "), data exchange went on");
 }
 
@@ -156,11 +173,11 @@ void add_set_slave_add_tests(std::vector<TestCase>& out) {
       "After Set_Slave_Add with No_Add_Chg != 0 a further Set_Slave_Add is refused until a reset "
       "(IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7)",
       {}, no_add_chg));
-  out.push_back(make_case(
-      "ADD-03", kGroup, "Wrong ident refused",
-      "Set_Slave_Add whose Ident_Number is not the slave's is refused; the address stays "
-      "(IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7)",
-      {}, wrong_ident));
+  out.push_back(
+      make_case("ADD-03", kGroup, "Wrong ident refused",
+                "Set_Slave_Add whose Ident_Number is not the slave's is refused; the address stays "
+                "(IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7)",
+                {}, wrong_ident));
   out.push_back(make_case(
       "ADD-04", kGroup, "Refused in Data_Exch",
       "Set_Slave_Add is accepted only in Power_On/Wait_Prm; in Data_Exch it is refused and data "

@@ -15,8 +15,8 @@ std::optional<dp::StandardDiag> standard_diag(const Reply& r) {
 }
 
 bool diag_ready(const dp::StandardDiag& d) {
-  constexpr std::uint8_t kNotReady =
-      dp::kDiagStationNonExistent | dp::kDiagStationNotReady | dp::kDiagCfgFault | dp::kDiagPrmFault;
+  constexpr std::uint8_t kNotReady = dp::kDiagStationNonExistent | dp::kDiagStationNotReady |
+                                     dp::kDiagCfgFault | dp::kDiagPrmFault;
   return (d.status_1 & kNotReady) == 0 && (d.status_2 & dp::kDiagPrmReq) == 0;
 }
 
@@ -51,7 +51,8 @@ TestCase make_case(std::string id, std::string group, std::string name, std::str
   return c;
 }
 
-// --- Run ------------------------------------------------------------------------------------------
+// --- Run
+// ------------------------------------------------------------------------------------------
 
 Run::Run(TestContext& ctx, TestResult& result, std::optional<bus::Baud> baud)
     : m_ctx(ctx), m_result(result) {
@@ -76,8 +77,8 @@ Run::~Run() {
     std::vector<Exchange> kept(m_evidence.begin(), m_evidence.begin() + kHead);
     kept.insert(kept.end(), m_evidence.end() - kTail, m_evidence.end());
     m_evidence = std::move(kept);
-    m_result.message += " (evidence: " + std::to_string(dropped) +
-                        " exchanges in the middle left out)";
+    m_result.message +=
+        " (evidence: " + std::to_string(dropped) + " exchanges in the middle left out)";
   }
   for (auto& e : m_evidence) m_result.evidence.push_back(std::move(e));
 }
@@ -98,7 +99,9 @@ bool Run::reopen(std::optional<bus::Baud> baud, std::string& error) {
   return true;
 }
 
-bus::Ticks Run::bits(std::int64_t n) const { return bus::bits_to_ticks(n, m_session->bus().baud()); }
+bus::Ticks Run::bits(std::int64_t n) const {
+  return bus::bits_to_ticks(n, m_session->bus().baud());
+}
 
 Exchange Run::slave_diag(std::string note, std::optional<std::uint8_t> sa) {
   const auto t = srd(m_dut, sa.value_or(m_tester), dp::kSapSlaveDiag, dp::kSapMs0, {});
@@ -203,7 +206,8 @@ bool acknowledged(const Reply& r) {
 }
 }  // namespace
 
-bool Run::start_up(std::string& why, const dp::SlaveParams* params, std::optional<std::uint8_t> sa) {
+bool Run::start_up(std::string& why, const dp::SlaveParams* params,
+                   std::optional<std::uint8_t> sa) {
   const dp::SlaveParams& p = params ? *params : m_ctx.params();
   if (!diag(why, "start-up: Slave_Diag", sa)) return false;
   const auto prm = p.set_prm_du();

@@ -35,6 +35,7 @@
 
 #include "groups.hpp"
 #include "steps.hpp"  // hex()
+
 #include "pbvbus/conformance/battery.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
 #include "pbvbus/dp/master.hpp"

@@ -22,6 +22,7 @@
 #include <string>
 
 #include "group_support.hpp"
+
 #include "pbvbus/fdl/bus_params.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -29,7 +30,9 @@ namespace {
 
 constexpr const char* kGroup = "Timing";
 
-bool is_answer(const Reply& r) { return r.kind == Reply::Kind::Sc || r.kind == Reply::Kind::Telegram; }
+bool is_answer(const Reply& r) {
+  return r.kind == Reply::Kind::Sc || r.kind == Reply::Kind::Telegram;
+}
 
 void tsdr_every_baud(TestContext& ctx, TestResult& res) {
   res.timing_not_meaningful = ctx.outside();
@@ -64,10 +67,12 @@ void tsdr_every_baud(TestContext& ctx, TestResult& res) {
       if (!is_answer(r) || e.tsdr_bits < 0)
         return run.fail("at " + bn + ": " + e.note + " got no reply within the slot time");
       const std::uint32_t min = after_prm ? prm_min : line_min;
-      if (e.tsdr_bits < static_cast<std::int64_t>(min) || e.tsdr_bits > static_cast<std::int64_t>(max))
-        return run.fail("at " + bn + ": the reply to " + e.note + " came after TSDR = " +
-                        std::to_string(e.tsdr_bits) + " bit times, outside [" + std::to_string(min) +
-                        ", " + std::to_string(max) + "] (min TSDR, GSD MaxTsdr_" + bn + ")");
+      if (e.tsdr_bits < static_cast<std::int64_t>(min) ||
+          e.tsdr_bits > static_cast<std::int64_t>(max))
+        return run.fail("at " + bn + ": the reply to " + e.note +
+                        " came after TSDR = " + std::to_string(e.tsdr_bits) +
+                        " bit times, outside [" + std::to_string(min) + ", " + std::to_string(max) +
+                        "] (min TSDR, GSD MaxTsdr_" + bn + ")");
       lo = std::min(lo, e.tsdr_bits);
       hi = std::max(hi, e.tsdr_bits);
       if (e.note.find("Set_Prm") != std::string::npos) after_prm = true;
@@ -113,7 +118,8 @@ void min_slave_interval(TestContext& ctx, TestResult& res) {
                     std::to_string(bus::ticks_to_us(shortest)) + ".." +
                     std::to_string(bus::ticks_to_us(longest)) + " us apart (Min_Slave_Intervall " +
                     std::to_string(msi * 100) + " us)";
-  if (shortest > interval) msg += "; one message cycle is longer than Min_Slave_Intervall at this baud";
+  if (shortest > interval)
+    msg += "; one message cycle is longer than Min_Slave_Intervall at this baud";
   run.pass(msg);
 }
 
@@ -136,12 +142,15 @@ void tsyn(TestContext& ctx, TestResult& res) {
     const bus::Ticks at = prev.response_end + run.bits(fdl::BusParams::kTsyn);
     const auto& sv = services[i % 3];
     Exchange e = run.service(sv.sap, {}, std::string(sv.name) + " after 33 bit times of idle", at);
-    const std::int64_t idle = bus::ticks_to_bits(e.request_start - prev.response_end, run.bus().baud());
+    const std::int64_t idle =
+        bus::ticks_to_bits(e.request_start - prev.response_end, run.bus().baud());
     worst = std::max(worst, idle);
     const Reply r = reply_of(e);
     if (!is_answer(r))
-      return run.fail(e.note + " (" + std::to_string(idle) + " bit times after the previous reply) "
-                      "got " + r.describe());
+      return run.fail(e.note + " (" + std::to_string(idle) +
+                      " bit times after the previous reply) "
+                      "got " +
+                      r.describe());
     prev = std::move(e);
   }
   std::string msg = "six requests sent after 33 bit times of idle were all answered";
@@ -168,7 +177,8 @@ void add_timing_tests(std::vector<TestCase>& out) {
       {SlaveMutant::SlowSlaveInterval}, min_slave_interval));
   out.push_back(make_case(
       "TIM-03", kGroup, "Request after TSYN answered",
-      "A station is ready to receive once the line has been idle for TSYN = 33 bit times; a request "
+      "A station is ready to receive once the line has been idle for TSYN = 33 bit times; a "
+      "request "
       "that follows the slave's reply after exactly 33 bit times is answered (IEC 61158-4-3 "
       "synchronisation time; protocol-facts.md §A, §C.2)",
       {}, tsyn));

@@ -27,12 +27,12 @@ TEST(GroupClass2, Class2DiagShowsTheOwner) {
   // SSAP 3E; FCS = 83+82+4D+3C+3E = 0x1CC -> CC.
   const Exchange* e = find_exchange(*t, "class 2: Slave_Diag");
   ASSERT_NE(e, nullptr);
-  EXPECT_EQ(e->request,
-            (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x83, 0x82, 0x4D, 0x3C, 0x3E, 0xCC, 0x16}));
+  EXPECT_EQ(e->request, (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x83, 0x82, 0x4D, 0x3C,
+                                                   0x3E, 0xCC, 0x16}));
   // Answer (SD3): in Data_Exch with the tester: 00, WD_On|always-1 0C, 00, Master_Add 01, 0A 01;
   // FCS = 82+83+08+3E+3C+00+0C+00+01+0A+01 = 0x19F -> 9F.
-  EXPECT_EQ(e->response, (std::vector<std::uint8_t>{0xA2, 0x82, 0x83, 0x08, 0x3E, 0x3C, 0x00, 0x0C, 0x00,
-                                                    0x01, 0x0A, 0x01, 0x9F, 0x16}));
+  EXPECT_EQ(e->response, (std::vector<std::uint8_t>{0xA2, 0x82, 0x83, 0x08, 0x3E, 0x3C, 0x00, 0x0C,
+                                                    0x00, 0x01, 0x0A, 0x01, 0x9F, 0x16}));
 }
 
 TEST(GroupClass2, IgnoreLockFails) {

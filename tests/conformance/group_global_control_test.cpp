@@ -42,8 +42,8 @@ TEST(GroupGlobalControl, ClearDataTelegramsOnTheWire) {
   //   LE = DA SA FC + 2 = 5; FCS = 03+01+4D+A5+A5 = 0x19B -> 9B.
   const Exchange* dx = find_exchange(*t, "outputs A5");
   ASSERT_NE(dx, nullptr);
-  EXPECT_EQ(dx->request,
-            (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x03, 0x01, 0x4D, 0xA5, 0xA5, 0x9B, 0x16}));
+  EXPECT_EQ(dx->request, (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x03, 0x01, 0x4D, 0xA5,
+                                                    0xA5, 0x9B, 0x16}));
   // Reply: DL (08) from 3 to 1 with the 2 input octets: 68 05 05 68 01 03 08 i0 i1 FCS 16.
   ASSERT_EQ(dx->response.size(), 11u);
   EXPECT_EQ(std::vector<std::uint8_t>(dx->response.begin(), dx->response.begin() + 7),
@@ -68,7 +68,8 @@ TEST(GroupGlobalControl, EachMutantFailsTheTestAimedAtIt) {
 
 TEST(GroupGlobalControl, UnsupportedSyncGivesNotSupported) {
   // PBVB0A01 with Sync_Mode_supp = 0: GC-02 is n/a, GC-06 checks the refusal.
-  auto gsd = shipped_gsd_with("PBVB0A01.gsd", "Sync_Mode_supp          = 1", "Sync_Mode_supp          = 0");
+  auto gsd = shipped_gsd_with("PBVB0A01.gsd", "Sync_Mode_supp          = 1",
+                              "Sync_Mode_supp          = 0");
   ASSERT_NE(gsd, nullptr);
   const auto r = run_only(shipped(Shipped::A01, std::nullopt, gsd), "Global_Control");
   EXPECT_EQ(verdict_of(r, "GC-02"), Verdict::NotApplicable) << describe(r);

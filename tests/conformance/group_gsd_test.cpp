@@ -26,12 +26,12 @@ TEST(GroupGsd, GetCfgTelegrams) {
   // Get_Cfg: DSAP 3B (59), SSAP 3E; FCS = 83+81+4D+3B+3E = 0x1CA -> CA.
   const Exchange* e = find_exchange(*t, "Get_Cfg");
   ASSERT_NE(e, nullptr);
-  EXPECT_EQ(e->request,
-            (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x83, 0x81, 0x4D, 0x3B, 0x3E, 0xCA, 0x16}));
+  EXPECT_EQ(e->request, (std::vector<std::uint8_t>{0x68, 0x05, 0x05, 0x68, 0x83, 0x81, 0x4D, 0x3B,
+                                                   0x3E, 0xCA, 0x16}));
   // PBVB0A04's one module is FF (16 words in/out, consistent): DL, DSAP 3E, SSAP 3B, FF;
   // LE = 6; FCS = 81+83+08+3E+3B+FF = 0x284 -> 84.
-  EXPECT_EQ(e->response,
-            (std::vector<std::uint8_t>{0x68, 0x06, 0x06, 0x68, 0x81, 0x83, 0x08, 0x3E, 0x3B, 0xFF, 0x84, 0x16}));
+  EXPECT_EQ(e->response, (std::vector<std::uint8_t>{0x68, 0x06, 0x06, 0x68, 0x81, 0x83, 0x08, 0x3E,
+                                                    0x3B, 0xFF, 0x84, 0x16}));
 }
 
 TEST(GroupGsd, MaxDiagDataLenCountsTheCfgFaultBlock) {
@@ -56,7 +56,8 @@ TEST(GroupGsd, MutantsFail) {
 }
 
 TEST(GroupGsd, UnsupportedFreezeMustGiveNotSupported) {
-  auto gsd = shipped_gsd_with("PBVB0A02.gsd", "Freeze_Mode_supp        = 1", "Freeze_Mode_supp        = 0");
+  auto gsd = shipped_gsd_with("PBVB0A02.gsd", "Freeze_Mode_supp        = 1",
+                              "Freeze_Mode_supp        = 0");
   ASSERT_NE(gsd, nullptr);
   const auto r = run_only(shipped(Shipped::A02, std::nullopt, gsd), "GSD-07");
   const TestResult* t = find_result(r, "GSD-07");

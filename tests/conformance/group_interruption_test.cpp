@@ -29,15 +29,15 @@ TEST(GroupInterruption, PowerCycleTelegrams) {
   // FCS = 83+81+4D+3D+3E+88+0A+01+0B+0A+01+00+12 = 0x287 -> 87.
   const Exchange* prm = find_exchange(*t, "start-up: Set_Prm");
   ASSERT_NE(prm, nullptr);
-  EXPECT_EQ(prm->request, (std::vector<std::uint8_t>{0x68, 0x0D, 0x0D, 0x68, 0x83, 0x81, 0x4D, 0x3D, 0x3E,
-                                                     0x88, 0x0A, 0x01, 0x0B, 0x0A, 0x01, 0x00, 0x12, 0x87,
-                                                     0x16}));
+  EXPECT_EQ(prm->request,
+            (std::vector<std::uint8_t>{0x68, 0x0D, 0x0D, 0x68, 0x83, 0x81, 0x4D, 0x3D, 0x3E, 0x88,
+                                       0x0A, 0x01, 0x0B, 0x0A, 0x01, 0x00, 0x12, 0x87, 0x16}));
   // After power off/on: SD3 A2 DA=1|EXT 81, SA=3|EXT 83, FC DL 08, DSAP 3E, SSAP 3C,
   // 02 05 00 FF 0A 01; FCS = 81+83+08+3E+3C+02+05+00+FF+0A+01 = 0x297 -> 97.
   const Exchange* d = find_exchange(*t, "Slave_Diag after power off/on");
   ASSERT_NE(d, nullptr);
-  EXPECT_EQ(d->response, (std::vector<std::uint8_t>{0xA2, 0x81, 0x83, 0x08, 0x3E, 0x3C, 0x02, 0x05, 0x00,
-                                                    0xFF, 0x0A, 0x01, 0x97, 0x16}));
+  EXPECT_EQ(d->response, (std::vector<std::uint8_t>{0xA2, 0x81, 0x83, 0x08, 0x3E, 0x3C, 0x02, 0x05,
+                                                    0x00, 0xFF, 0x0A, 0x01, 0x97, 0x16}));
   // Data_Exchange in Wait_Prm: RS = SD1 10 01 03 03 FCS 16, FCS = 01+03+03 = 07.
   const Exchange* dx = find_exchange(*t, "Data_Exchange after power off/on");
   ASSERT_NE(dx, nullptr);

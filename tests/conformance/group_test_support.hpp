@@ -51,10 +51,14 @@ inline std::shared_ptr<const devices::GsdFile> shipped_gsd_with(const std::strin
 enum class Shipped { A01, A02, A03, A04 };
 inline const char* shipped_name(Shipped s) {
   switch (s) {
-    case Shipped::A01: return "PBVB0A01";
-    case Shipped::A02: return "PBVB0A02";
-    case Shipped::A03: return "PBVB0A03";
-    case Shipped::A04: return "PBVB0A04";
+    case Shipped::A01:
+      return "PBVB0A01";
+    case Shipped::A02:
+      return "PBVB0A02";
+    case Shipped::A03:
+      return "PBVB0A03";
+    case Shipped::A04:
+      return "PBVB0A04";
   }
   return "?";
 }
@@ -72,8 +76,9 @@ inline DutSpec shipped(Shipped s, std::optional<devices::SlaveMutant> mutant = s
   }
   spec.gsd = std::move(gsd);
   switch (s) {
-    case Shipped::A01: break;  // compact station: its one module
-    case Shipped::A02:         // examples/dp-basic.textproto, slave 4
+    case Shipped::A01:
+      break;            // compact station: its one module
+    case Shipped::A02:  // examples/dp-basic.textproto, slave 4
       spec.modules = {devices::ModuleChoice::named("8DI DC24V"),
                       devices::ModuleChoice::named("8DO DC24V/0.5A"),
                       devices::ModuleChoice::named("2AO U/I 16 bit")};
@@ -83,7 +88,8 @@ inline DutSpec shipped(Shipped s, std::optional<devices::SlaveMutant> mutant = s
                       devices::ModuleChoice::named("8DO DC24V/0.5A"),
                       devices::ModuleChoice::named("2AI U/I consistent")};
       break;
-    case Shipped::A04: break;  // examples/gateway.textproto, slave 6: its one module
+    case Shipped::A04:
+      break;  // examples/gateway.textproto, slave 6: its one module
   }
   spec.address = 3;
   spec.mutant = mutant;

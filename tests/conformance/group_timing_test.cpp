@@ -42,14 +42,16 @@ TEST(GroupTiming, TsdrTooLateFailsAtTheFirstBaud) {
   ASSERT_NE(t, nullptr);
   EXPECT_EQ(t->verdict, Verdict::Fail);
   EXPECT_NE(t->message.find("at 9.6k"), std::string::npos) << t->message;
-  EXPECT_NE(t->message.find("TSDR = 80 bit times, outside [11, 60]"), std::string::npos) << t->message;
+  EXPECT_NE(t->message.find("TSDR = 80 bit times, outside [11, 60]"), std::string::npos)
+      << t->message;
 }
 
 TEST(GroupTiming, PollsAtMinSlaveIntervalSpacing) {
   // PBVB0A01 with Min_Slave_Intervall = 20 (2 ms): at 1.5 Mbit/s that is 3000 bit times, longer
   // than one message cycle (Data_Exchange SD2 11 octets = 121 bits, TSDR 11, reply 11 octets =
   // 121 bits, TSYN 33: 286 bits), so the polls start exactly 3000 bit times apart.
-  auto gsd = shipped_gsd_with("PBVB0A01.gsd", "Min_Slave_Intervall     = 1", "Min_Slave_Intervall     = 20");
+  auto gsd = shipped_gsd_with("PBVB0A01.gsd", "Min_Slave_Intervall     = 1",
+                              "Min_Slave_Intervall     = 20");
   ASSERT_NE(gsd, nullptr);
   const auto r = run_only(shipped(Shipped::A01, std::nullopt, gsd), "TIM-02");
   const TestResult* t = find_result(r, "TIM-02");

@@ -286,8 +286,15 @@ const std::vector<TestCase>& all_tests() {
     detail::add_chk_cfg_tests(v);
     detail::add_read_service_tests(v);
     detail::add_fcb_tests(v);
-    // cgrp's groups go here, in groups.hpp order (Global_Control, Set_Slave_Add, Timing,
-    // Interruption, Class 2, Fail-safe, DP-V1, Consistency, GSD).
+    detail::add_global_control_tests(v);
+    detail::add_set_slave_add_tests(v);
+    detail::add_timing_tests(v);
+    detail::add_interruption_tests(v);
+    detail::add_class2_tests(v);
+    detail::add_fail_safe_tests(v);
+    detail::add_dpv1_tests(v);
+    detail::add_consistency_tests(v);
+    detail::add_gsd_tests(v);
     return v;
   }();
   return tests;

@@ -1,0 +1,274 @@
+// Group "GSD" (GSD-nn): what the slave reports and accepts agrees with its device description
+// (PI 2.122 GSD keywords; protocol-facts.md §I.2 Ident_Number, Module, User_Prm_Data_Len,
+// Max_Diag_Data_Len, DPV1_Slave, Sync_Mode_supp/Freeze_Mode_supp; §D.2–§D.4 for the telegrams).
+//
+// Decisions:
+// - Get_Cfg is compared octet by octet with the concatenated Module identifiers of the chosen
+//   modules (what a configuration tool sends as Chk_Cfg): a slave reports its real configuration
+//   in the encoding its GSD gives.
+// - User_Prm_Data length: the GSD-assembled length is accepted (no Prm_Fault); one octet more and
+//   one octet less are refused (Prm_Fault). "One more" is n/a when the GSD allows structured
+//   parameter blocks after it (Prm_Block_Structure_supp) or the 237-octet limit is reached; "one
+//   less" when the assembled length is 0.
+// - Max_Diag_Data_Len is checked on every diagnosis the test provokes: in Wait_Prm, after a
+//   Chk_Cfg with one module too many (Cfg_Fault with an identifier-related block), in data
+//   exchange, and (white box, DP-V1 model) with a process alarm outstanding.
+// - "DP-V1 Set_Prm accepted iff DPV1_Slave": a DP-V1 slave accepts DPV1_Enable; a DP-V0 slave
+//   refuses a Set_Prm whose User_Prm_Data is led by DPV1_Status `80 00 00` (Prm_Fault).
+// - Sync/Freeze: Set_Prm with Sync_Req (Freeze_Req) is accepted when the GSD supports it and
+//   answered with Not_Supported when it does not.
+
+#include <algorithm>
+#include <string>
+
+#include "group_support.hpp"
+
+#include "pbvbus/dp/prm.hpp"
+
+namespace pbvbus::conformance::detail {
+namespace {
+
+constexpr const char* kGroup = "GSD";
+
+std::vector<std::uint8_t> ident_octets(std::uint16_t id) {
+  return {static_cast<std::uint8_t>(id >> 8), static_cast<std::uint8_t>(id & 0xFF)};
+}
+
+void diag_ident(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  const std::uint16_t want = ctx.spec().gsd->ident_number();
+  std::string why;
+  auto d = run.diag(why, "Slave_Diag in Wait_Prm");
+  if (!d) return run.fail(why);
+  if (d->ident != want)
+    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) +
+                    " in Wait_Prm, the GSD "
+                    "says Ident_Number " +
+                    hex(ident_octets(want)));
+  if (!run.start_up(why)) return run.fail(why);
+  d = run.diag(why, "Slave_Diag in Data_Exch");
+  if (!d) return run.fail(why);
+  if (d->ident != want)
+    return run.fail("Slave_Diag octets 5..6 read " + hex(ident_octets(d->ident)) +
+                    " in Data_Exch, the GSD "
+                    "says Ident_Number " +
+                    hex(ident_octets(want)));
+  run.pass("Slave_Diag carries Ident_Number " + hex(ident_octets(want)) +
+           " before and after the start-up");
+}
+
+void get_cfg_is_gsd_cfg(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  std::string why;
+  if (!run.start_up(why)) return run.fail(why);
+  const auto want = ctx.params().chk_cfg_du();
+  const Reply r = reply_of(run.get_cfg());
+  if (!r.ok_with_data() || r.data != want)
+    return run.fail("Get_Cfg answered " + r.describe() + ", the GSD modules give " + hex(want));
+  run.pass("Get_Cfg = " + hex(want) + " (the GSD modules' identifiers)");
+}
+
+void io_lengths(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  std::string err;
+  const auto len = devices::gsd_cfg_lengths(ctx.params().chk_cfg_du(), &err);
+  if (!len) return run.fail("the GSD module identifiers cannot be read: " + err);
+  std::string why;
+  if (!run.start_up(why)) return run.fail(why);
+  const std::vector<std::uint8_t> out(len->output_len, 0);
+  const Reply r = reply_of(run.data_exchange(
+      out, "Data_Exchange with " + std::to_string(len->output_len) + " output octets"));
+  const bool ok = len->input_len == 0 ? r.kind == Reply::Kind::Sc
+                                      : r.ok_with_data() && r.data.size() == len->input_len;
+  if (!ok)
+    return run.fail("Data_Exchange with the " + std::to_string(len->output_len) +
+                    " output octets of the identifiers answered " + r.describe() + ", expected " +
+                    std::to_string(len->input_len) + " input octets");
+  run.pass("Data_Exchange: " + std::to_string(len->output_len) + " octets out accepted, " +
+           std::to_string(len->input_len) + " in, as the identifiers say");
+}
+
+/// Set_Prm with `p`, then the diagnosis: true if Prm_Fault is set.
+std::optional<bool> prm_fault_after(Run& run, const dp::SlaveParams& p, const std::string& note) {
+  run.set_prm(p.set_prm_du(), note);
+  std::string why;
+  const auto d = run.diag(why, "Slave_Diag after " + note);
+  if (!d) {
+    run.fail(why);
+    return std::nullopt;
+  }
+  return (d->status_1 & dp::kDiagPrmFault) != 0;
+}
+
+void user_prm_len(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  const auto& gsd = *ctx.spec().gsd;
+  const std::size_t n = ctx.params().user_prm.size();
+  std::string why;
+  if (!run.start_up(why))
+    return run.fail("with the " + std::to_string(n) + " assembled User_Prm_Data octets: " + why);
+  std::string msg = std::to_string(n) + " octets accepted";
+  const bool longer_ok = gsd.dpv1().prm_block_structure_supp || n + 1 > dp::kMaxUserPrmLen;
+  if (!longer_ok) {
+    dp::SlaveParams p = ctx.params();
+    p.user_prm.push_back(0x00);
+    const auto f =
+        prm_fault_after(run, p, "Set_Prm with " + std::to_string(n + 1) + " User_Prm_Data octets");
+    if (!f) return;
+    if (!*f)
+      return run.fail("Set_Prm with " + std::to_string(n + 1) +
+                      " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
+    msg += ", " + std::to_string(n + 1) + " refused";
+  }
+  if (n > 0) {
+    dp::SlaveParams p = ctx.params();
+    p.user_prm.pop_back();
+    const auto f =
+        prm_fault_after(run, p, "Set_Prm with " + std::to_string(n - 1) + " User_Prm_Data octets");
+    if (!f) return;
+    if (!*f)
+      return run.fail("Set_Prm with " + std::to_string(n - 1) +
+                      " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
+    msg += ", " + std::to_string(n - 1) + " refused";
+  }
+  run.pass(msg + " (Prm_Fault)");
+}
+
+void max_diag_len(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  const std::size_t max = ctx.spec().gsd->slave_features().max_diag_data_len;
+  std::size_t longest = 0;
+  auto check = [&](const std::string& note) -> bool {
+    const Reply r = reply_of(run.slave_diag(note));
+    if (!r.ok_with_data()) {
+      run.fail(note + " answered " + r.describe());
+      return false;
+    }
+    longest = std::max(longest, r.data.size());
+    if (r.data.size() > max) {
+      run.fail(note + ": " + std::to_string(r.data.size()) + " octets " + hex(r.data) +
+               ", more than Max_Diag_Data_Len = " + std::to_string(max));
+      return false;
+    }
+    return true;
+  };
+  if (!check("Slave_Diag in Wait_Prm")) return;
+  const auto& p = ctx.params();
+  run.set_prm(p.set_prm_du());
+  auto cfg = p.chk_cfg_du();
+  cfg.push_back(0x10);  // one 1-octet input module too many
+  run.chk_cfg(cfg, "Chk_Cfg with one module too many");
+  if (!check("Slave_Diag after a wrong Chk_Cfg")) return;
+  std::string why;
+  if (!run.start_up(why)) return run.fail(why);
+  if (!check("Slave_Diag in Data_Exch")) return;
+  if (run.model() && ctx.spec().gsd->dpv1().dpv1_slave && p.dpv1()) {
+    if (run.model()->apply(devices::SlaveFault::process_alarm(0, {0x01})).empty() &&
+        !check("Slave_Diag with a process alarm outstanding"))
+      return;
+  }
+  run.pass("every diagnosis was within Max_Diag_Data_Len = " + std::to_string(max) + " (longest " +
+           std::to_string(longest) + ")");
+}
+
+void dpv1_prm(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  dp::SlaveParams p = ctx.params();
+  std::string why;
+  if (ctx.spec().gsd->dpv1().dpv1_slave) {
+    if (p.user_prm.size() < 3) p.user_prm.resize(3, 0);
+    p.user_prm[0] |= dp::kDpv1Enable;
+    if (!run.start_up(why, &p))
+      return run.fail("DPV1_Slave = 1 but Set_Prm with DPV1_Enable: " + why);
+    return run.pass("DPV1_Slave = 1: Set_Prm with DPV1_Enable accepted");
+  }
+  p.user_prm.insert(p.user_prm.begin(), {dp::kDpv1Enable, 0x00, 0x00});
+  const auto f = prm_fault_after(run, p, "Set_Prm led by DPV1_Status 80 00 00");
+  if (!f) return;
+  if (!*f)
+    return run.fail("DPV1_Slave = 0 but a Set_Prm led by DPV1_Status 80 00 00 gave no Prm_Fault");
+  run.pass("DPV1_Slave = 0: a Set_Prm led by DPV1_Status 80 00 00 was refused (Prm_Fault)");
+}
+
+void sync_freeze(TestContext& ctx, TestResult& res) {
+  Run run(ctx, res);
+  if (!run) return;
+  const auto& f = ctx.spec().gsd->slave_features();
+  std::string msg;
+  const struct {
+    std::uint8_t bit;
+    bool supp;
+    const char* name;
+  } cases[] = {{dp::kPrmSyncReq, f.sync_mode_supp, "Sync_Req"},
+               {dp::kPrmFreezeReq, f.freeze_mode_supp, "Freeze_Req"}};
+  for (const auto& c : cases) {
+    dp::SlaveParams p = ctx.params();
+    p.station_status |= c.bit;
+    run.set_prm(p.set_prm_du(), std::string("Set_Prm with ") + c.name);
+    std::string why;
+    const auto d = run.diag(why, std::string("Slave_Diag after Set_Prm with ") + c.name);
+    if (!d) return run.fail(why);
+    const bool ns = (d->status_1 & dp::kDiagNotSupported) != 0;
+    const bool pf = (d->status_1 & dp::kDiagPrmFault) != 0;
+    if (c.supp && (ns || pf))
+      return run.fail(std::string("the GSD supports it, but Set_Prm with ") + c.name +
+                      " gave the diagnosis " + hex(d->encode()));
+    if (!c.supp && !ns)
+      return run.fail(std::string("the GSD does not support it, but Set_Prm with ") + c.name +
+                      " gave no Not_Supported: " + hex(d->encode()));
+    msg +=
+        std::string(msg.empty() ? "" : "; ") + c.name + (c.supp ? " accepted" : " Not_Supported");
+  }
+  run.pass(msg + ", as the GSD says");
+}
+
+}  // namespace
+
+void add_gsd_tests(std::vector<TestCase>& out) {
+  using devices::SlaveMutant;
+  out.push_back(make_case(
+      "GSD-01", kGroup, "Diagnosis ident = Ident_Number",
+      "Slave_Diag octets 5..6 carry the GSD's Ident_Number in every state (PI 2.122 Ident_Number; "
+      "protocol-facts.md §D.4, §I.2)",
+      {SlaveMutant::WrongDiagIdent}, diag_ident));
+  out.push_back(make_case(
+      "GSD-02", kGroup, "Get_Cfg = the modules' identifiers",
+      "Get_Cfg returns the real configuration: the identifiers of the configured GSD modules "
+      "(PI 2.122 Module; protocol-facts.md §D.3, §I.1)",
+      {SlaveMutant::WrongGetCfg}, get_cfg_is_gsd_cfg));
+  out.push_back(
+      make_case("GSD-03", kGroup, "Data_Exchange lengths",
+                "Data_Exchange takes as many output octets and returns as many input octets as the "
+                "configuration identifiers add up to (protocol-facts.md §D.3, §D.7)",
+                {}, io_lengths));
+  out.push_back(make_case(
+      "GSD-04", kGroup, "User_Prm_Data length",
+      "The slave accepts exactly the User_Prm_Data the GSD assembles (User_Prm_Data_Len plus the "
+      "modules' parameters) and sets Prm_Fault for any other length (PI 2.122; protocol-facts.md "
+      "§I.1, §D.2, §D.4)",
+      {}, user_prm_len));
+  out.push_back(make_case(
+      "GSD-05", kGroup, "Max_Diag_Data_Len",
+      "No diagnosis is longer than the GSD's Max_Diag_Data_Len (PI 2.122; protocol-facts.md §I.2, "
+      "§D.4 Ext_Diag_Overflow)",
+      {}, max_diag_len));
+  out.push_back(
+      make_case("GSD-06", kGroup, "DP-V1 Set_Prm iff DPV1_Slave",
+                "A Set_Prm with DPV1_Status (DPV1_Enable) is accepted exactly when the GSD says "
+                "DPV1_Slave = 1 (PI 2.122; protocol-facts.md §D.2, §I.2)",
+                {}, dpv1_prm));
+  out.push_back(make_case(
+      "GSD-07", kGroup, "Sync/Freeze iff supported",
+      "Set_Prm with Sync_Req/Freeze_Req is accepted when the GSD says Sync_Mode_supp/"
+      "Freeze_Mode_supp = 1 and answered with Not_Supported otherwise (PI 2.122; protocol-facts.md "
+      "§D.6, §D.4)",
+      {}, sync_freeze));
+}
+
+}  // namespace pbvbus::conformance::detail

@@ -23,6 +23,8 @@
 #include "groups.hpp"
 #include "pbvbus/bus/pty_station.hpp"
 #include "pbvbus/conformance/battery.hpp"
+
+#include "pbvbus/bus/pty.hpp"
 #include "pbvbus/dp/sap.hpp"
 #include "steps.hpp"
 
@@ -226,13 +228,9 @@ class OutsideContext final : public ContextBase {
     }
     // The program opens pty_path: a symlink to the pty's slave side (an existing symlink is
     // replaced; any other existing file is an error, never overwritten).
-    std::error_code ec;
-    const std::filesystem::path link(*m_spec->pty_path);
-    if (std::filesystem::is_symlink(std::filesystem::symlink_status(link, ec))) std::filesystem::remove(link, ec);
-    ec.clear();
-    std::filesystem::create_symlink(m_pty->path(), link, ec);
-    if (ec) {
-      error = "cannot create " + link.string() + " -> " + m_pty->path() + ": " + ec.message();
+    const std::string e = bus::make_pty_link(m_pty->path(), *m_spec->pty_path);
+    if (!e.empty()) {
+      error = e;
       return false;
     }
     m_link_made = true;

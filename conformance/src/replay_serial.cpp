@@ -12,9 +12,11 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <system_error>
 #include <thread>
 #include <vector>
 
+#include "pbvbus/bus/pty.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
 
@@ -31,11 +33,6 @@ void make_raw(int fd) {
   if (::tcgetattr(fd, &t) != 0) return;  // not a terminal: nothing to set
   ::cfmakeraw(&t);
   ::tcsetattr(fd, TCSANOW, &t);
-}
-
-bool set_nonblocking(int fd) {
-  const int fl = ::fcntl(fd, F_GETFL);
-  return fl >= 0 && ::fcntl(fd, F_SETFL, fl | O_NONBLOCK) == 0;
 }
 
 }  // namespace
@@ -62,43 +59,20 @@ std::unique_ptr<SerialTarget> open_serial_target(const std::string& path, bool c
     t->m_path = path;
     return t;
   }
-  t->m_fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (t->m_fd < 0) {
-    error = errno_text("posix_openpt");
-    return nullptr;
-  }
-  char name[128];
-  if (::grantpt(t->m_fd) != 0 || ::unlockpt(t->m_fd) != 0 ||
-      ::ptsname_r(t->m_fd, name, sizeof name) != 0) {
-    error = errno_text("cannot set up the pseudo-terminal");
-    return nullptr;
-  }
-  t->m_path = name;
-  // Our own handle on the slave side: a reader may open and close the path freely, and the
-  // slave's termios (raw: no CR/LF mapping of the octets we write) stays set.
-  t->m_slave = ::open(name, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK);
-  if (t->m_slave < 0) {
-    error = errno_text("cannot open " + t->m_path);
-    return nullptr;
-  }
-  make_raw(t->m_slave);
-  if (!set_nonblocking(t->m_fd)) {
-    error = errno_text("fcntl O_NONBLOCK");
+  // Our own handle on the slave side (bus::open_pty): a reader may open and close the path
+  // freely, and the slave's termios (raw: no CR/LF mapping of the octets we write) stays set.
+  try {
+    const bus::Pty pty = bus::open_pty();
+    t->m_fd = pty.master;
+    t->m_slave = pty.slave;
+    t->m_path = pty.path;
+  } catch (const std::system_error& e) {
+    error = std::string("cannot set up the pseudo-terminal: ") + e.what();
     return nullptr;
   }
   if (!path.empty()) {
-    struct stat st {};
-    if (::lstat(path.c_str(), &st) == 0) {
-      if (!S_ISLNK(st.st_mode)) {
-        error = "cannot link the pty to " + path + ": a file of that name exists";
-        return nullptr;
-      }
-      ::unlink(path.c_str());
-    }
-    if (::symlink(name, path.c_str()) != 0) {
-      error = errno_text("cannot link the pty to " + path);
-      return nullptr;
-    }
+    error = bus::make_pty_link(t->m_path, path);
+    if (!error.empty()) return nullptr;
     t->m_link = path;
   }
   return t;

@@ -26,15 +26,16 @@
 // - Timing: replay measures TSDR in VIRTUAL time on the replay's line. A program behind a pty
 //   answers when the wall clock lets it: its reply enters the line at the virtual time matching
 //   the wall time it was read (PtyStation, Interface timing: a response goes out as soon as the
-//   line is free), so the measured TSDR is the program's wall-clock latency scaled by 1/20 plus
-//   the pty's and Python's delays, not bus timing. Seen: 11 bit times for most replies, 7 once
-//   (the program's min-TSDR wait starts when it READS the request, which the pty may deliver
-//   before the request's end in virtual time). Without a window option replay checks the DP
-//   profile's [11, 60] and reports such "timing" differences (exit 1). The test therefore gives
-//   --min-tsdr 0 --max-tsdr 100 (TSL): every reply heard within the slot time counts as in
-//   time, and a reply later than TSL is a missing reply anyway. Timing differences are then 0,
-//   asserted exactly. (Nothing in replay's --pty path treats timing differently; the window
-//   options are the documented way.)
+//   line is free), so the measured TSDR is the program's min-TSDR wait plus the pty's, Python's
+//   and the scheduler's latency scaled by 1/20. This test found a bug there: run_pty drove the
+//   PacedRunner in 1 ms slices, every run_until() re-anchored virtual time to the wall clock,
+//   and the program's reply delay shrank (TSDR 7 bit times measured from a program that waits
+//   11; the battery had the same bug, fixed in 08dd63a). Fixed in tools/src/cmd_replay.cpp (one
+//   run, stopped when the replayer is done); measured since: 11 bit times for most replies, up
+//   to ~20 now and then. The window is [min TSDR 11 (default), TSL 100] (--max-tsdr 100): an
+//   early reply (the bug) is still a timing difference, while the latency a loaded machine adds
+//   beyond max TSDR 60 (125 ms of wall time) is not bus timing and is tolerated up to the slot
+//   time; a reply later than TSL is a missing reply anyway. Timing differences: 0, asserted.
 // - The second run ends the program with SIGTERM about halfway (8 s into the ~18 s replay): it
 //   stops reading, prints its summary (JSON) and exits; the PtyStation keeps its own handle on
 //   the pty, so the line goes on and every request after that gets no reply. Exact: all
@@ -263,7 +264,7 @@ ReplayRun run_replay(const std::string& name, const std::string& capture, std::c
     return r;
   }
   Child replay = Child::spawn({kBinary, "replay", capture, "--pty", link, "--station", std::to_string(kDut),
-                               "--speed", kSpeed, "--mask", "inputs", "--min-tsdr", "0", "--max-tsdr", "100",
+                               "--speed", kSpeed, "--mask", "inputs", "--max-tsdr", "100",
                                "--max-diffs", "100", "--json"},
                               base + ".replay");
   if (replay.pid <= 0) {
@@ -313,6 +314,7 @@ TEST(ReplayPty, HonestPythonSlaveAnswersEveryReplayedRequest) {
 
   ReplayRun r = run_replay("honest", cap, 0s);
   if (r.rc == 1 && num(r.report, "totals.differences") == num(r.report, "totals.by_kind.missing_reply")) {
+    // The program not scheduled within the slot time (208 ms of wall time) on a loaded machine.
     std::cout << "[ retry    ] missing replies only (a loaded machine?): running again\n";
     ::testing::Test::RecordProperty("retried_after_missed_replies", "1");
     r = run_replay("honest_retry", cap, 0s);
@@ -331,7 +333,7 @@ TEST(ReplayPty, HonestPythonSlaveAnswersEveryReplayedRequest) {
   for (const char* k : {"missing_reply", "extra_reply", "other_fc", "other_data", "timing"})
     EXPECT_EQ(num(r.report, std::string("totals.by_kind.") + k), 0) << k << "\n" << d;
   EXPECT_EQ(num(r.report, "totals.unusable"), 0) << d;
-  EXPECT_EQ(get(r.report, "tsdr_window.0"), "0") << d;
+  EXPECT_EQ(get(r.report, "tsdr_window.0"), "11") << d;
   EXPECT_EQ(get(r.report, "tsdr_window.1"), "100") << d;
   // The inputs mask hid the counter octet of every Data_Exchange reply (see the header).
   EXPECT_EQ(get(r.report, "masks.0.rule"), "inputs") << d;

@@ -22,7 +22,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <boost/asio/steady_timer.hpp>
 #include <charconv>
+#include <chrono>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <memory>
@@ -315,9 +318,25 @@ int run_pty(const ReplayArgs& ra, const cf::ReplayInput& in, std::ostream& out, 
     pty->attach_io(runner);
     line.start();
     const bus::Ticks cap = time_cap(in, rp);
-    // Short slices: at 1/1000 one virtual millisecond is a wall second.
-    const bus::Ticks slice = bus::kTicksPerMs;
-    while (!rp.finished() && sched.now() < cap) runner.run_until(sched.now() + slice);
+    // ONE run up to the cap, stopped when the replayer is done (checked every 5 ms of wall
+    // time by a timer on the runner's io_context). Every run_until() re-anchors virtual time to
+    // the wall clock, so a run in slices lost the wall time between slices and shrank the
+    // program's reply delay in virtual time (seen: TSDR 7 bit times from a program that waits
+    // 11; the same fix as the battery's paced waits, conformance/src/test_bus.cpp).
+    boost::asio::steady_timer poll(runner.io_context());
+    std::function<void(const boost::system::error_code&)> check = [&](const boost::system::error_code& ec) {
+      if (ec) return;
+      if (rp.finished()) {
+        runner.stop();
+        return;
+      }
+      poll.expires_after(std::chrono::milliseconds(5));
+      poll.async_wait(check);
+    };
+    poll.expires_after(std::chrono::milliseconds(5));
+    poll.async_wait(check);
+    runner.run_until(cap);
+    poll.cancel();
     pty->detach_io();
     cf::ReplayCompareOptions co;
     co.masks = ra.masks;

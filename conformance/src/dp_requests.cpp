@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "groups.hpp"
+#include "report_util.hpp"
 
 namespace pbvbus::conformance::detail {
 
@@ -34,16 +35,7 @@ std::vector<std::uint8_t> encode_request(std::uint8_t da, std::uint8_t sa, std::
   return {b.begin(), b.end()};
 }
 
-std::string hex(std::span<const std::uint8_t> b) {
-  std::string s;
-  char buf[4];
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", b[i]);
-    if (i) s += ' ';
-    s += buf;
-  }
-  return s;
-}
+std::string hex(std::span<const std::uint8_t> b) { return hex_octets(b); }
 
 }  // namespace
 

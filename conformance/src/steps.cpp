@@ -2,6 +2,8 @@
 
 #include "steps.hpp"
 
+#include "report_util.hpp"
+
 #include <cstdio>
 
 #include "pbvbus/dp/diagnosis.hpp"
@@ -10,16 +12,7 @@
 
 namespace pbvbus::conformance::detail {
 
-std::string hex(std::span<const std::uint8_t> b) {
-  std::string s;
-  char buf[4];
-  for (std::size_t i = 0; i < b.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%02X", b[i]);
-    if (i) s += ' ';
-    s += buf;
-  }
-  return s;
-}
+std::string hex(std::span<const std::uint8_t> b) { return hex_octets(b); }
 
 std::uint8_t tester_address(Session& s) { return s.bus().options().tester_address; }
 

@@ -861,6 +861,11 @@ def main():
                "inputs": slave.inputs().hex(), "outputs": slave.outputs.hex(),
                "fdl": station.counts, "dp": slave.stats}
     print(json.dumps(summary), flush=True)
+    # Done: a SIGTERM from whoever stops us may still come (the battery closing the pty ends the
+    # loop first). Ignore it from here: Python's finalization puts Python-level handlers back to
+    # SIG_DFL (not SIG_IGN ones), so a late SIGTERM would otherwise end a clean exit as 143.
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_IGN)
     return 0
 
 

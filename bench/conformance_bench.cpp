@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "pbvbus/conformance/battery.hpp"
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace {

@@ -30,9 +30,9 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/tools/dp_plan.hpp"
-#include "pbvbus/tools/dp_system.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/scenario/dp_plan.hpp"
+#include "pbvbus/simulation/dp_system.hpp"
 
 namespace {
 /// Heap bytes in use (glibc mallinfo2: allocated chunks, net of frees).

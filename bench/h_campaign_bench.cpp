@@ -25,7 +25,7 @@
 #include <iostream>
 #include <string>
 
-#include "pbvbus/devices/h_campaign.hpp"
+#include "pbvbus/s7h/h_campaign.hpp"
 
 namespace {
 

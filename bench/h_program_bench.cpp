@@ -20,8 +20,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "pbvbus/devices/h_program.hpp"
-#include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_program.hpp"
+#include "pbvbus/s7h/h_redundant_execution.hpp"
 
 namespace {
 

@@ -22,8 +22,8 @@
 #include <string>
 
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace {
 

@@ -14,7 +14,7 @@
 // The program is the same in both: at every token receipt of a master it increments one 16-bit
 // counter and writes it into the output module of every station (redundant: through
 // MasterSystem::write_outputs, i.e. into both lines' images, as
-// tests/devices/redundant_master_system_test.cpp does; plain: into the master's image). In the
+// tests/devices/switched_io/redundant_master_system_test.cpp does; plain: into the master's image). In the
 // redundant system it runs at the token receipts of either line.
 //
 // Bus parameters, both systems: fdl::BusParams::defaults(12M), hsa = 33 (the highest address on
@@ -54,13 +54,13 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/fdl/active_station.hpp"
-#include "pbvbus/tools/dp_plan.hpp"
+#include "pbvbus/scenario/dp_plan.hpp"
 
 namespace {
 

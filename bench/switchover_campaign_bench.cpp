@@ -24,7 +24,7 @@
 #include <iostream>
 #include <string>
 
-#include "pbvbus/devices/switchover_campaign.hpp"
+#include "pbvbus/switched_io/switchover_campaign.hpp"
 
 namespace {
 

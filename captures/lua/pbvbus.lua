@@ -144,7 +144,7 @@ local line_event_codes = {
   [8] = "transceiver failed", [9] = "transceiver repaired", [10] = "babbling transmitter",
   [11] = "babbling stopped",
 }
--- Redundancy events (tools/include/pbvbus/tools/redundancy_system.hpp): code =
+-- Redundancy events (simulation/include/pbvbus/simulation/redundancy_system.hpp): code =
 -- redundancy::SystemEvent::Kind, value = the S7 event id (0 for a switchover record).
 -- H-system CPU pair events (captures/include/pbvbus/captures/cpu_event.hpp): code = kind,
 -- a = rack, b = role after the event, value = event ID (bits 0..15) | OB << 16 | reason << 24 |

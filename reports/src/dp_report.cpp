@@ -1,11 +1,12 @@
 // The DP section of the `pbvbus run` report, text and JSON (schema in report.hpp).
+#include "pbvbus/reports/dp_report.hpp"
+
 #include <cstdio>
 #include <optional>
 #include <ostream>
 #include <string>
 
-#include "pbvbus/tools/json_text.hpp"
-#include "pbvbus/tools/dp_system.hpp"
+#include "pbvbus/reports/json_text.hpp"
 
 namespace pbvbus::tools {
 

@@ -1,4 +1,4 @@
-#include "pbvbus/tools/json_text.hpp"
+#include "pbvbus/reports/json_text.hpp"
 
 #include <cstdint>
 #include <cstdio>

@@ -1,9 +1,10 @@
 // The redundancy part of the run report (redundancy_system.hpp; schema in report.hpp).
+#include "pbvbus/reports/redundancy_report.hpp"
+
 #include <cstdio>
 #include <ostream>
 
-#include "pbvbus/tools/json_text.hpp"
-#include "pbvbus/tools/redundancy_system.hpp"
+#include "pbvbus/reports/json_text.hpp"
 
 namespace pbvbus::tools {
 

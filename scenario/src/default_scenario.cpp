@@ -1,7 +1,7 @@
 // The scenario `pbvbus run` runs without a file. It must run unattended and end by itself: no
 // serial attachment, a fixed duration. It is examples/h-system.textproto (the seeds' story: a
 // CPU pair powering up to Redundant, F5, an IM failure, F1 and the return of the failed CPU),
-// word for word except for the GSD paths (tests/tools/default_scenario_test.cpp keeps the two
+// word for word except for the GSD paths (tests/scenario/default_scenario_test.cpp keeps the two
 // equal).
 //
 // GSD paths: the built-in scenario has no file to be relative to, so "@EXAMPLES@" stands for
@@ -9,7 +9,7 @@
 // from its source tree then reports the missing GSD file like any scenario would.
 #include <string>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 #ifndef PBVBUS_EXAMPLES_DIR
 #define PBVBUS_EXAMPLES_DIR "examples"

@@ -1,14 +1,14 @@
 // DP master systems in scenarios: GSD-driven slave configuration and derived bus parameters
-// (decisions in tools/include/pbvbus/tools/dp_plan.hpp).
-#include "pbvbus/tools/dp_plan.hpp"
+// (decisions in scenario/include/pbvbus/scenario/dp_plan.hpp).
+#include "pbvbus/scenario/dp_plan.hpp"
 
 #include <algorithm>
 #include <filesystem>
 #include <map>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/dp/prm.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 

@@ -1,5 +1,5 @@
 // The loader's gateway checks (gateway_plan.hpp has the rules).
-#include "pbvbus/tools/gateway_plan.hpp"
+#include "pbvbus/scenario/gateway_plan.hpp"
 
 #include <arpa/inet.h>
 
@@ -8,7 +8,7 @@
 #include <map>
 #include <set>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 

@@ -1,12 +1,12 @@
 // A scenario's h_system entries (h_plan.hpp).
-#include "pbvbus/tools/h_plan.hpp"
+#include "pbvbus/scenario/h_plan.hpp"
 
 #include <algorithm>
 #include <exception>
 #include <map>
 
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/timing_plan.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/scenario/timing_plan.hpp"
 
 namespace pbvbus::tools {
 

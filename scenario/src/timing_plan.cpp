@@ -1,5 +1,5 @@
 // The planner's input from a scenario (timing_plan.hpp).
-#include "pbvbus/tools/timing_plan.hpp"
+#include "pbvbus/scenario/timing_plan.hpp"
 
 #include <algorithm>
 

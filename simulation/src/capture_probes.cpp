@@ -1,4 +1,4 @@
-#include "pbvbus/tools/capture_probes.hpp"
+#include "pbvbus/simulation/capture_probes.hpp"
 
 #include <charconv>
 

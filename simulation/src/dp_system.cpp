@@ -1,5 +1,5 @@
-// DP master systems at run time (tools/include/pbvbus/tools/dp_system.hpp).
-#include "pbvbus/tools/dp_system.hpp"
+// DP master systems at run time (simulation/include/pbvbus/simulation/dp_system.hpp).
+#include "pbvbus/simulation/dp_system.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,5 +1,5 @@
 // The gateways of a running Simulation (gateway_node.hpp has the decisions).
-#include "pbvbus/tools/gateway_node.hpp"
+#include "pbvbus/simulation/gateway_node.hpp"
 
 #include <stdexcept>
 
@@ -13,7 +13,7 @@
 #include "pbvbus/gateways/slcan_door.hpp"
 #include "pbvbus/gateways/socketcan_door.hpp"
 #include "pbvbus/gateways/socketcand_door.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 

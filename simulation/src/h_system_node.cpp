@@ -1,14 +1,14 @@
 // A scenario's simulated h_system at run time (h_system_node.hpp).
-#include "pbvbus/tools/h_system_node.hpp"
+#include "pbvbus/simulation/h_system_node.hpp"
 
 #include <functional>
 #include <stdexcept>
 
 #include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/devices/h_update_timing.hpp"
-#include "pbvbus/tools/h_plan.hpp"
-#include "pbvbus/tools/redundancy_system.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
+#include "pbvbus/scenario/h_plan.hpp"
+#include "pbvbus/simulation/redundancy_system.hpp"
 
 namespace pbvbus::tools {
 

@@ -1,4 +1,4 @@
-#include "pbvbus/tools/line_stats.hpp"
+#include "pbvbus/simulation/line_stats.hpp"
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"

@@ -1,5 +1,5 @@
 // A scenario's redundant_master_system at run time (redundancy_system.hpp).
-#include "pbvbus/tools/redundancy_system.hpp"
+#include "pbvbus/simulation/redundancy_system.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -7,8 +7,8 @@
 
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/tools/dp_system.hpp"
-#include "pbvbus/tools/timing_plan.hpp"
+#include "pbvbus/simulation/dp_system.hpp"
+#include "pbvbus/scenario/timing_plan.hpp"
 
 namespace pbvbus::tools {
 

@@ -1,4 +1,4 @@
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 #include "pbvbus/bus/pty.hpp"
 
@@ -15,8 +15,8 @@
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/pty_station.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/devices/fdl_poller.hpp"
-#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl_traffic/fdl_poller.hpp"
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
 #include "pbvbus/fdl/active_station.hpp"
 #include "pbvbus/fdl/passive_station.hpp"
 

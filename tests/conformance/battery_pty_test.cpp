@@ -11,7 +11,7 @@
 #include <string>
 
 #include "pbvbus/conformance/battery.hpp"
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace pbvbus::conformance {
 namespace {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "pbvbus/conformance/battery.hpp"
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace pbvbus::conformance::testing {
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "pbvbus/conformance/report.hpp"
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace pbvbus::conformance {
 namespace {

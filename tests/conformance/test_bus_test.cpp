@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "pbvbus/conformance/test_bus.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 
 namespace pbvbus::conformance {
 namespace {

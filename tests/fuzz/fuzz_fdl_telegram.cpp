@@ -6,7 +6,7 @@
 // encoder's order), the re-encoded frame decodes to the same fields, and frame_length() agrees.
 // The same bytes are also read as a FrameSpec for the encoder: whatever encode()/encode_as()
 // produces must decode to the same fields. Any violation traps, so libFuzzer reports it with
-// the input. The oracle is in tests/fdl/telegram_oracle_helpers.cpp.
+// the input. The oracle is in tests/stacks/fdl/telegram_oracle_helpers.cpp.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace pbvbus::devices;

@@ -13,8 +13,8 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/fdl/active_station.hpp"
 #include "pbvbus/gateways/modbus_gateway.hpp"
 

@@ -15,10 +15,10 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/h_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/s7h/h_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/gateways/modbus_gateway.hpp"
 
 namespace pbvbus::gateways {

@@ -20,7 +20,7 @@
 #include "../captures/tshark_helpers.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -11,13 +11,13 @@
 #include <vector>
 
 #include "pbvbus/captures/pcapng_reader.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/fdl/active_station.hpp"
 #include "pbvbus/tools/class2_cli.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {

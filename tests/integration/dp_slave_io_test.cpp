@@ -1,5 +1,5 @@
 // dp_slave `io` behaviours and DP slave faults end to end: a scenario with one modular slave
-// (examples/gsd/PBVB0A02.gsd, the module list of tests/devices/slave_model_test.cpp) run in fast
+// (examples/gsd/PBVB0A02.gsd, the module list of tests/devices/slaves/slave_model_test.cpp) run in fast
 // mode; the bytes of its Data_Exchange answers and diagnoses are checked on the wire.
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "frame_recorder.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -3,7 +3,7 @@
 // pbvbus Lua dissector: the CPU pair's state changes and OB 72s as Cpu records with their
 // fields, the H faults as Note records before their reactions, the OB 85s of the program as Cpu
 // records of kind OB, and the DP master system failure of the lost side as a redundancy record.
-// Times are the scenario's (see tests/tools/h_system_run_test.cpp for their derivation).
+// Times are the scenario's (see tests/simulation/h_system_run_test.cpp for their derivation).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,8 +15,8 @@
 
 #include "../captures/tshark_helpers.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -13,11 +13,11 @@
 #include "../captures/tshark_helpers.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/devices/fdl_poller.hpp"
-#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl_traffic/fdl_poller.hpp"
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
 #include "pbvbus/fdl/telegram.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -27,7 +27,7 @@
 #include <thread>
 
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -10,10 +10,10 @@
 #include <thread>
 
 #include "pbvbus/bus/frame_splitter.hpp"
-#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
 #include "pbvbus/fdl/telegram.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -13,8 +13,8 @@
 
 #include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 #include "../captures/tshark_helpers.hpp"
 
 namespace pbvbus::tools {

@@ -2,7 +2,7 @@
 // timeline of states, roles and events per CPU"; examples/h-system.textproto): the real binary
 // runs `pbvbus run --capture X --quiet`, then `pbvbus timeline X -o X.svg` and `-o X.html`, as a
 // user would. Both CPUs get a row with their spans and OB ticks; the times are the scenario's
-// (its header comment; tests/tools/h_system_run_test.cpp derives them): startup 1 s, link-up
+// (its header comment; tests/simulation/h_system_run_test.cpp derives them): startup 1 s, link-up
 // 2 s, update W = 145 ms, F5 at 5 s, F1 at 12 s, CPU 0 back at 14 s, run end 18 s.
 #include <sys/wait.h>
 #include <unistd.h>

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <string>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

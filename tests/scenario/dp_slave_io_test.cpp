@@ -1,12 +1,12 @@
 // dp_slave `io` behaviours and the DP slave faults in scenario files: what the loader plans
-// (tools/include/pbvbus/tools/dp_plan.hpp DpIoPlan, scenario.hpp PlanFault) and its errors at
+// (scenario/include/pbvbus/scenario/dp_plan.hpp DpIoPlan, scenario.hpp PlanFault) and its errors at
 // FILE:LINE:COLUMN.
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -1,5 +1,5 @@
-// The scenario's `gateway` entries (tools/proto/scenario.proto message Gateway,
-// tools/include/pbvbus/tools/gateway_plan.hpp): what the loader plans from a valid entry, every
+// The scenario's `gateway` entries (scenario/proto/scenario.proto message Gateway,
+// scenario/include/pbvbus/scenario/gateway_plan.hpp): what the loader plans from a valid entry, every
 // check with its exact FILE:LINE:COLUMN message, and the outputs ownership (a served dp_master
 // runs no test program).
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

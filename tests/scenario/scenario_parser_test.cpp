@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -5,9 +5,9 @@
 
 #include <string>
 
-#include "pbvbus/devices/slave_mutant.hpp"
-#include "pbvbus/tools/dp_system.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
+#include "pbvbus/simulation/dp_system.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

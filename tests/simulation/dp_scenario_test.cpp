@@ -1,12 +1,13 @@
 // dp_master / dp_slave in scenario files: planning from the GSDs, derived bus parameters, and
-// errors located at FILE:LINE:COLUMN (tools/include/pbvbus/tools/dp_plan.hpp).
+// errors located at FILE:LINE:COLUMN (scenario/include/pbvbus/scenario/dp_plan.hpp).
 #include <gtest/gtest.h>
 
 #include <sstream>
 #include <string>
 
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/run_report.hpp"
 
 namespace pbvbus::tools {
 namespace {

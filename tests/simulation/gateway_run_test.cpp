@@ -17,9 +17,10 @@
 
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/gateways/modbus_map.hpp"
-#include "pbvbus/tools/report.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/run_report.hpp"
 
 namespace pbvbus::tools {
 namespace {

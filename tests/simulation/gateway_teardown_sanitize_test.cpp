@@ -15,8 +15,8 @@
 #include <string>
 
 #include "pbvbus/bus/paced_runner.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 namespace {

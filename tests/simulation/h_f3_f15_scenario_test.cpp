@@ -20,9 +20,10 @@
 #include <vector>
 
 #include "scenario_run_support.hpp"
-#include "pbvbus/tools/h_report.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/h_report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/run_report.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -21,7 +21,8 @@
 #include <vector>
 
 #include "pbvbus/captures/cpu_event.hpp"
-#include "pbvbus/tools/h_report.hpp"
+#include "pbvbus/simulation/h_report.hpp"
+#include "pbvbus/reports/h_report.hpp"
 
 namespace pbvbus::tools {
 namespace {

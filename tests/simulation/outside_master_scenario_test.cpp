@@ -15,8 +15,9 @@
 
 #include "pbvbus/dp/sap.hpp"
 #include "pbvbus/fdl/telegram.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/run_report.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/tools/report.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools::test {
 

@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "pbvbus/captures/pcapng_reader.hpp"
-#include "pbvbus/tools/capture_probes.hpp"
+#include "pbvbus/simulation/capture_probes.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

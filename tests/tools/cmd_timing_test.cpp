@@ -14,7 +14,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

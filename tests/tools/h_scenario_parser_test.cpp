@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 namespace {

@@ -89,7 +89,7 @@ TEST(HTimingCmd, ChecksTheConfiguredHParametersAgainstThePlan) {
 }
 
 // Figures from a redundant_master_system: examples/switched-io.textproto's system. Its planner
-// (tests/tools/switched_io_scenario_test.cpp) gives T_TR = 4996 bits at 1.5 Mbit/s =
+// (tests/simulation/switched_io_scenario_test.cpp) gives T_TR = 4996 bits at 1.5 Mbit/s =
 // 3330.666 µs, rounded up to 3331 µs; the slowest T_SLAVE_UM is 820 ms (PBVB0A11).
 TEST(HTimingCmd, TakesTheDpFiguresFromARedundantSystem) {
   std::ifstream in(PBVBUS_SOURCE_DIR "/examples/switched-io.textproto");

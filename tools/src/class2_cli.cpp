@@ -1,7 +1,7 @@
 // `pbvbus run --dp2 SPEC`: class-2 master services against a running scenario
 // (class2_cli.hpp documents the command line and the decisions).
 
-#include "pbvbus/tools/json_text.hpp"
+#include "pbvbus/reports/json_text.hpp"
 #include "pbvbus/tools/class2_cli.hpp"
 
 #include <cstdio>
@@ -14,7 +14,7 @@
 #include "pbvbus/dp/master_report.hpp"
 #include "pbvbus/fdl/active_station.hpp"
 #include "pbvbus/fdl/telegram.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 

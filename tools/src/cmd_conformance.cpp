@@ -29,9 +29,9 @@
 #include "pbvbus/conformance/battery.hpp"
 #include "pbvbus/conformance/mutation.hpp"
 #include "pbvbus/conformance/report.hpp"
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 

@@ -20,10 +20,10 @@
 
 #include "pbvbus/gateways/modbus_map.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/gateway_node.hpp"
-#include "pbvbus/tools/json_text.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/gateway_node.hpp"
+#include "pbvbus/reports/json_text.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 

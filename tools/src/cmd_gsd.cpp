@@ -11,8 +11,8 @@
 #include <sstream>
 #include <string>
 
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/tools/json_text.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/reports/json_text.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {

@@ -41,10 +41,10 @@
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/conformance/replay.hpp"
 #include "pbvbus/conformance/replay_serial.hpp"
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 

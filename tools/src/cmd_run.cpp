@@ -42,9 +42,10 @@
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/tools/class2_cli.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/report.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/simulation.hpp"
+#include "pbvbus/simulation/report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/run_report.hpp"
 
 namespace pbvbus::tools {
 
@@ -53,7 +54,7 @@ namespace {
 constexpr const char* kUsage =
     "usage: pbvbus run [SCENARIO] [options]\n"
     "\n"
-    "Runs a scenario (Protocol Buffers text format, see tools/proto/scenario.proto); without\n"
+    "Runs a scenario (Protocol Buffers text format, see scenario/proto/scenario.proto); without\n"
     "SCENARIO, a built-in default scenario.\n"
     "\n"
     "options:\n"

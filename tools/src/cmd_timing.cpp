@@ -73,10 +73,10 @@
 
 #include "pbvbus/redundancy/switchover_timing.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/tools/json_text.hpp"
-#include "pbvbus/tools/scenario.hpp"
-#include "pbvbus/tools/timing_plan.hpp"
-#include "pbvbus/tools/h_plan.hpp"
+#include "pbvbus/reports/json_text.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/scenario/timing_plan.hpp"
+#include "pbvbus/scenario/h_plan.hpp"
 
 namespace pbvbus::tools {
 

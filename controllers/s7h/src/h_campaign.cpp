@@ -1,6 +1,6 @@
 // The seeded fault campaign over the H-system and its observer (h_campaign.hpp has the
 // decisions, docs/h-campaign.md the reasons).
-#include "pbvbus/devices/h_campaign.hpp"
+#include "pbvbus/s7h/h_campaign.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -16,10 +16,11 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/tap.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/campaign/campaign_support.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::devices {
@@ -71,9 +72,7 @@ std::string_view to_string(HFault f) {
 }
 
 int HCampaignResult::events_with(std::uint16_t code) const {
-  for (const auto& [c, n] : io_events)
-    if (c == code) return n;
-  return 0;
+  return campaign::count_of(io_events, code);
 }
 
 std::string HCampaignResult::summary() const {
@@ -83,12 +82,7 @@ std::string HCampaignResult::summary() const {
     o << ' ' << to_string(static_cast<HFault>(k)) << '=' << drawn[k];
   o << ") defective " << defective << " comparison-stops " << comparison_stops << " role swaps "
     << role_swaps << " update-timeouts " << update_timeouts << " refusals " << refusals
-    << " diag-checks " << diag_checks << "; events";
-  for (const auto& [c, n] : io_events) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, " %04X=", c);
-    o << buf << n;
-  }
+    << " diag-checks " << diag_checks << "; events" << campaign::format_counts(io_events);
   o << " OB72=" << ob72 << " OB121=" << ob121 << " (observed " << observed_events << ", expected "
     << expected_events << "); samples " << output_samples << " pulses " << pulses << " cleared "
     << cleared_samples << "; DX "
@@ -111,11 +105,7 @@ constexpr bus::Ticks kCommitted = kMs / 2;
 constexpr std::uint8_t kSw[2] = {20, 21};
 constexpr std::uint8_t kOne[2] = {40, 60};
 
-std::string fmt_time(bus::Ticks t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f ms", static_cast<double>(t) / static_cast<double>(kMs));
-  return buf;
-}
+std::string fmt_time(bus::Ticks t) { return campaign::format_ms(t); }
 
 /// One expected event: an OB of the pair (72/121, with its reason) or an I/O event.
 struct Expect {
@@ -163,9 +153,7 @@ struct Step {
 };
 
 GsdFile load(const std::string& dir, const char* name) {
-  auto r = load_gsd(std::filesystem::path(dir) / name);
-  if (!r.ok() || !r.file) throw std::runtime_error(std::string("h campaign: cannot load ") + name);
-  return *r.file;
+  return campaign::load_gsd_or_throw(dir, name, "h campaign");
 }
 std::vector<ModuleChoice> switched_modules() {
   return {ModuleChoice::named("16DI DC24V"), ModuleChoice::named("16DO DC24V/0.5A")};
@@ -251,18 +239,14 @@ class HCampaignRun {
  private:
   struct Sw {
     std::unique_ptr<SwitchedStationModel> model;
-    bool started = false;
-    bool exempt = false;
-    std::uint16_t last = 0;
+    campaign::CounterWatch watch;  ///< the backplane outputs' counter
   };
   void build();
   bus::Ticks now() const { return m_sched.now(); }
   void run_to(bus::Ticks t) { m_sched.run_until(t); }
   std::string step_name() const { return m_steps.empty() ? "(none)" : m_steps.back().what; }
-  bus::Ticks draw(bus::Ticks lo, bus::Ticks hi) {
-    return std::uniform_int_distribution<bus::Ticks>(lo, hi)(m_rng);
-  }
-  int draw_int(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(m_rng); }
+  bus::Ticks draw(bus::Ticks lo, bus::Ticks hi) { return m_rng.ticks(lo, hi); }
+  int draw_int(int lo, int hi) { return m_rng.integer(lo, hi); }
   /// The observer's W (digest §3.1): MAX(75 ms + 0.7 ms per changed KB, 50 ms + T_PH).
   bus::Ticks update_w(std::uint32_t kb) const {
     const bus::Ticks tph = to_ticks(m_o.h_parameters.t_ph.value_or(0));
@@ -342,7 +326,7 @@ class HCampaignRun {
   std::string rack_name(int r) const { return "rack " + std::to_string(r); }
 
   HCampaignOptions m_o;
-  std::mt19937_64 m_rng;
+  campaign::Draw m_rng;
   HCpuPairParams m_params;
   bus::Scheduler m_sched;
   std::unique_ptr<bus::Line> m_bus[2];
@@ -488,34 +472,22 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     Sw& s = m_sw[k];
     const auto out = s.model->outputs();
     const auto v = static_cast<std::uint16_t>((out[0] << 8) | out[1]);
-    if (!s.started) {
-      s.started = v != 0;
-      s.last = v;
-      continue;
-    }
-    ++m_r.output_samples;
     // Outputs 0 are allowed while no channel reaches the station or no CPU runs the program
     // (HOLD, both STOP: the DP master in Clear drives the safe state), until the first new
     // value after it.
     const bool none = (!m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end)) ||
                       m_obs.no_program(f.end);
-    if (none) s.exempt = true;
+    const campaign::CounterWatch::Sample c = s.watch.sample(v, none);
+    if (!c.counted) continue;
+    ++m_r.output_samples;
     if (v == 0 && m_obs.no_program(f.end)) ++m_r.cleared_samples;
-    std::string bad;
-    if (v == 0) {
-      if (!s.exempt) bad = "outputs 0";
-    } else {
-      if (static_cast<std::uint16_t>(v - s.last) >= 0x8000) bad = "older value";
-      if (!none && v != s.last) s.exempt = false;
-    }
-    if (!bad.empty()) {
+    if (!c.bad.empty()) {
       ++m_r.pulses;
       if (m_r.pulse_reports.size() < 20)
         m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) + " " +
-                                    bad + " (" + std::to_string(v) + " after " +
-                                    std::to_string(s.last) + "), step '" + step_name() + "'");
+                                    std::string(c.bad) + " (" + std::to_string(v) + " after " +
+                                    std::to_string(c.previous) + "), step '" + step_name() + "'");
     }
-    if (v != 0) s.last = v;
   }
 }
 
@@ -1227,7 +1199,7 @@ HCampaignResult HCampaignRun::run() {
   std::discrete_distribution<int> pick(w.begin(), w.end());
   while (m_r.injections() < m_o.steps) {
     run_to(now() + draw(m_o.gap_min, m_o.gap_max));
-    const auto f = static_cast<HFault>(pick(m_rng));
+    const auto f = static_cast<HFault>(pick(m_rng.engine()));
     if (index == m_o.tamper.hidden_fault_at) {
       hidden_cycle();
       m_r.faults -= 1;
@@ -1264,13 +1236,11 @@ HCampaignResult HCampaignRun::run() {
   }
   run_to(now() + 500 * kMs);
   match_all();
-  const std::uint16_t codes[6] = {0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3, 0x38C3};
-  for (int c = 0; c < 6; ++c) m_r.io_events[c] = {codes[c], 0};
+  m_r.io_events = campaign::zero_event_counts();
   for (const auto& e : m_h->events()) {
     if (e.ob == 72) ++m_r.ob72;
     if (e.ob == 121) ++m_r.ob121;
-    for (auto& [c, n] : m_r.io_events)
-      if (e.source == Src::Io && e.code == c) ++n;
+    if (e.source == Src::Io) campaign::count_event(m_r.io_events, e.code);
   }
   if (m_o.keep_log) {
     for (const auto& st : m_steps)

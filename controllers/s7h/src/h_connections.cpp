@@ -1,6 +1,6 @@
 // Configured S7 connections over the CPs of an H-system (F4, R8); the rules are in
 // h_connections.hpp and docs/h-system.md "Connections and CPs (F4, R8)".
-#include "pbvbus/devices/h_connections.hpp"
+#include "pbvbus/s7h/h_connections.hpp"
 
 #include <algorithm>
 

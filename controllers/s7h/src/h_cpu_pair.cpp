@@ -1,4 +1,4 @@
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 #include <algorithm>
 #include <stdexcept>

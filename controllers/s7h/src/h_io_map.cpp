@@ -1,7 +1,7 @@
 // The H-system's I/O map (h_io_map.hpp has the address rules).
-#include "pbvbus/devices/h_io_map.hpp"
+#include "pbvbus/s7h/h_io_map.hpp"
 
-#include "pbvbus/devices/redundant_master_system.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
 
 namespace pbvbus::devices {
 

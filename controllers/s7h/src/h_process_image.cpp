@@ -1,5 +1,5 @@
 // Process image of one H-CPU (devices/h_process_image.hpp).
-#include "pbvbus/devices/h_process_image.hpp"
+#include "pbvbus/s7h/h_process_image.hpp"
 
 #include <algorithm>
 #include <stdexcept>

@@ -1,5 +1,5 @@
 // The user program of an H-CPU: one OB 1 over a ProcessImage (devices/h_program.hpp).
-#include "pbvbus/devices/h_program.hpp"
+#include "pbvbus/s7h/h_program.hpp"
 
 #include <algorithm>
 #include <limits>

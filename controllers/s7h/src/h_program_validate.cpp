@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_program.hpp"
+#include "pbvbus/s7h/h_program.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -1,6 +1,6 @@
 // Redundant execution and comparison on the two CPUs of an H-system
 // (devices/h_redundant_execution.hpp).
-#include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_redundant_execution.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -1,6 +1,6 @@
 // The H-system model: the CPU pair driving the redundant DP master systems (h_system.hpp has
 // the decisions, docs/h-system.md the reasons).
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 #include <algorithm>
 #include <cstdio>

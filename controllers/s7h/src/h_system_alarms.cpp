@@ -2,7 +2,7 @@
 // H-system model (h_system.hpp and h_system_records.hpp have the decisions).
 #include <cstdio>
 
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

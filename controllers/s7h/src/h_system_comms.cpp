@@ -2,7 +2,7 @@
 // "F4 connections, SSL" of h_system.hpp; rules in h_connections.hpp and h_ssl.hpp).
 #include <algorithm>
 
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

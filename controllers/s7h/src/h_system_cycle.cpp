@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "pbvbus/devices/h_system.hpp"
-#include "pbvbus/devices/slave_fault.hpp"
+#include "pbvbus/s7h/h_system.hpp"
+#include "pbvbus/slaves/slave_fault.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
 
 namespace pbvbus::devices {

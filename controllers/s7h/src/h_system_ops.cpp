@@ -1,6 +1,6 @@
 // The pair's link-up/update operations through the H-system model (h_system.hpp): each at
 // scheduler.now(), then the reconciliation like every other operation.
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

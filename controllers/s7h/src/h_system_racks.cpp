@@ -7,7 +7,7 @@
 #include <set>
 #include <stdexcept>
 
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

@@ -1,7 +1,7 @@
 // The update phases of the CPU pair acting on the H-system's I/O (h_system.hpp has the
 // decisions, docs/h-system.md "Update phases on the I/O" the reasons): the measures and the
 // update's copy of the images at t4.
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

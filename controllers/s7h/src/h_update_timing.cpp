@@ -1,5 +1,5 @@
 // H-system update planner and H-parameter checks: see h_update_timing.hpp and docs/h-timing.md.
-#include "pbvbus/devices/h_update_timing.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
 
 #include <algorithm>
 #include <limits>

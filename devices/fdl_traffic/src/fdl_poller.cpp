@@ -1,4 +1,4 @@
-#include "pbvbus/devices/fdl_poller.hpp"
+#include "pbvbus/fdl_traffic/fdl_poller.hpp"
 
 namespace pbvbus::devices {
 

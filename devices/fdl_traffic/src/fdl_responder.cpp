@@ -1,4 +1,4 @@
-#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
 
 namespace pbvbus::devices {
 

@@ -5,7 +5,7 @@
 #include <cctype>
 #include <string>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace pbvbus::devices {
 

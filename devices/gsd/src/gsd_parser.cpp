@@ -16,7 +16,7 @@
 #include <type_traits>
 #include <unordered_map>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace pbvbus::devices {
 

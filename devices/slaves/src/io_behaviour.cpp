@@ -1,5 +1,5 @@
 // Input behaviours of simulated DP slave modules (io_behaviour.hpp).
-#include "pbvbus/devices/io_behaviour.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
 
 namespace pbvbus::devices {
 

@@ -1,5 +1,5 @@
 // Fault steps of simulated DP slaves (slave_fault.hpp).
-#include "pbvbus/devices/slave_fault.hpp"
+#include "pbvbus/slaves/slave_fault.hpp"
 
 namespace pbvbus::devices {
 

@@ -1,5 +1,5 @@
 // A simulated DP slave built from a GSD and a module list (slave_model.hpp).
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 // The mutant catalogue (slave_mutant.hpp; docs/mutants.md): names as in scenarios and the rule
 // of IEC 61158-6 / protocol-facts.md each mutant breaks. The hooks live in fdl::PassiveStation
 // (PassiveMutation) and dp::SlaveEngine (dp::EngineMutation); SlaveModel maps between them.
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 
 #include <array>
 

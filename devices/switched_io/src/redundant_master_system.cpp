@@ -1,5 +1,5 @@
 // The redundant DP master system on two lines (redundant_master_system.hpp).
-#include "pbvbus/devices/redundant_master_system.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
 
 #include <stdexcept>
 

@@ -1,5 +1,5 @@
 // A switched station on two lines (switched_station.hpp).
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 
 #include <algorithm>
 #include <filesystem>

@@ -1,5 +1,5 @@
 // The seeded random fault campaign for switched I/O (switchover_campaign.hpp).
-#include "pbvbus/devices/switchover_campaign.hpp"
+#include "pbvbus/switched_io/switchover_campaign.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -12,10 +12,11 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/tap.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/campaign/campaign_support.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 
 namespace pbvbus::devices {
 
@@ -41,23 +42,15 @@ std::string_view to_string(CampaignFault f) {
   return "?";
 }
 
-int CampaignResult::events_with(std::uint16_t code) const {
-  for (const auto& [c, n] : events)
-    if (c == code) return n;
-  return 0;
-}
+int CampaignResult::events_with(std::uint16_t code) const { return campaign::count_of(events, code); }
 
 std::string CampaignResult::summary() const {
   std::ostringstream o;
   o << "faults " << faults << " repairs " << repairs << " (cycles:";
   for (int k = 0; k < kCampaignFaultKinds; ++k)
     o << ' ' << to_string(static_cast<CampaignFault>(k)) << '=' << drawn[k];
-  o << ") switchovers " << switchovers << " station switches " << station_switches << "; events";
-  for (const auto& [c, n] : events) {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, " %04X=", c);
-    o << buf << n;
-  }
+  o << ") switchovers " << switchovers << " station switches " << station_switches << "; events"
+    << campaign::format_counts(events);
   o << " (expected " << expected_events << "); samples " << output_samples << " pulses " << pulses
     << " safe-state " << safe_state_samples << "; alarms raised " << alarms_raised << " delivered "
     << alarms_delivered << " lost " << alarms_lost << " duplicated " << alarms_duplicated
@@ -75,11 +68,7 @@ using redundancy::SystemEvent;
 using Bytes = std::vector<std::uint8_t>;
 constexpr bus::Ticks kMs = bus::kTicksPerMs;
 
-std::string fmt_time(bus::Ticks t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f ms", static_cast<double>(t) / static_cast<double>(kMs));
-  return buf;
-}
+std::string fmt_time(bus::Ticks t) { return campaign::format_ms(t); }
 
 /// One expected S7 event: code, line (-1 = either) and station (0xFF = the master system).
 struct Expect {
@@ -105,9 +94,7 @@ struct Step {
 };
 
 GsdFile load(const std::string& dir, const char* name) {
-  auto r = load_gsd(std::filesystem::path(dir) / name);
-  if (!r.ok() || !r.file) throw std::runtime_error(std::string("campaign: cannot load ") + name);
-  return *r.file;
+  return campaign::load_gsd_or_throw(dir, name, "campaign");
 }
 
 std::vector<ModuleChoice> switched_modules() {
@@ -143,10 +130,7 @@ class Campaign {
     std::unique_ptr<SwitchedStationModel> model;
     bool iface_ok[2] = {true, true};
     int act = 0;  ///< the observer's expected active line (-1: none)
-    // sampler
-    bool started = false;
-    bool exempt = false;  ///< no channel (or not yet a new value after that): 0 is expected
-    std::uint16_t last = 0;
+    campaign::CounterWatch watch;  ///< the sampler's view of the backplane outputs
     int primary = -1;
   };
   struct One {
@@ -187,10 +171,8 @@ class Campaign {
   /// and the observer's expected active lines updated.
   std::vector<Expect> derive(const Snapshot& before, bool silent);
 
-  bus::Ticks draw(bus::Ticks lo, bus::Ticks hi) {
-    return std::uniform_int_distribution<bus::Ticks>(lo, hi)(m_rng);
-  }
-  int draw_int(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(m_rng); }
+  bus::Ticks draw(bus::Ticks lo, bus::Ticks hi) { return m_rng.ticks(lo, hi); }
+  int draw_int(int lo, int hi) { return m_rng.integer(lo, hi); }
 
   /// Starts a step now (the injection already done by the caller).
   void begin_step(std::string what, bool repair, std::vector<Expect> ex, bool lines_differ = false);
@@ -214,7 +196,7 @@ class Campaign {
   std::string sw_name(int k) const { return "station " + std::to_string(m_sw[k].address); }
 
   CampaignOptions m_o;
-  std::mt19937_64 m_rng;
+  campaign::Draw m_rng;
   bus::Scheduler m_sched;
   std::unique_ptr<bus::Line> m_bus[2];
   fdl::BusParams m_bp;
@@ -345,33 +327,17 @@ void Campaign::sample(const bus::TapFrame& f) {
       if (s.primary >= 0) ++m_r.station_switches;
       s.primary = p;
     }
-    if (!s.started) {
-      s.started = v != 0;
-      s.last = v;
-      continue;
-    }
-    ++m_r.output_samples;
     const bool no_channel = !reach_sw(static_cast<int>(k), 0) && !reach_sw(static_cast<int>(k), 1);
-    if (no_channel) s.exempt = true;
-    std::string bad;
-    if (v == 0) {
-      if (s.exempt)
-        ++m_r.safe_state_samples;
-      else
-        bad = "outputs 0";
-    } else {
-      if (static_cast<std::uint16_t>(v - s.last) >= 0x8000) bad = "older value";
-      // A new value after a channel is back ends the safe-state allowance (a held old value
-      // does not: its hold may still run out).
-      if (!no_channel && v != s.last) s.exempt = false;
-      s.last = v;
-    }
-    if (!bad.empty()) {
+    const campaign::CounterWatch::Sample c = s.watch.sample(v, no_channel);
+    if (!c.counted) continue;
+    ++m_r.output_samples;
+    if (c.safe_state) ++m_r.safe_state_samples;
+    if (!c.bad.empty()) {
       ++m_r.pulses;
       if (m_r.pulse_reports.size() < 20)
         m_r.pulse_reports.push_back(fmt_time(f.end) + ": " + sw_name(static_cast<int>(k)) + " " +
-                                    bad + " (" + std::to_string(v) + " after " +
-                                    std::to_string(s.last) + ")");
+                                    std::string(c.bad) + " (" + std::to_string(v) + " after " +
+                                    std::to_string(c.previous) + ")");
     }
   }
 }
@@ -672,7 +638,7 @@ void Campaign::hidden_cycle() {
 }
 
 void Campaign::maybe_raise_alarm(double p) {
-  if (!m_o.alarms || std::uniform_real_distribution<double>(0, 1)(m_rng) >= p) return;
+  if (!m_o.alarms || !m_rng.chance(p)) return;
   const int k = draw_int(0, static_cast<int>(m_sw.size()) - 1);
   const std::uint32_t id = ++m_alarm_id;
   const Bytes data{static_cast<std::uint8_t>(id >> 24), static_cast<std::uint8_t>(id >> 16),
@@ -817,7 +783,7 @@ CampaignResult Campaign::run() {
   while (m_r.injections() < m_o.faults) {
     wait_recovered();
     check_active();
-    const auto f = static_cast<CampaignFault>(pick(m_rng));
+    const auto f = static_cast<CampaignFault>(pick(m_rng.engine()));
     // An alarm just before the fault (0..3 ms), on a random station.
     maybe_raise_alarm(0.5);
     run_to(now() + draw(0, 3 * kMs));
@@ -837,11 +803,9 @@ CampaignResult Campaign::run() {
   match_all(m_r);
   count_alarms();
   m_r.switchovers = m_sys->system().switchovers();
-  const std::uint16_t codes[6] = {0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3, 0x38C3};
-  for (int c = 0; c < 6; ++c) m_r.events[c] = {codes[c], 0};
+  m_r.events = campaign::zero_event_counts();
   for (const auto& e : m_sys->system().events())
-    for (auto& [c, n] : m_r.events)
-      if (e.s7() && e.code() == c) ++n;
+    if (e.s7()) campaign::count_event(m_r.events, e.code());
   m_r.simulated = now();
   m_r.frames = m_bus[0]->stats().frames + m_bus[1]->stats().frames;
   m_r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_campaign.hpp"
+#include "pbvbus/s7h/h_campaign.hpp"
 
 namespace pbvbus::devices {
 namespace {

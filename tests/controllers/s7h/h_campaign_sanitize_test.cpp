@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "pbvbus/devices/h_campaign.hpp"
+#include "pbvbus/s7h/h_campaign.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -11,7 +11,7 @@
 // doctored event list, a program writing 0 once and a second master outside F6 must each be
 // caught (an update timeout it is not told about: h_campaign_link_test.cpp). The full
 // campaign is bench/h_campaign_bench.cpp.
-#include "pbvbus/devices/h_campaign.hpp"
+#include "pbvbus/s7h/h_campaign.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,13 +1,13 @@
 // HConnections: configured S7 connections over the CPs of an H-system (F4, R8; rules in
-// devices/include/pbvbus/devices/h_connections.hpp and docs/h-system.md).
-#include "pbvbus/devices/h_connections.hpp"
+// controllers/s7h/include/pbvbus/s7h/h_connections.hpp and docs/h-system.md).
+#include "pbvbus/s7h/h_connections.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -4,7 +4,7 @@
 // Every time below is written as the arithmetic of the default parameters:
 //   STARTUP 1 s, LINK-UP 2 s, UPDATE 75 ms + 0.7 ms x 100 KB = 145 ms, role window 3 s,
 //   self-test (ERROR-SEARCH) 90 s, F17 window 7 days.
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 #include <gtest/gtest.h>
 

@@ -16,7 +16,7 @@
 
 #include "h_system_fixture.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -19,10 +19,10 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/tap.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/h_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/s7h/h_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/dp/prm.hpp"
 
 namespace pbvbus::devices {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 namespace {

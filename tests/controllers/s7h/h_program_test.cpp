@@ -2,7 +2,7 @@
 // pulses on virtual time, the discrepancy monitor (error 7960), validation. Every time is
 // written out by hand in ticks (1 ms = 3 636 000 ticks, 1 µs = 3 636 ticks, bus/time.hpp) with
 // the arithmetic in a comment; every expected byte is literal.
-#include "pbvbus/devices/h_program.hpp"
+#include "pbvbus/s7h/h_program.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Redundant execution of the user program on both CPUs (devices/h_redundant_execution.hpp,
 // docs/h-programs.md; seeds-digest.md §5, §7 F16/F18, §11 C3). Times are written out by hand in
 // ticks (1 ms = 3 636 000 ticks), expected bytes are literal.
-#include "pbvbus/devices/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_redundant_execution.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@
 #include <gmock/gmock.h>
 
 #include "h_system_fixture.hpp"
-#include "pbvbus/devices/h_update_timing.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -1,7 +1,7 @@
 // H-system update planner and H-parameter checks (devices/h_update_timing.hpp; seeds-digest.md
 // §3.1, §10 item 6, §11 T1–T8). Every expected figure is written out by hand, in µs, with the
 // arithmetic in a comment; nothing is recomputed with the library's own formulas.
-#include "pbvbus/devices/h_update_timing.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
 // FdlPoller (traffic-generating initiator user) and FdlResponder (passive-station user).
 #include <gtest/gtest.h>
 
-#include "pbvbus/devices/fdl_poller.hpp"
-#include "pbvbus/devices/fdl_responder.hpp"
+#include "pbvbus/fdl_traffic/fdl_poller.hpp"
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 using namespace pbvbus::devices;
 

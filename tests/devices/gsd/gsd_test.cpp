@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/gsd.hpp"
+#include "pbvbus/gsd/gsd.hpp"
 
 namespace fs = std::filesystem;
 using namespace pbvbus::devices;

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 
 using namespace pbvbus::devices;
 

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "hex.hpp"
-#include "pbvbus/devices/io_behaviour.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -2,15 +2,15 @@
 // round-trip, every enum value has its row, and each mutant maps to exactly one hook (an
 // fdl::PassiveMutation or a dp::EngineMutation), on a GSD that has the features it breaks
 // (PBVB0A03: DP-V1 with MSAC_C1, Sync/Freeze, Fail_Safe, consistent modules).
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 
 #include <gtest/gtest.h>
 
 #include <set>
 #include <string>
 
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 
 namespace pbvbus::devices {
 namespace {

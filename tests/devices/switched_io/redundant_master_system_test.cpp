@@ -16,10 +16,10 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "pbvbus/devices/switchover_campaign.hpp"
+#include "pbvbus/switched_io/switchover_campaign.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -5,7 +5,7 @@
 // MasterSystem raised. The observer's own tests: a fault it is not told about, a doctored event
 // list and a program that writes 0 once must each be caught. The full campaign (>= 1000) is
 // bench/switchover_campaign_bench.cpp.
-#include "pbvbus/devices/switchover_campaign.hpp"
+#include "pbvbus/switched_io/switchover_campaign.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,10 +15,10 @@
 
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 
 namespace pbvbus::devices {
 namespace {

@@ -20,9 +20,9 @@
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/conformance/test_bus.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/slave_model.hpp"
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
 
 namespace pbvbus::conformance {

@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_system.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
 #include "pbvbus/gateways/dp_master_source.hpp"
 #include "pbvbus/gateways/process_source.hpp"
 

@@ -41,8 +41,8 @@
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/io_behaviour.hpp"
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_config.hpp"
 #include "pbvbus/fdl/bus_params.hpp"

@@ -32,12 +32,12 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/h_connections.hpp"
-#include "pbvbus/devices/h_cpu_pair.hpp"
-#include "pbvbus/devices/h_expansion_rack.hpp"
-#include "pbvbus/devices/h_program_spec.hpp"
-#include "pbvbus/devices/h_update_timing.hpp"
-#include "pbvbus/tools/dp_plan.hpp"
+#include "pbvbus/s7h/h_connections.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_expansion_rack.hpp"
+#include "pbvbus/s7h/h_program_spec.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
+#include "pbvbus/scenario/dp_plan.hpp"
 
 namespace pbvbus::tools {
 

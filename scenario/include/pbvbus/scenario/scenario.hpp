@@ -1,6 +1,6 @@
 #pragma once
 // Scenario files (design.md "Configuration and command line"): Protocol Buffers text format
-// against tools/proto/scenario.proto, loaded into a checked ScenarioPlan that the Simulation
+// against scenario/proto/scenario.proto, loaded into a checked ScenarioPlan that the Simulation
 // builds from.
 //
 // Every error names the file, line and column (1-based) of the text it refers to, both for
@@ -39,9 +39,9 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
-#include "pbvbus/tools/dp_plan.hpp"
-#include "pbvbus/tools/gateway_plan.hpp"
-#include "pbvbus/tools/h_plan.hpp"
+#include "pbvbus/scenario/dp_plan.hpp"
+#include "pbvbus/scenario/gateway_plan.hpp"
+#include "pbvbus/scenario/h_plan.hpp"
 #include "scenario.pb.h"
 
 namespace pbvbus::tools {

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "pbvbus/redundancy/switchover_timing.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
 

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::captures {
 class PcapngWriter;

@@ -33,9 +33,9 @@
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 #include "pbvbus/fdl/active_station.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/fdl/passive_station.hpp"
-#include "pbvbus/tools/dp_plan.hpp"
+#include "pbvbus/scenario/dp_plan.hpp"
 
 namespace pbvbus::tools {
 
@@ -159,12 +159,6 @@ DpMasterReport dp_master_report(const dp::Master& m, std::uint64_t global_contro
                                 const std::vector<const DpSlavePlan*>& plans,
                                 const std::string& line, bus::Baud baud);
 
-/// The DP part of the text report (dp_report.cpp).
-void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os);
-/// The DP part of the JSON report: `,"dp_masters":[...]` (schema in report.hpp).
-void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os);
-/// The slaves' own views, text and JSON (`,"dp_slaves":[...]`).
-void write_dp_slaves_text(const std::vector<DpSlaveView>& r, std::ostream& os);
-void write_dp_slaves_json(const std::vector<DpSlaveView>& r, std::ostream& os);
+// Text and JSON forms: pbvbus/reports/dp_report.hpp.
 
 }  // namespace pbvbus::tools

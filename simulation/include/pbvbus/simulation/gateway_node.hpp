@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/tools/gateway_plan.hpp"
-#include "pbvbus/tools/gateway_report.hpp"
+#include "pbvbus/scenario/gateway_plan.hpp"
+#include "pbvbus/simulation/gateway_report.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;

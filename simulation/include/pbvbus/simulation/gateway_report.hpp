@@ -73,8 +73,6 @@ struct GatewayReport {
   std::vector<GatewayDoorReport> doors;
 };
 
-void write_gateways_text(const std::vector<GatewayReport>& r, std::ostream& os);
-/// `,"gateways":[...]` (schema above).
-void write_gateways_json(const std::vector<GatewayReport>& r, std::ostream& os);
+// Text and JSON forms: pbvbus/reports/gateway_report.hpp.
 
 }  // namespace pbvbus::tools

@@ -35,7 +35,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/captures/event_record.hpp"
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 namespace pbvbus::tools {
 
@@ -150,16 +150,8 @@ struct HSystemReport {
 /// the update windows (t1, t5).
 HSystemReport make_h_report(std::string name, const devices::HCpuPair& pair);
 
-/// "within" / "EXCEEDED" for a measured window against its planned bound.
-std::string_view window_verdict(bus::Ticks measured, bus::Ticks planned);
+// Text and JSON forms, window_verdict, format_s_ms: pbvbus/reports/h_report.hpp.
 
-/// The text part: per pair the CPUs, a timeline table per CPU, the I/O events, the updates.
-void write_h_text(const std::vector<HSystemReport>& systems, std::ostream& os);
-/// `,"h_systems_run":[...]` (nothing when `systems` is empty), to append inside a JSON object.
-void write_h_json(const std::vector<HSystemReport>& systems, std::ostream& os);
-
-/// "12.345" (s with ms, rounded down).
-std::string format_s_ms(bus::Ticks t);
 /// The one-line text of an event as the timeline and the capture show it: "CPU 0: STOP ->
 /// STARTUP", "CPU 1: role none -> standby", "system mode Solo -> Link-up", "CPU 1: OB 72
 /// (master CPU lost)" (the why of a state change is in the diagnostic buffer, not the event).

@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/devices/h_system.hpp"
-#include "pbvbus/tools/h_report.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/s7h/h_system.hpp"
+#include "pbvbus/simulation/h_report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::captures {
 class PcapngWriter;

@@ -27,10 +27,10 @@
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
-#include "pbvbus/devices/switched_station.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
+#include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/redundancy/switchover_timing.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::captures {
 class PcapngWriter;
@@ -91,10 +91,7 @@ struct RedundancyReport {
   std::uint64_t exceeded = 0;
 };
 
-/// The redundancy part of the run report, text and JSON (`,"redundancy":[...]`, schema in
-/// report.hpp); nothing when there is no redundant system.
-void write_redundancy_text(const std::vector<RedundancyReport>& r, std::ostream& os);
-void write_redundancy_json(const std::vector<RedundancyReport>& r, std::ostream& os);
+// Text and JSON forms: pbvbus/reports/redundancy_report.hpp.
 
 class RedundantSystemNode {
  public:

@@ -146,13 +146,13 @@
 
 #include "pbvbus/bus/pty_station.hpp"
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/fdl_poller.hpp"
+#include "pbvbus/fdl_traffic/fdl_poller.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
-#include "pbvbus/tools/dp_system.hpp"
-#include "pbvbus/tools/gateway_report.hpp"
-#include "pbvbus/tools/line_stats.hpp"
-#include "pbvbus/tools/h_report.hpp"
-#include "pbvbus/tools/redundancy_system.hpp"
+#include "pbvbus/simulation/dp_system.hpp"
+#include "pbvbus/simulation/gateway_report.hpp"
+#include "pbvbus/simulation/line_stats.hpp"
+#include "pbvbus/simulation/h_report.hpp"
+#include "pbvbus/simulation/redundancy_system.hpp"
 
 namespace pbvbus::tools {
 
@@ -243,7 +243,6 @@ struct Report {
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".
 std::string_view live_type_key(fdl::StationType t);
 
-void write_text(const Report& r, std::ostream& os);
-void write_json(const Report& r, std::ostream& os);
+// Text and JSON forms: pbvbus/reports/run_report.hpp.
 
 }  // namespace pbvbus::tools

@@ -35,12 +35,12 @@
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/paced_runner.hpp"
 #include "pbvbus/bus/scheduler.hpp"
-#include "pbvbus/tools/capture_probes.hpp"
-#include "pbvbus/tools/gateway_node.hpp"
-#include "pbvbus/tools/h_system_node.hpp"
-#include "pbvbus/tools/redundancy_system.hpp"
-#include "pbvbus/tools/report.hpp"
-#include "pbvbus/tools/scenario.hpp"
+#include "pbvbus/simulation/capture_probes.hpp"
+#include "pbvbus/simulation/gateway_node.hpp"
+#include "pbvbus/simulation/h_system_node.hpp"
+#include "pbvbus/simulation/redundancy_system.hpp"
+#include "pbvbus/simulation/report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::captures {
 class PcapngWriter;

@@ -109,7 +109,7 @@
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_system.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 

@@ -47,7 +47,7 @@
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 
 namespace pbvbus::devices {
 

@@ -110,7 +110,7 @@
 
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_update_timing.hpp"
+#include "pbvbus/s7h/h_update_timing.hpp"
 
 namespace pbvbus::devices {
 

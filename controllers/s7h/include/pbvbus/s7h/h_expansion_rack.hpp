@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "pbvbus/devices/io_behaviour.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
 
 namespace pbvbus::devices {
 

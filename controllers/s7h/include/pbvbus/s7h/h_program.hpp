@@ -39,8 +39,8 @@
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_process_image.hpp"
-#include "pbvbus/devices/h_program_spec.hpp"
+#include "pbvbus/s7h/h_process_image.hpp"
+#include "pbvbus/s7h/h_program_spec.hpp"
 
 namespace pbvbus::devices {
 

@@ -45,8 +45,8 @@
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_process_image.hpp"
-#include "pbvbus/devices/h_program.hpp"
+#include "pbvbus/s7h/h_process_image.hpp"
+#include "pbvbus/s7h/h_program.hpp"
 
 namespace pbvbus::devices {
 

@@ -96,16 +96,16 @@
 
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
-#include "pbvbus/devices/h_connections.hpp"
-#include "pbvbus/devices/h_cpu_pair.hpp"
-#include "pbvbus/devices/h_expansion_rack.hpp"
-#include "pbvbus/devices/h_io_map.hpp"
-#include "pbvbus/devices/h_program_spec.hpp"
-#include "pbvbus/devices/h_redundant_execution.hpp"
-#include "pbvbus/devices/h_ssl.hpp"
-#include "pbvbus/devices/h_system_records.hpp"
-#include "pbvbus/devices/h_update_measure.hpp"
-#include "pbvbus/devices/redundant_master_system.hpp"
+#include "pbvbus/s7h/h_connections.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_expansion_rack.hpp"
+#include "pbvbus/s7h/h_io_map.hpp"
+#include "pbvbus/s7h/h_program_spec.hpp"
+#include "pbvbus/s7h/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_ssl.hpp"
+#include "pbvbus/s7h/h_system_records.hpp"
+#include "pbvbus/s7h/h_update_measure.hpp"
+#include "pbvbus/switched_io/redundant_master_system.hpp"
 
 namespace pbvbus::devices {
 
@@ -407,7 +407,7 @@ class HSystemModel final : public bus::EventTarget {
   std::array<std::vector<DiagEntry>, 2> m_io_diag;
 
   // ---- F4 connections, SSL ----
-  // (devices/src/h_system_comms.cpp; rules in h_connections.hpp and h_ssl.hpp). The
+  // (controllers/s7h/src/h_system_comms.cpp; rules in h_connections.hpp and h_ssl.hpp). The
   // connections follow the pair at every reconcile(); their events go into both powered CPUs'
   // diagnostic buffers (000 §9.1.4: "both CPUs report the event").
  public:

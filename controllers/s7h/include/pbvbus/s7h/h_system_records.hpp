@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <functional>
 
-#include "pbvbus/devices/h_cpu_pair.hpp"
+#include "pbvbus/s7h/h_cpu_pair.hpp"
 #include "pbvbus/dp/master_acyclic.hpp"
 
 namespace pbvbus::devices {

@@ -71,10 +71,10 @@
 #include <vector>
 
 #include "pbvbus/bus/device.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/io_behaviour.hpp"
-#include "pbvbus/devices/slave_fault.hpp"
-#include "pbvbus/devices/slave_mutant.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
+#include "pbvbus/slaves/slave_fault.hpp"
+#include "pbvbus/slaves/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 #include "pbvbus/fdl/bus_params.hpp"

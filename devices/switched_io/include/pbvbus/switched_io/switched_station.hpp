@@ -62,9 +62,9 @@
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"
-#include "pbvbus/devices/gsd.hpp"
-#include "pbvbus/devices/io_behaviour.hpp"
-#include "pbvbus/devices/slave_model.hpp"
+#include "pbvbus/gsd/gsd.hpp"
+#include "pbvbus/slaves/io_behaviour.hpp"
+#include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/fdl/passive_station.hpp"
 #include "pbvbus/redundancy/redundant_slave.hpp"
 

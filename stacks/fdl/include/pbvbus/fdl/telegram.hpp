@@ -8,7 +8,7 @@
 // it accepts, decode() accepts and returns the same fields.
 //
 // Canonical form. Every frame decode() accepts is re-encoded to the identical bytes by
-// reencode() (checked by the fuzz target tests/fuzz and tests/fdl/telegram_mutation_parser_test),
+// reencode() (checked by the fuzz target tests/fuzz and tests/stacks/fdl/telegram_mutation_parser_test),
 // with one deliberate exception: within one extension chain (DAE or SAE) the receiver accepts
 // the region/segment octet before or after the SAP octet, because the parsing rule of §B.2 is
 // order-free ("read octets while bit 7 is set; the SAP is the octet with bit 6 = 0"), while the

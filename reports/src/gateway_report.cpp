@@ -1,10 +1,10 @@
 // Text and JSON of the gateways' report (gateway_report.hpp has the schema).
-#include "pbvbus/tools/gateway_report.hpp"
+#include "pbvbus/reports/gateway_report.hpp"
 
 #include <cstdio>
 #include <ostream>
 
-#include "pbvbus/tools/json_text.hpp"
+#include "pbvbus/reports/json_text.hpp"
 
 namespace pbvbus::tools {
 

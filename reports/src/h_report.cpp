@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <sstream>
 
-#include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/reports/json_text.hpp"
 
 namespace pbvbus::tools {
@@ -23,18 +22,6 @@ using devices::HProfile;
 using devices::Redf;
 using devices::SystemMode;
 
-// The capture encoding (captures/cpu_event.hpp) names the devices enums by number.
-static_assert(static_cast<int>(HEvent::Kind::State) == static_cast<int>(captures::CpuEventKind::State));
-static_assert(static_cast<int>(HEvent::Kind::Role) == static_cast<int>(captures::CpuEventKind::Role));
-static_assert(static_cast<int>(HEvent::Kind::SystemMode) ==
-              static_cast<int>(captures::CpuEventKind::SystemMode));
-static_assert(static_cast<int>(HEvent::Kind::Ob) == static_cast<int>(captures::CpuEventKind::Ob));
-static_assert(static_cast<int>(CpuRole::Master) == 1 && static_cast<int>(CpuRole::Standby) == 2);
-static_assert(static_cast<int>(CpuState::Stop) == 1 && static_cast<int>(CpuState::SyncUp) == 9);
-static_assert(static_cast<int>(SystemMode::Solo) == 2 && static_cast<int>(SystemMode::SyncUp) == 7);
-static_assert(static_cast<int>(devices::HReason::LinkLost) == 5 &&
-              static_cast<int>(devices::HReason::MasterSwap) == 8);
-
 std::string_view profile_name(HProfile p) { return p == HProfile::S7_1500RH ? "S7-1500R/H" : "S7-400H"; }
 
 std::string_view kind_name(HEvent::Kind k) {
@@ -45,18 +32,6 @@ std::string_view kind_name(HEvent::Kind k) {
     case HEvent::Kind::Ob: return "ob";
   }
   return "?";
-}
-
-/// The REDF LED as HCpuPair::leds() derives it, from the pair's mode (h_report.hpp).
-Redf redf_of(bool powered, SystemMode m) {
-  if (!powered) return Redf::Off;
-  switch (m) {
-    case SystemMode::LinkUp:
-    case SystemMode::SyncUp: return Redf::Flash0_5Hz;
-    case SystemMode::Update: return Redf::Flash2Hz;
-    case SystemMode::Redundant: return Redf::Off;
-    default: return Redf::On;
-  }
 }
 
 std::string hex16(std::uint16_t v) {

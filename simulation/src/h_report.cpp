@@ -10,11 +10,6 @@ namespace pbvbus::tools {
 
 namespace {
 
-std::string hex_byte(std::uint8_t b) {
-  static const char* d = "0123456789ABCDEF";
-  return {d[b >> 4], d[b & 0xF]};
-}
-
 using devices::CpuRole;
 using devices::CpuState;
 using devices::HEvent;
@@ -34,18 +29,6 @@ static_assert(static_cast<int>(SystemMode::Solo) == 2 && static_cast<int>(System
 static_assert(static_cast<int>(devices::HReason::LinkLost) == 5 &&
               static_cast<int>(devices::HReason::MasterSwap) == 8);
 
-std::string_view profile_name(HProfile p) { return p == HProfile::S7_1500RH ? "S7-1500R/H" : "S7-400H"; }
-
-std::string_view kind_name(HEvent::Kind k) {
-  switch (k) {
-    case HEvent::Kind::State: return "state";
-    case HEvent::Kind::Role: return "role";
-    case HEvent::Kind::SystemMode: return "system_mode";
-    case HEvent::Kind::Ob: return "ob";
-  }
-  return "?";
-}
-
 /// The REDF LED as HCpuPair::leds() derives it, from the pair's mode (h_report.hpp).
 Redf redf_of(bool powered, SystemMode m) {
   if (!powered) return Redf::Off;
@@ -64,61 +47,8 @@ std::string hex16(std::uint16_t v) {
   return b;
 }
 
-/// Milliseconds with three decimals (µs resolution, rounded down), a valid JSON number.
-std::string ms3(bus::Ticks t) {
-  const std::int64_t us = t / bus::kTicksPerUs;
-  char b[40];
-  std::snprintf(b, sizeof b, "%lld.%03lld", static_cast<long long>(us / 1000),
-                static_cast<long long>(us % 1000));
-  return b;
-}
-
-std::string pad(std::string_view s, std::size_t w) {
-  std::string r(s);
-  if (r.size() < w) r.append(w - r.size(), ' ');
-  else r += ' ';
-  return r;
-}
-
-std::string ob_cell(int ob, std::uint16_t code) {
-  if (ob == 0) return {};
-  std::string s = "OB " + std::to_string(ob);
-  if (code != 0) s += " " + hex16(code);
-  return s;
-}
-
-std::string cpu_name(int rack) {
-  return "CPU " + std::to_string(rack) + " (rack " + std::to_string(rack) + ")";
-}
-
-void json_time(std::ostream& os, const char* key, bus::Ticks t) {
-  os << "\"" << key << "_ns\":" << bus::ticks_to_ns(t) << ",\"" << key << "_ms\":" << ms3(t);
-}
-void json_opt_time(std::ostream& os, const char* key, const std::optional<bus::Ticks>& t) {
-  if (t) {
-    json_time(os, key, *t);
-  } else {
-    os << "\"" << key << "_ns\":null,\"" << key << "_ms\":null";
-  }
-}
-
-struct WindowCheck {
-  std::optional<bus::Ticks> measured;
-  std::optional<bus::Ticks> planned;
-  std::string verdict;  ///< "within", "EXCEEDED", "not measured", "not planned"
-};
-WindowCheck check_window(const HUpdateWindow& w, const std::optional<bus::Ticks>& start,
-                         const std::optional<bus::Ticks>& planned) {
-  WindowCheck c;
-  c.planned = planned;
-  if (start) c.measured = w.t5 - *start;
-  if (!c.measured) c.verdict = "not measured";
-  else if (!planned) c.verdict = "not planned";
-  else c.verdict = std::string(window_verdict(*c.measured, *planned));
-  return c;
-}
-
 }  // namespace
+
 std::string h_event_text(const HEvent& e, HProfile p) {
   const std::string cpu = "CPU " + std::to_string(e.rack) + ": ";
   switch (e.kind) {

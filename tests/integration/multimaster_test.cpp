@@ -11,6 +11,7 @@
 #include <set>
 
 #include "../captures/tshark_helpers.hpp"
+#include "frame_recorder.hpp"
 #include "pbvbus/captures/pcapng_reader.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/fdl_traffic/fdl_poller.hpp"
@@ -245,6 +246,64 @@ TEST_F(Multimaster, GapsRespectTsynAndTsdr) {
   }
   EXPECT_GT(requests, 10'000u);
   EXPECT_GT(responses, 10'000u);
+}
+
+// After the repair the two logical rings (1 <-> 2 on one side, 3 alone on the other) meet.
+// Measured from a whole-line tap (every frame once, from its sender's side), in bit times at
+// 1.5 Mbit/s since the repair at 3 s.
+struct MergeTimes {
+  std::int64_t first_ring12_token = -1;  ///< first valid token frame of master 1 or 2
+  std::int64_t last_lone_token = -1;     ///< last valid DC 03 03 (master 3 alone)
+  std::int64_t ring_whole = -1;          ///< first DC 01 03 (3 passes to 1: one ring 1-2-3)
+};
+
+MergeTimes merge_times(const test::FrameRecorder& rec, bus::Ticks repair, bus::Ticks bit) {
+  MergeTimes m;
+  for (const auto& f : rec.frames()) {
+    if (f.start < repair || !f.intact()) continue;
+    fdl::Telegram t;
+    if (fdl::decode(f.bytes, t) != fdl::DecodeError::None || t.type != fdl::FrameType::SD4) continue;
+    const std::int64_t at = (f.start - repair) / bit;
+    if ((t.sa == 1 || t.sa == 2) && m.first_ring12_token < 0) m.first_ring12_token = at;
+    if (t.sa == 3 && t.da == 3) m.last_lone_token = at;
+    if (t.sa == 3 && t.da == 1 && m.ring_whole < 0) m.ring_whole = at;
+  }
+  return m;
+}
+
+TEST(MultimasterMerge, NoTwoTokensAfterTheRepair) {
+  // IEC 61158-4-3 token procedures (docs/fdl-stations.md "Two rings meet"): a station that
+  // holds the token or checks its pass and hears a valid frame it did not expect gives its token
+  // up, so after the repair one token survives the first intact frame. Here the frames of both
+  // sides collide until master 3's SRD at 695 bits (ends 838): master 1, checking its pass to 2
+  // (DC 02 01 at 599, destroyed), gives ring 1-2's token up, and masters 1 and 2 send nothing
+  // until master 3's GAP poll reaches address 1 (59th poll, 1112 + 58 * 1236 = 72 800 bits;
+  // derivation in tests/fdl/token_merge_test.cpp, which builds the same stations by hand).
+  const auto loaded = load_scenario_file(PBVBUS_SOURCE_DIR "/examples/multimaster.textproto");
+  ASSERT_TRUE(loaded.ok());
+  Simulation sim(*loaded.plan);
+  test::FrameRecorder rec;
+  sim.line(0).add_tap(rec);
+  sim.run_until(4 * bus::kTicksPerSecond);
+  const bus::Ticks bit = bus::ticks_per_bit(bus::Baud::k1_5M);
+  const MergeTimes m = merge_times(rec, 3 * bus::kTicksPerSecond, bit);
+  // Token frames of the two rings never interleave: master 3's last token to itself comes
+  // before the first token of master 1 or 2 (the span of interleaving is zero).
+  EXPECT_EQ(m.last_lone_token, 71'930);
+  EXPECT_EQ(m.ring_whole, 72'980);
+  EXPECT_EQ(m.first_ring12_token, 73'050);  // 1 passes to 2 after its own cycles
+  EXPECT_LT(m.last_lone_token, m.first_ring12_token);
+  // And no frame of master 1 or 2 (intact or not) starts after 838 until the poll of 1.
+  for (const auto& f : rec.frames()) {
+    if (f.start < 3 * bus::kTicksPerSecond) continue;
+    const std::int64_t at = (f.start - 3 * bus::kTicksPerSecond) / bit;
+    if (at >= 72'800) break;
+    fdl::Telegram t;
+    const bool from12 = f.intact() && fdl::decode(f.bytes, t) == fdl::DecodeError::None &&
+                        t.type != fdl::FrameType::SC && (t.sa == 1 || t.sa == 2) &&
+                        !(t.type == fdl::FrameType::SD1 && !t.is_request());
+    EXPECT_FALSE(from12 && at >= 838) << "frame from master " << int(t.sa) << " at " << at;
+  }
 }
 
 }  // namespace

@@ -192,13 +192,14 @@ TEST_F(ModbusTcpLimits, OutOfDescriptorsTheDoorPausesInsteadOfSpinningAndServesT
     ASSERT_GE(waiting[1], 0);
     // One second of bus time (paced: about one of wall time) with accept() failing. Accepting
     // again at once would fail at once, forever: a whole core. Paused, the door retries every
-    // 100 ms. The bound is generous for a loaded machine.
+    // 100 ms. Measured on the loaded 2-core build machine: spinning took about half of the wall
+    // time, pausing 0.5 ms; the bound (a tenth) is generous both ways.
     const auto cpu0 = test::thread_cpu();
     const auto wall0 = std::chrono::steady_clock::now();
     runner.run_for(1000 * bus::kTicksPerMs);
     const auto cpu = test::thread_cpu() - cpu0;
     const auto wall = std::chrono::steady_clock::now() - wall0;
-    EXPECT_LT(cpu, wall / 4) << "cpu " << cpu.count() << " ns in " << wall.count() << " ns";
+    EXPECT_LT(cpu, wall / 10) << "cpu " << cpu.count() << " ns in " << wall.count() << " ns";
     EXPECT_EQ(srv->stats().clients_now, 0u);
     EXPECT_GE(srv->stats().accept_pauses, 3u);  // ~10: one per 100 ms
     EXPECT_EQ(logged("accept failed: Too many open files"), 1u);  // once per episode

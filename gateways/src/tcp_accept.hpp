@@ -6,14 +6,15 @@
 //
 // Decisions (also in docs/gateway-modbus-doors.md, docs/gateway-can-doors.md):
 //  - Backlog SOMAXCONN (4096 in glibc; the kernel clamps it to net.core.somaxconn): a burst of
-//    connects waits in the kernel instead of being reset while the bus thread is busy.
+//    connects waits in the kernel while the bus thread is busy, instead of having its SYNs
+//    dropped (the clients then retry only after a second or more).
 //  - Accepted connections get a fixed kernel send buffer (SO_SNDBUF 32 KiB; the kernel doubles
 //    it for its bookkeeping). Left to autotuning, Linux buffered megabytes for a loopback client
 //    that never reads (measured: 2.8 MB of stale CAN frames; 4.2 MB, ~16000 Modbus replies),
 //    so the door's own bound (max_output) applied only long after.
 //  - accept() failing for any reason but "nothing pending" (EMFILE/ENFILE: out of descriptors;
 //    ENOBUFS/ENOMEM) leaves the connection in the backlog and the listener readable, so waiting
-//    for readability again wakes at once: the door span a whole core until a descriptor was
+//    for readability again wakes at once: the door spun a whole core until a descriptor was
 //    freed. Instead the door stops accepting and retries after kAcceptRetry (a timer): clients
 //    wait in the backlog (their connect already succeeded) and are served once descriptors are
 //    free again. One line is logged when such an episode starts and one when it ends, never one

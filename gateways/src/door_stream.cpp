@@ -31,7 +31,7 @@ int listen_tcp(const std::string& address, std::uint16_t port, std::uint16_t& bo
   }
   const int one = 1;
   ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa) != 0 || ::listen(fd, 16) != 0) {
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa) != 0 || ::listen(fd, tcp_accept::kListenBacklog) != 0) {
     err = errno_text("listen on " + address + ":" + std::to_string(port));
     ::close(fd);
     return -1;
@@ -42,8 +42,9 @@ int listen_tcp(const std::string& address, std::uint16_t port, std::uint16_t& bo
   return fd;
 }
 
-TcpListener::TcpListener(boost::asio::io_context& io, int fd, OnAccept on_accept)
-    : m_sd(io, fd), m_on_accept(std::move(on_accept)) {
+TcpListener::TcpListener(boost::asio::io_context& io, int fd, std::string who, DoorLog log,
+                         OnAccept on_accept)
+    : m_sd(io, fd), m_on_accept(std::move(on_accept)), m_backoff(io, std::move(who), std::move(log)) {
   start_accept();
 }
 
@@ -56,17 +57,24 @@ void TcpListener::start_accept() {
                                SOCK_NONBLOCK | SOCK_CLOEXEC);
       if (fd < 0) {
         if (errno == EINTR || errno == ECONNABORTED) continue;
-        break;  // EAGAIN: no more; EMFILE & co.: try again on the next readiness
+        if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+        // EMFILE & co.: the connection stays pending and the listener readable; waiting for
+        // readability again would spin. Pause, then try again (tcp_accept.hpp).
+        m_backoff.failed(errno, [this] { start_accept(); });
+        return;
       }
+      m_backoff.succeeded();
       const int one = 1;
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-      // A fixed kernel send buffer: autotuned, Linux lets a stalled loopback client hoard
-      // megabytes of stale frames before the door's own bound (and drop count) applies.
-      const int sndbuf = kKernelSendBuffer;
-      ::setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &sndbuf, sizeof sndbuf);
-      ++m_accepted;
-      m_on_accept(fd, m_accepted);
+      tcp_accept::cap_send_buffer(fd);
+      const bool taken = m_on_accept(fd, m_accepted + 1);
       if (alive.expired()) return;  // the door closed from inside on_accept
+      if (taken) {
+        ++m_accepted;
+      } else {
+        ::close(fd);  // refused (the door's client limit): the client sees EOF at once
+        ++m_refused;
+      }
     }
     start_accept();
   });

@@ -10,9 +10,10 @@
 //  - A read wake-up takes at most 64 KiB, so one flooding client cannot hold the loop.
 //  - Output waits in a per-connection queue bounded by the door's max_output; what does not fit
 //    is dropped and counted (Stream::dropped) — a client that never reads never delays the bus.
-//  - Accepted connections get TCP_NODELAY and a fixed kernel send buffer (SO_SNDBUF 32 KiB):
-//    left to autotuning, Linux buffered 2.8 MB (measured) for a stalled loopback client, stale
-//    frames it would read long after, before the door's own bound and drop count applied.
+//  - Accepted connections get TCP_NODELAY and a fixed kernel send buffer; the backlog and what
+//    a failing accept() does are tcp_accept.hpp's, shared with the Modbus door.
+//  - A door refuses a connection (its client limit) by returning false from OnAccept: the
+//    listener closes it at once, so the client learns it at connect time, and counts it.
 //  - A write error on a socket (the peer is gone) or a read of 0/an error closes the connection
 //    on the next turn (Stream::gone(), posted: we may be inside the hub's delivery).
 
@@ -26,6 +27,7 @@
 #include <string_view>
 
 #include "pbvbus/bus/time.hpp"
+#include "tcp_accept.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;
@@ -35,36 +37,42 @@ namespace pbvbus::gateways::door_stream {
 
 using Descriptor = boost::asio::posix::stream_descriptor;
 
-/// SO_SNDBUF of accepted connections (the kernel doubles it for its bookkeeping).
-constexpr int kKernelSendBuffer = 32 * 1024;
 /// At most this many octets are read per wake-up of one connection.
 constexpr std::size_t kMaxReadPerWake = 64 * 1024;
 
 /// "what: strerror(errno)".
 std::string errno_text(const std::string& what);
 
-/// A non-blocking IPv4 TCP listener on address:port. Returns the fd (and the port actually bound
-/// in `bound`) or -1 with `err` set.
+/// A non-blocking IPv4 TCP listener on address:port (backlog tcp_accept::kListenBacklog).
+/// Returns the fd (and the port actually bound in `bound`) or -1 with `err` set.
 int listen_tcp(const std::string& address, std::uint16_t port, std::uint16_t& bound,
                std::string& err);
 
 /// A listening socket on the io_context: accepts every pending connection on each readiness,
 /// tunes it (TCP_NODELAY, SO_SNDBUF) and hands it to `on_accept(fd, n)` (n = 1, 2, ...: the
-/// count of connections accepted so far, including this one). Destroying it stops accepting.
+/// count of connections taken so far, including this one). `on_accept` returns false to refuse
+/// it: the listener then closes it and counts it in refused(). A failing accept() pauses the
+/// listener (tcp_accept::AcceptBackoff, logged through `log` with `who`). Destroying it stops
+/// accepting.
 class TcpListener {
  public:
-  using OnAccept = std::function<void(int fd, std::uint64_t n)>;
-  TcpListener(boost::asio::io_context& io, int fd, OnAccept on_accept);
+  using OnAccept = std::function<bool(int fd, std::uint64_t n)>;
+  TcpListener(boost::asio::io_context& io, int fd, std::string who, DoorLog log,
+              OnAccept on_accept);
   TcpListener(const TcpListener&) = delete;
   TcpListener& operator=(const TcpListener&) = delete;
   std::uint64_t accepted() const { return m_accepted; }
+  std::uint64_t refused() const { return m_refused; }
+  const tcp_accept::AcceptBackoff& backoff() const { return m_backoff; }
 
  private:
   void start_accept();
 
   Descriptor m_sd;  // owns the listening fd
   OnAccept m_on_accept;
+  tcp_accept::AcceptBackoff m_backoff;
   std::uint64_t m_accepted = 0;
+  std::uint64_t m_refused = 0;
   std::shared_ptr<bool> m_alive = std::make_shared<bool>(true);
 };
 

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "pbvbus/gateways/modbus_frame.hpp"
+#include "tcp_accept.hpp"
+#include "throttled_log.hpp"
 
 namespace pbvbus::gateways {
 
@@ -27,10 +29,13 @@ static_assert(kReadBuffer >= 2 * kModbusTcpMaxAdu);
 struct ModbusTcpServer::Impl : std::enable_shared_from_this<ModbusTcpServer::Impl> {
   struct Connection;
   Impl(asio::io_context& i, ModbusHandler& h, ModbusTcpOptions o)
-      : io(i), handler(h), opt(std::move(o)), acceptor(i) {}
+      : io(i), handler(h), opt(std::move(o)), acceptor(i), backoff(i, "modbus_tcp", opt.log),
+        evictions(opt.log) {}
 
   void start();
   void accept();
+  void admit(tcp::socket s);
+  void evict_longest_idle();
   void close();
   void forget(std::list<std::shared_ptr<Connection>>::iterator it);
 
@@ -38,9 +43,11 @@ struct ModbusTcpServer::Impl : std::enable_shared_from_this<ModbusTcpServer::Imp
   ModbusHandler& handler;
   ModbusTcpOptions opt;
   tcp::acceptor acceptor;
+  tcp_accept::AcceptBackoff backoff;
+  ThrottledLog evictions;
+  std::string who = "modbus_tcp";  // starts each logged line: "modbus_tcp HOST:PORT"
   std::uint16_t port = 0;
   ModbusDoorStats stats;
-  std::uint64_t rejected = 0;
   bool closed = false;
   std::list<std::shared_ptr<Connection>> conns;
 };
@@ -76,8 +83,10 @@ void ModbusTcpServer::Impl::start() {
   acceptor.open(ep.protocol());
   acceptor.set_option(tcp::acceptor::reuse_address(true));
   acceptor.bind(ep);
-  acceptor.listen();
+  acceptor.listen(tcp_accept::kListenBacklog);
   port = acceptor.local_endpoint().port();
+  who = "modbus_tcp " + opt.address + ":" + std::to_string(port);
+  backoff.set_who(who);
   accept();
 }
 
@@ -85,29 +94,56 @@ void ModbusTcpServer::Impl::accept() {
   std::weak_ptr<Impl> w = shared_from_this();
   acceptor.async_accept([w](const boost::system::error_code& ec, tcp::socket s) {
     auto self = w.lock();
-    if (!self || self->closed) return;
-    if (!ec) {
-      if (self->conns.size() >= self->opt.max_clients) {
-        // Over the limit: accept and close at once, so the client learns it at connect time
-        // instead of hanging in the listen backlog.
-        ++self->rejected;
-        ++self->stats.clients_closed_bad;
-        boost::system::error_code ignore;
-        s.close(ignore);
-      } else {
-        auto c = std::make_shared<Connection>(self.get(), std::move(s));
-        self->conns.push_front(c);
-        c->self = self->conns.begin();
-        ++self->stats.clients_accepted;
-        ++self->stats.clients_now;
-        c->start();
-      }
-    } else if (ec == asio::error::operation_aborted) {
+    if (!self || self->closed || ec == asio::error::operation_aborted) return;
+    if (ec) {
+      // EMFILE & co.: the connection stays pending, so accepting again at once would fail at
+      // once, forever. Pause, then try again (tcp_accept.hpp).
+      ++self->stats.accept_pauses;
+      self->backoff.failed(ec.value(), [w] {
+        if (auto p = w.lock(); p && !p->closed) p->accept();
+      });
       return;
     }
-    // Other accept errors (EMFILE, ECONNABORTED) are per attempt: keep listening.
-    self->accept();
+    self->backoff.succeeded();
+    self->admit(std::move(s));
+    if (!self->closed) self->accept();
   });
+}
+
+void ModbusTcpServer::Impl::admit(tcp::socket s) {
+  if (opt.max_clients == 0) {
+    // Accept and close at once, so the client learns it at connect time instead of hanging in
+    // the listen backlog.
+    ++stats.clients_refused;
+    boost::system::error_code ignore;
+    s.close(ignore);
+    return;
+  }
+  while (conns.size() >= opt.max_clients) evict_longest_idle();
+  auto c = std::make_shared<Connection>(this, std::move(s));
+  conns.push_front(c);
+  c->self = conns.begin();
+  ++stats.clients_accepted;
+  stats.clients_now = conns.size();
+  c->start();
+}
+
+void ModbusTcpServer::Impl::evict_longest_idle() {
+  // The list runs newest first: on equal times the older connection (later in the list) goes.
+  std::shared_ptr<Connection> victim;
+  for (const auto& c : conns)
+    if (!victim || c->last_request <= victim->last_request) victim = c;
+  boost::system::error_code ec;
+  const auto peer = victim->sock.remote_endpoint(ec);
+  const auto idle_ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - victim->last_request);
+  ++stats.clients_evicted;
+  evictions(who + ": evicted the longest-idle client " +
+            (ec ? std::string("(peer unknown)") : peer.address().to_string() + ":" +
+                                                      std::to_string(peer.port())) +
+            " (no request for " + std::to_string(idle_ms.count()) + " ms) for a new one: " +
+            std::to_string(conns.size()) + " clients open (max_clients)");
+  victim->close(false);
 }
 
 void ModbusTcpServer::Impl::forget(std::list<std::shared_ptr<Connection>>::iterator it) {
@@ -128,6 +164,9 @@ void ModbusTcpServer::Impl::close() {
 void ModbusTcpServer::Impl::Connection::start() {
   boost::system::error_code ignore;
   sock.set_option(tcp::no_delay(true), ignore);
+  // A small kernel send buffer: the door's own bound (max_output) then applies after some
+  // 100 KB built for a client that does not read, not after megabytes (tcp_accept.hpp).
+  sock.set_option(asio::socket_base::send_buffer_size(tcp_accept::kKernelSendBuffer), ignore);
   sock.non_blocking(true, ignore);  // for the first, immediate write attempt in flush()
   last_request = Clock::now();
   if (srv->opt.idle_timeout.count() > 0) arm_idle(last_request + srv->opt.idle_timeout);
@@ -287,7 +326,7 @@ const ModbusDoorStats& ModbusTcpServer::stats() const {
   return m->stats;
 }
 std::uint64_t ModbusTcpServer::rejected() const {
-  return m->rejected;
+  return m->stats.clients_refused;
 }
 void ModbusTcpServer::close() {
   m->close();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "door_stream.hpp"
+#include "throttled_log.hpp"
 #include "pbvbus/bus/paced_runner.hpp"
 
 namespace pbvbus::gateways {
@@ -30,7 +31,11 @@ struct SlcanDoor::Link : door_stream::Stream {
 };
 
 struct SlcanDoor::Listener : door_stream::TcpListener {
-  using TcpListener::TcpListener;
+  Listener(boost::asio::io_context& io, int fd, const std::string& name, const DoorLog& log,
+           OnAccept on_accept)
+      : TcpListener(io, fd, name, log, std::move(on_accept)), who(name), refusals(log) {}
+  std::string who;  // starts each logged line: "slcan HOST:PORT"
+  ThrottledLog refusals;
 };
 
 SlcanDoor::SlcanDoor(bus::PacedRunner& runner, CanHub& hub, Options options)
@@ -69,11 +74,9 @@ std::string SlcanDoor::open() {
       close();
       return "slcan door: " + err;
     }
-    m_listener = std::make_unique<Listener>(m_runner.io_context(), fd,
-                                            [this](int conn, std::uint64_t n) {
-      door_stream::start_read(add_link(conn, true, m_opt.name + ":tcp:" + std::to_string(n)),
-                              m_runner);
-    });
+    m_listener = std::make_unique<Listener>(
+        m_runner.io_context(), fd, m_opt.name + " " + m_opt.tcp_address + ":" + std::to_string(m_port),
+        m_opt.log, [this](int conn, std::uint64_t n) { return accept_tcp(conn, n); });
   }
   return {};
 }
@@ -113,10 +116,26 @@ SlcanDoor::Stats SlcanDoor::stats() const {
     s.frames_out += l->frames_out;
     s.dropped += l->dropped;
   }
-  if (m_listener) s.clients_total = m_closed.clients_total + m_listener->accepted();
+  if (m_listener) {
+    s.clients_total = m_closed.clients_total + m_listener->accepted();
+    s.refused = m_closed.refused + m_listener->refused();
+    s.accept_pauses = m_closed.accept_pauses + m_listener->backoff().pauses();
+  }
   // The pty is one client for as long as the door has it (the report said "0 clients (1 now)").
   if (m_pty_slave >= 0) ++s.clients_total;
   return s;
+}
+
+bool SlcanDoor::accept_tcp(int fd, std::uint64_t n) {
+  std::size_t open = 0;
+  for (const auto& [key, l] : m_links) open += l->is_socket ? 1 : 0;
+  if (open >= m_opt.max_clients) {
+    m_listener->refusals(m_listener->who + ": refused a client: " + std::to_string(open) +
+                         " connections open (max_clients)");
+    return false;
+  }
+  door_stream::start_read(add_link(fd, true, m_opt.name + ":tcp:" + std::to_string(n)), m_runner);
+  return true;
 }
 
 std::shared_ptr<SlcanDoor::Link> SlcanDoor::add_link(int fd, bool is_socket, std::string name) {

@@ -116,6 +116,10 @@ std::string encode_error(std::string_view text) {
 void SocketcandSession::feed(std::string_view bytes, std::vector<std::string>& replies,
                              std::vector<CanFrame>& to_bus) {
   for (char c : bytes) {
+    // The close rule is checked at every error, not once per feed(): a single read can hold an
+    // endless run of errors (a 10 000-character element is 39 of them), and every byte after
+    // the 8th one in a row is not read at all.
+    if (wants_close()) return;
     switch (m_lex) {
       case Lex::Between:
         if (c == '<') {

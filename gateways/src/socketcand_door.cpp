@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "door_stream.hpp"
+#include "throttled_log.hpp"
 #include "pbvbus/bus/paced_runner.hpp"
 
 namespace pbvbus::gateways {
@@ -25,7 +26,11 @@ struct SocketcandDoor::Link : door_stream::Stream {
 };
 
 struct SocketcandDoor::Listener : door_stream::TcpListener {
-  using TcpListener::TcpListener;
+  Listener(boost::asio::io_context& io, int fd, const std::string& name, const DoorLog& log,
+           OnAccept on_accept)
+      : TcpListener(io, fd, name, log, std::move(on_accept)), who(name), refusals(log) {}
+  std::string who;  // starts each logged line: "socketcand HOST:PORT"
+  ThrottledLog refusals;
 };
 
 SocketcandDoor::SocketcandDoor(bus::PacedRunner& runner, CanHub& hub, Options options)
@@ -42,7 +47,8 @@ std::string SocketcandDoor::open() {
     return "socketcand door: " + err;
   }
   m_listener = std::make_unique<Listener>(
-      m_runner.io_context(), fd, [this](int conn, std::uint64_t n) { add_link(conn, n); });
+      m_runner.io_context(), fd, m_opt.name + " " + m_opt.address + ":" + std::to_string(m_port),
+      m_opt.log, [this](int conn, std::uint64_t n) { return accept_link(conn, n); });
   return {};
 }
 
@@ -71,11 +77,20 @@ SocketcandDoor::Stats SocketcandDoor::stats() const {
     s.frames_out += l->frames_out;
     s.dropped += l->dropped;
   }
-  if (m_listener) s.clients_total = m_closed.clients_total + m_listener->accepted();
+  if (m_listener) {
+    s.clients_total = m_closed.clients_total + m_listener->accepted();
+    s.refused = m_closed.refused + m_listener->refused();
+    s.accept_pauses = m_closed.accept_pauses + m_listener->backoff().pauses();
+  }
   return s;
 }
 
-void SocketcandDoor::add_link(int fd, std::uint64_t n) {
+bool SocketcandDoor::accept_link(int fd, std::uint64_t n) {
+  if (m_links.size() >= m_opt.max_clients) {
+    m_listener->refusals(m_listener->who + ": refused a client: " +
+                         std::to_string(m_links.size()) + " connections open (max_clients)");
+    return false;
+  }
   auto l = std::make_shared<Link>(*this, m_runner.io_context(), fd, m_opt.channel);
   l->key = m_next_link++;
   std::weak_ptr<Link> w = l;
@@ -86,6 +101,7 @@ void SocketcandDoor::add_link(int fd, std::uint64_t n) {
   m_links.emplace(l->key, l);
   emit(*l, socketcand::SocketcandSession::greeting(), false);  // `< hi >`, alone
   door_stream::start_read(l, m_runner);
+  return true;
 }
 
 void SocketcandDoor::on_bytes(Link& l, const std::string& bytes, bus::Ticks now) {

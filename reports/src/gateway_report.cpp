@@ -41,7 +41,12 @@ void write_gateways_text(const std::vector<GatewayReport>& r, std::ostream& os) 
         continue;
       }
       os << ": " << d.clients_total << " clients (" << d.clients << " now, "
-         << d.clients_closed_bad << " closed bad)";
+         << d.clients_closed_bad << " closed bad";
+      // Only when they happened: a door under pressure says so, a quiet one stays short.
+      if (d.clients_refused != 0) os << ", " << d.clients_refused << " refused";
+      if (d.clients_evicted != 0) os << ", " << d.clients_evicted << " evicted";
+      if (d.accept_pauses != 0) os << ", " << d.accept_pauses << " accept pauses";
+      os << ")";
       if (d.kind.rfind("modbus", 0) == 0)
         os << ", " << d.requests << " requests, " << d.exceptions << " exceptions, "
            << d.bad_frames << " bad frames";
@@ -90,7 +95,10 @@ void write_gateways_json(const std::vector<GatewayReport>& r, std::ostream& os) 
       os << (k ? "," : "") << "{\"kind\":" << json_quote(d.kind) << ",\"where\":" << json_quote(d.where)
          << ",\"link\":" << json_quote(d.link) << ",\"error\":" << json_quote(d.error)
          << ",\"clients\":" << d.clients << ",\"clients_total\":" << d.clients_total
-         << ",\"clients_closed_bad\":" << d.clients_closed_bad << ",\"requests\":" << d.requests
+         << ",\"clients_closed_bad\":" << d.clients_closed_bad
+         << ",\"clients_refused\":" << d.clients_refused
+         << ",\"clients_evicted\":" << d.clients_evicted
+         << ",\"accept_pauses\":" << d.accept_pauses << ",\"requests\":" << d.requests
          << ",\"exceptions\":" << d.exceptions << ",\"bad_frames\":" << d.bad_frames
          << ",\"frames_in\":" << d.frames_in << ",\"frames_out\":" << d.frames_out
          << ",\"errors\":" << d.errors << ",\"dropped\":" << d.dropped << "}";

@@ -346,10 +346,12 @@ class GwPlanner {
         error(i, {{"can"}, {"slcan_tcp"}}, "slcan_tcp needs listen (HOST:PORT)");
       else
         can.slcan_tcp = endpoint(i, {{"can"}, {"slcan_tcp"}, {"listen"}}, c.slcan_tcp().listen(), "slcan_tcp");
+      can.slcan_max_clients = c.slcan_tcp().max_clients();
     }
     if (c.has_socketcand()) {
       const std::string l = c.socketcand().listen().empty() ? "127.0.0.1:29536" : c.socketcand().listen();
       can.socketcand = endpoint(i, {{"can"}, {"socketcand"}, {"listen"}}, l, "socketcand");
+      can.socketcand_max_clients = c.socketcand().max_clients();
     }
     if (c.has_socketcan()) {
       if (c.socketcan().interface().empty())

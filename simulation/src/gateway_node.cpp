@@ -1,6 +1,7 @@
 // The gateways of a running Simulation (gateway_node.hpp has the decisions).
 #include "pbvbus/simulation/gateway_node.hpp"
 
+#include <iostream>
 #include <stdexcept>
 
 #include "pbvbus/bus/paced_runner.hpp"
@@ -60,6 +61,14 @@ gateways::CanopenOptions can_options(const GwCan& c) {
   return o;
 }
 
+/// Where the doors' log lines go: stderr, named by the gateway. They report a door under
+/// pressure (out of descriptors, clients refused or evicted), so they are not --quiet's to hide.
+gateways::DoorLog door_log(const std::string& gateway) {
+  return [gateway](const std::string& line) {
+    std::cerr << "pbvbus run: gateway \"" << gateway << "\": " << line << std::endl;
+  };
+}
+
 /// The frame counters every CAN door's stats have (SlcanDoor, SocketcandDoor, SocketcanDoor).
 template <class Stats>
 void can_door_counts(GatewayDoorReport& d, const Stats& s) {
@@ -67,6 +76,15 @@ void can_door_counts(GatewayDoorReport& d, const Stats& s) {
   d.frames_out = s.frames_out;
   d.errors = s.errors;
   d.dropped = s.dropped;
+}
+
+/// The client counters of the CAN TCP doors (SlcanDoor, SocketcandDoor).
+template <class Stats>
+void can_door_clients(GatewayDoorReport& d, const Stats& s) {
+  d.clients = s.clients;
+  d.clients_total = s.clients_total;
+  d.clients_refused = s.refused;
+  d.accept_pauses = s.accept_pauses;
 }
 
 }  // namespace
@@ -118,6 +136,7 @@ void GatewayNode::open(bus::PacedRunner& runner) {
     o.address = m_plan.modbus_tcp->host;
     o.port = m_plan.modbus_tcp->port;
     if (m_plan.max_clients != 0) o.max_clients = m_plan.max_clients;
+    o.log = door_log(m_plan.name);
     try {
       m_tcp = std::make_unique<gateways::ModbusTcpServer>(runner.io_context(), *m_modbus, o);
     } catch (const std::exception& e) {
@@ -149,6 +168,8 @@ void GatewayNode::open(bus::PacedRunner& runner) {
       o.tcp_address = c.slcan_tcp->host;
       o.tcp_port = c.slcan_tcp->port;
     }
+    if (c.slcan_max_clients != 0) o.max_clients = c.slcan_max_clients;
+    o.log = door_log(m_plan.name);
     m_slcan = std::make_unique<gateways::SlcanDoor>(runner, *m_hub, o);
     if (std::string why = m_slcan->open(); !why.empty()) throw std::runtime_error(who + "slcan: " + why);
   }
@@ -156,6 +177,8 @@ void GatewayNode::open(bus::PacedRunner& runner) {
     gateways::SocketcandDoorOptions o;
     o.address = c.socketcand->host;
     o.port = c.socketcand->port;
+    if (c.socketcand_max_clients != 0) o.max_clients = c.socketcand_max_clients;
+    o.log = door_log(m_plan.name);
     m_socketcand = std::make_unique<gateways::SocketcandDoor>(runner, *m_hub, o);
     if (std::string why = m_socketcand->open(); !why.empty())
       throw std::runtime_error(who + "socketcand on " + c.socketcand->str() + ": " + why);
@@ -247,6 +270,9 @@ GatewayReport GatewayNode::report() const {
     d.clients = s.clients_now;
     d.clients_total = s.clients_accepted;
     d.clients_closed_bad = s.clients_closed_bad;
+    d.clients_refused = s.clients_refused;
+    d.clients_evicted = s.clients_evicted;
+    d.accept_pauses = s.accept_pauses;
     d.requests = s.requests;
     d.exceptions = s.exceptions;
     d.bad_frames = s.bad_frames;
@@ -269,8 +295,7 @@ GatewayReport GatewayNode::report() const {
       d.where += (d.where.empty() ? "" : " ") +
                  GwEndpoint{m_plan.can->slcan_tcp->host, m_slcan->port()}.str();
     const auto s = m_slcan->stats();
-    d.clients = s.clients;
-    d.clients_total = s.clients_total;
+    can_door_clients(d, s);
     can_door_counts(d, s);
     r.doors.push_back(std::move(d));
   }
@@ -279,8 +304,7 @@ GatewayReport GatewayNode::report() const {
     d.kind = "socketcand";
     d.where = GwEndpoint{m_plan.can->socketcand->host, m_socketcand->port()}.str();
     const auto s = m_socketcand->stats();
-    d.clients = s.clients;
-    d.clients_total = s.clients_total;
+    can_door_clients(d, s);
     d.clients_closed_bad = s.closed_bad;
     can_door_counts(d, s);
     r.doors.push_back(std::move(d));

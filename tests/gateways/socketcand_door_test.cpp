@@ -145,6 +145,32 @@ TEST(SocketcandDoor, GarbageIsAnsweredThenRepeatedGarbageCloses) {
   EXPECT_EQ(rig.hub.ports(), 1u);
 }
 
+TEST(SocketcandDoor, EightErrorsInARowCloseEvenWhenTheyArriveInOneWrite) {
+  // Everything in one write, so in one read of the door: a 10 000-character element (39 errors
+  // by the 256-character rule) then `< echo >`. The client gets exactly 8 error answers, no
+  // echo, then EOF.
+  Rig rig;
+  SocketcandDoor door(rig.runner, rig.hub, ephemeral());
+  ASSERT_EQ(door.open(), "");
+  std::string got;
+  bool eof = false;
+  std::thread client([&] {
+    const int fd = connect_tcp(door.port());
+    recv_once(fd);  // "< hi >"
+    write_all(fd, "<" + std::string(10'000, 'x') + "> < echo >");
+    got = read_n(fd, 100'000, &eof);
+    ::close(fd);
+  });
+  EXPECT_TRUE(rig.run_until([&] { return door.stats().closed_bad == 1; }));
+  client.join();
+  std::string want;
+  for (int i = 0; i < socketcand::kMaxConsecutiveErrors; ++i) want += "< error element too long >";
+  EXPECT_EQ(got, want);
+  EXPECT_TRUE(eof);
+  EXPECT_EQ(door.stats().errors, 8u);
+  EXPECT_EQ(door.stats().clients, 0u);
+}
+
 TEST(SocketcandDoor, ClientThatNeverReadsCannotStallTheBus) {
   Rig rig;
   SocketcandDoor door(rig.runner, rig.hub, ephemeral(0ms));

@@ -123,6 +123,32 @@ TEST(SocketcandSession, GarbageAndOverlongElementsAreAnsweredThenClosed) {
   EXPECT_EQ(s.stats().garbage, 1u + 1u + 8u);
 }
 
+TEST(SocketcandSession, TheEighthErrorInARowEndsTheSessionInsideOneFeed) {
+  // A 10 000-character element then `< echo >`, all in one feed (one read of the door). Errors:
+  // the element is too long at its 257th character, then one more per further 256 characters
+  // (up to 39 in all); the 8th in a row must end the session there: exactly 8 error answers,
+  // the rest (the echo included) not read at all.
+  SocketcandSession s;
+  std::vector<std::string> replies;
+  std::vector<CanFrame> bus;
+  s.feed("<" + std::string(10'000, 'x') + "> < echo >", replies, bus);
+  EXPECT_TRUE(s.wants_close());
+  ASSERT_EQ(replies.size(), static_cast<std::size_t>(kMaxConsecutiveErrors));
+  for (const std::string& r : replies) EXPECT_EQ(r, "< error element too long >");
+  EXPECT_EQ(s.stats().errors, 8u);
+  // Once closing, nothing more is read: a valid command does not revive the session.
+  s.feed("< echo >< open can0 >", replies, bus);
+  EXPECT_EQ(replies.size(), 8u);
+  EXPECT_TRUE(s.wants_close());
+  // Eight invalid elements in one feed, then more: the same, whatever kind of error.
+  SocketcandSession t;
+  std::vector<std::string> r2;
+  t.feed("< a >< b >< c >< d >< e >< f >< g >< h >< i >< echo >", r2, bus);
+  EXPECT_TRUE(t.wants_close());
+  EXPECT_EQ(r2.size(), 8u);
+  EXPECT_EQ(t.stats().elements, 8u);
+}
+
 TEST(SocketcandSession, UnsupportedCommandsAreStated) {
   SocketcandSession s;
   std::vector<std::string> replies;

@@ -66,8 +66,8 @@ TEST(GatewayScenario, AValidEntryIsPlanned) {
     node { address: 5 node: 42 }
     tpdo_cycle: "50ms" heartbeat: "2s"
     slcan_pty { link: "./ttyCAN0" }
-    slcan_tcp { listen: "127.0.0.1:20001" }
-    socketcand { }
+    slcan_tcp { listen: "127.0.0.1:20001" max_clients: 3 }
+    socketcand { max_clients: 5 }
     socketcan { interface: "vcan0" }
   }
 }
@@ -114,6 +114,8 @@ TEST(GatewayScenario, AValidEntryIsPlanned) {
   EXPECT_EQ(g.can->slcan_tcp->str(), "127.0.0.1:20001");
   ASSERT_TRUE(g.can->socketcand);
   EXPECT_EQ(g.can->socketcand->str(), "127.0.0.1:29536");  // the default
+  EXPECT_EQ(g.can->slcan_max_clients, 3u);
+  EXPECT_EQ(g.can->socketcand_max_clients, 5u);
   EXPECT_EQ(g.can->socketcan, "vcan0");
   // Outputs ownership: master 1 is served, master 2 is not.
   EXPECT_TRUE(p.dp_masters[0].gateway_outputs);
@@ -129,6 +131,8 @@ TEST(GatewayScenario, DefaultsOfTheDoors) {
   EXPECT_EQ(g.can->tpdo_cycle, 100 * kMs);
   EXPECT_EQ(g.can->heartbeat, 1000 * kMs);
   EXPECT_FALSE(g.can->slcan_pty);
+  EXPECT_EQ(g.max_clients, 0u);  // 0: the doors' own default (32)
+  EXPECT_EQ(g.can->socketcand_max_clients, 0u);
 }
 
 TEST(GatewayScenario, TheMasterSystemMustExist) {

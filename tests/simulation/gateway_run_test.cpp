@@ -156,6 +156,41 @@ TEST(GatewayRun, ModbusTcpReadThroughThePacedRun) {
   EXPECT_EQ(r.gateways[0].modbus->requests, 1u);
 }
 
+TEST(GatewayRun, TheReportShowsRefusedEvictedAndAcceptPausesApartFromClosedBad) {
+  GatewayReport g;
+  g.name = "gw";
+  g.served = "dp_master 1 on L";
+  GatewayDoorReport quiet;
+  quiet.kind = "socketcand";
+  quiet.where = "127.0.0.1:29536";
+  quiet.clients_total = 2;
+  GatewayDoorReport busy;
+  busy.kind = "modbus_tcp";
+  busy.where = "127.0.0.1:1502";
+  busy.clients_total = 40;
+  busy.clients = 32;
+  busy.clients_closed_bad = 1;
+  busy.clients_evicted = 8;
+  busy.accept_pauses = 3;
+  g.doors = {quiet, busy};
+  std::ostringstream text, json;
+  write_gateways_text({g}, text);
+  // Text: the new counters only when they happened.
+  EXPECT_NE(text.str().find("socketcand 127.0.0.1:29536: 2 clients (0 now, 0 closed bad), "),
+            std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find("modbus_tcp 127.0.0.1:1502: 40 clients (32 now, 1 closed bad, 8 "
+                            "evicted, 3 accept pauses), "),
+            std::string::npos)
+      << text.str();
+  // JSON: always, each on its own.
+  write_gateways_json({g}, json);
+  EXPECT_NE(json.str().find("\"clients_closed_bad\":1,\"clients_refused\":0,\"clients_evicted\":8,"
+                            "\"accept_pauses\":3,"),
+            std::string::npos)
+      << json.str();
+}
+
 TEST(GatewayRun, ARedundantSystemsGatewayOwnsItsOutputs) {
   // examples/switched-io.textproto (switched stations 3..6 of "H-DP 1", one-sided slaves 10 on
   // DP_A and 11 on DP_B) with a gateway on the system and Quantum-style standby units.

@@ -19,6 +19,11 @@
 //  - A scenario with a gateway runs paced (its doors face programs in real time); --fast is
 //    refused for it. The doors print where they listen (the port an ephemeral one got) unless
 //    --quiet; a door that cannot open ends the run with exit 1 before it starts.
+//  - With --json, a run that cannot start (a bad scenario, a door's port in use, a link path
+//    that is a regular file, ...) still prints one JSON object on stdout, besides the usual
+//    text on stderr: {"schema":"pbvbus.run.error/1","error":TEXT,"exit_code":N}. A program
+//    that parses stdout then learns why instead of finding nothing. Bad usage (an unknown
+//    option, --help) is not a run: text only.
 //  - Exit codes: 0 done, 1 the run failed (capture could not be written, a gateway's door could
 //    not open), 2 bad usage or a bad scenario.
 
@@ -42,10 +47,11 @@
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/tools/class2_cli.hpp"
 #include "pbvbus/tools/commands.hpp"
-#include "pbvbus/simulation/report.hpp"
-#include "pbvbus/scenario/scenario.hpp"
-#include "pbvbus/simulation/simulation.hpp"
+#include "pbvbus/reports/json_text.hpp"
 #include "pbvbus/reports/run_report.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/report.hpp"
+#include "pbvbus/simulation/simulation.hpp"
 
 namespace pbvbus::tools {
 
@@ -70,9 +76,16 @@ constexpr const char* kUsage =
     "  --capture FILE    write a pcapng capture; '-' streams it to stdout\n"
     "  --probe WHERE     where the capture listens on lines without a capture entry in the\n"
     "                    scenario: first (default), last, or next to station ADDR\n"
-    "  --json            print the report as JSON (schema pbvbus.run.report/1)\n"
+    "  --json            print the report as JSON (schema pbvbus.run.report/1); a run that\n"
+    "                    cannot start prints {\"schema\":\"pbvbus.run.error/1\",\"error\":...}\n"
     "  --quiet           print nothing but errors (and the --json report)\n"
     "  -h, --help        this text\n";
+
+/// The --json answer of a run that could not start (schema pbvbus.run.error/1).
+void write_json_error(std::ostream& out, const std::string& error, int exit_code) {
+  out << "{\"schema\":\"pbvbus.run.error/1\",\"error\":" << json_quote(error)
+      << ",\"exit_code\":" << exit_code << "}\n";
+}
 
 /// "N" or "N/M", positive integers.
 std::optional<bus::Speed> parse_speed(const std::string& v) {
@@ -258,8 +271,19 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
 
   const LoadResult loaded = ra.scenario ? load_scenario_file(*ra.scenario)
                                         : parse_scenario(default_scenario_text(), "<built-in default>");
+  // Start-up failures: the text on stderr, and with --json the error object on stdout.
+  const auto fail = [&](int rc, const std::string& why) {
+    err << "pbvbus run: " << why << "\n";
+    if (ra.json) write_json_error(out, why, rc);
+    return rc;
+  };
   if (!loaded.ok()) {
-    for (const auto& d : loaded.errors) err << d.str() << "\n";
+    std::string all;
+    for (const auto& d : loaded.errors) {
+      err << d.str() << "\n";
+      all += (all.empty() ? "" : "\n") + d.str();
+    }
+    if (ra.json) write_json_error(out, all, 2);
     return 2;
   }
 
@@ -269,21 +293,13 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     for (const auto& st : l.stations)
       has_serial |= st.kind == StationKind::SerialMonitor || st.kind == StationKind::SerialStation;
   // Gateways are doors to the outside like a pty: paced by default, and only paced.
-  if (!plan.gateways.empty() && ra.fast) {
-    err << "pbvbus run: " << plan.file << " has a gateway: its doors need a paced run (drop --fast)\n";
-    return 2;
-  }
+  if (!plan.gateways.empty() && ra.fast)
+    return fail(2, plan.file + " has a gateway: its doors need a paced run (drop --fast)");
   const bool paced = ra.paced || (!ra.fast && (has_serial || !plan.gateways.empty()));
   const std::optional<bus::Ticks> duration = ra.duration ? ra.duration : plan.duration;
-  if (!duration && !paced) {
-    err << "pbvbus run: " << plan.file
-        << ": the scenario has no duration; add duration: \"5s\" or use --duration\n";
-    return 2;
-  }
-  if (ra.speed && !paced) {
-    err << "pbvbus run: --speed applies to paced runs only (add --paced)\n";
-    return 2;
-  }
+  if (!duration && !paced)
+    return fail(2, plan.file + ": the scenario has no duration; add duration: \"5s\" or use --duration");
+  if (ra.speed && !paced) return fail(2, "--speed applies to paced runs only (add --paced)");
 
   // With the capture on stdout, everything else goes to stderr.
   const bool capture_stdout = ra.capture && *ra.capture == "-";
@@ -292,18 +308,12 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   std::unique_ptr<captures::PcapngWriter> capture;
   if (ra.capture) {
     std::string why;
-    if (!plan_capture_probes(plan, ra.probe.value_or(ProbeDefault{}), &why)) {
-      err << "pbvbus run: " << why << "\n";
-      return 2;
-    }
+    if (!plan_capture_probes(plan, ra.probe.value_or(ProbeDefault{}), &why)) return fail(2, why);
   }
   if (ra.capture) {
     std::string why;
     capture = captures::PcapngWriter::open(*ra.capture, {}, &why);
-    if (!capture) {
-      err << "pbvbus run: cannot write the capture " << *ra.capture << ": " << why << "\n";
-      return 2;
-    }
+    if (!capture) return fail(2, "cannot write the capture " + *ra.capture + ": " + why);
   }
 
   SimulationOptions so;
@@ -315,17 +325,13 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   try {
     sim = std::make_unique<Simulation>(plan, so);
   } catch (const std::exception& e) {
-    err << "pbvbus run: " << e.what() << "\n";
-    return 1;
+    return fail(1, e.what());
   }
   std::unique_ptr<Class2Cli> dp2;
   if (!ra.dp2.empty()) {
     std::string why;
     dp2 = Class2Cli::attach(*sim, ra.dp2, why);
-    if (!dp2) {
-      err << "pbvbus run: " << why << "\n";
-      return 2;
-    }
+    if (!dp2) return fail(2, why);
   }
   // A paced run without a duration goes on until interrupted.
   // (Ten years: far enough, and safe from overflow when the runner scales it to wall time.)
@@ -353,8 +359,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     try {
       runner_ptr = &sim->paced_runner(ra.speed.value_or(bus::Speed{}));
     } catch (const std::exception& e) {
-      err << "pbvbus run: " << e.what() << "\n";
-      return 1;
+      return fail(1, e.what());
     }
     bus::PacedRunner& runner = *runner_ptr;
     if (!ra.quiet)

@@ -27,6 +27,9 @@ struct ModbusDoorStats {
   std::uint64_t clients_accepted = 0;   ///< TCP connections accepted (RTU: 0)
   std::uint64_t clients_now = 0;        ///< open TCP connections
   std::uint64_t clients_closed_bad = 0; ///< closed for a protocol violation, flood or stall
+  std::uint64_t clients_evicted = 0;    ///< closed to make room for a new one (max_clients)
+  std::uint64_t clients_refused = 0;    ///< accepted and closed at once (max_clients is 0)
+  std::uint64_t accept_pauses = 0;      ///< accept() failed (e.g. out of descriptors): paused
   std::uint64_t requests = 0;           ///< well-framed requests handed to the core
   std::uint64_t exceptions = 0;         ///< of their answers, exception responses
   std::uint64_t bad_frames = 0;         ///< dropped: bad MBAP header, bad RTU CRC, overlong

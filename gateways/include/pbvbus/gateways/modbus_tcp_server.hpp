@@ -22,12 +22,21 @@
 //    before the close when the socket takes them at once).
 //  - Responses are queued and written with async_write (first tried at once, non-blocking). A
 //    client that does not read its responses, so that more than `max_output` (64 KiB) waits in
-//    the door, is closed (clients_closed_bad).
+//    the door, is closed (clients_closed_bad). The kernel's share is bounded too: accepted
+//    sockets get SO_SNDBUF 32 KiB (tcp_accept.hpp). Autotuned, Linux took 4.2 MB from a
+//    client that never read (~16000 replies built for nobody) before the door's bound applied.
 //  - A connection with no complete request for `idle_timeout` (60 s wall time; zero = never) is
 //    closed (half-open or stalled clients; clients_closed_bad). Wall time, not virtual time: it
 //    protects the door's resources, not the bus's timing.
-//  - Beyond `max_clients` (32) open connections, a new one is accepted and closed at once:
-//    counted in clients_closed_bad and rejected(), not in clients_accepted.
+//  - At most `max_clients` (32) connections. When a new client comes and the door is full, the
+//    connection that has gone longest without a complete request (or since its connect) is
+//    closed to make room: counted in clients_evicted, logged (throttled). Refusing the new
+//    client instead let 32 idle connections lock every new client out for the idle timeout,
+//    and forever if each sent a request now and then; a Modbus client that is still in use
+//    reconnects, a forgotten one does not, and many Modbus servers evict the same way.
+//    max_clients 0 refuses every client (accepted and closed at once: clients_refused).
+//  - Backlog SOMAXCONN; a failing accept() (out of descriptors) pauses the acceptor and retries
+//    on a timer instead of spinning, logged once per episode (tcp_accept.hpp; accept_pauses).
 //  - The handler returning 0 (no response) for a TCP request: nothing is sent, counted in
 //    no_reply. A response that starts with FC|0x80 counts in exceptions.
 //  - TCP_NODELAY on every connection: Modbus is request/response, Nagle would only add delay.
@@ -43,16 +52,18 @@
 #include <string>
 
 #include "pbvbus/gateways/modbus_handler.hpp"
+#include "pbvbus/gateways/tcp_door_limits.hpp"
 
 namespace pbvbus::gateways {
 
 struct ModbusTcpOptions {
   std::string address = "127.0.0.1";  ///< listen address (loopback unless told otherwise)
   std::uint16_t port = 502;           ///< 0 = an ephemeral port (see port())
-  std::size_t max_clients = 32;
+  std::size_t max_clients = kDefaultMaxClients;  ///< beyond: the longest-idle one is evicted
   std::size_t max_requests_per_turn = 16;
   std::size_t max_output = 64 * 1024;              ///< octets of unsent responses per connection
   std::chrono::milliseconds idle_timeout{60'000};  ///< zero = never
+  DoorLog log{};  ///< evictions, accept() failures (empty: none)
 };
 
 class ModbusTcpServer {
@@ -67,7 +78,8 @@ class ModbusTcpServer {
   /// The port listened on (the ephemeral one when the options said 0).
   std::uint16_t port() const;
   const ModbusDoorStats& stats() const;
-  /// Connections refused because max_clients were open.
+  /// Connections refused at once (stats().clients_refused; only with max_clients 0: a full
+  /// door evicts instead).
   std::uint64_t rejected() const;
   /// Closes the acceptor and every connection. Idempotent.
   void close();

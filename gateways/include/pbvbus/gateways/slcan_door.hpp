@@ -21,6 +21,12 @@
 //    autotuning, Linux buffers megabytes for a stalled loopback client (measured: 2.8 MB),
 //    stale frames the client would read long after, before the door's bound applies.
 //  - A write error (the peer is gone) closes a TCP connection; a read of 0 or an error too.
+//  - At most Options::max_clients TCP connections at once (the pty is not counted): one more is
+//    accepted and closed at once, counted in Stats::refused and logged (throttled). Refused,
+//    not evicting an idle one as the Modbus door does: a CAN client that only listens
+//    (can_logger, candump through slcand) is idle by nature and must not be thrown out.
+//  - A failing accept() (out of descriptors) pauses the listener and retries on a timer instead
+//    of spinning; logged once per episode (tcp_accept.hpp).
 //  - open() returns an error text instead of throwing (no pty support, port in use, ...).
 //  - The door must be destroyed (or closed) before the runner whose io_context it uses.
 
@@ -32,6 +38,7 @@
 
 #include "pbvbus/gateways/can_frame.hpp"
 #include "pbvbus/gateways/slcan.hpp"
+#include "pbvbus/gateways/tcp_door_limits.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;
@@ -46,6 +53,8 @@ struct SlcanDoorOptions {
   std::string tcp_address = "127.0.0.1";  ///< loopback unless told otherwise
   std::uint16_t tcp_port = 0;         ///< 0 = an ephemeral port (see port())
   std::size_t max_output = 64 * 1024; ///< per-connection queue bound, octets
+  std::size_t max_clients = kDefaultMaxClients;  ///< TCP connections at once (the pty aside)
+  DoorLog log{};                      ///< refused clients, accept() failures (empty: none)
   std::string serial = "PBV1";        ///< `N` reply (4 characters)
   std::string name = "slcan";         ///< hub port names: NAME:pty, NAME:tcp:N
 };
@@ -62,6 +71,8 @@ class SlcanDoor {
     std::uint64_t errors = 0;          ///< lines answered '\a'
     std::uint64_t overlong = 0;        ///< of those, overlong lines
     std::uint64_t dropped = 0;         ///< frames/replies dropped: a client's queue was full
+    std::uint64_t refused = 0;         ///< TCP connections refused: max_clients were open
+    std::uint64_t accept_pauses = 0;   ///< accept() failed (e.g. out of descriptors): paused
   };
 
   SlcanDoor(bus::PacedRunner& runner, CanHub& hub, Options options = {});
@@ -86,6 +97,7 @@ class SlcanDoor {
   struct Listener;  // door_stream::TcpListener
 
   std::shared_ptr<Link> add_link(int fd, bool is_socket, std::string name);
+  bool accept_tcp(int fd, std::uint64_t n);
   void on_bytes(Link& l, const std::string& bytes, bus::Ticks now);
   void on_hub_frame(Link& l, const CanFrame& f, bus::Ticks now);
   void emit(Link& l, std::string_view s, bool frame);

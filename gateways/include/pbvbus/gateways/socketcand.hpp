@@ -12,7 +12,9 @@
 //    same garbage run or overlong element count as one more error, so an endless stream of
 //    garbage is closed too: after kMaxConsecutiveErrors errors in a row with no valid command
 //    between them, wants_close() turns true and the door closes the connection. An element
-//    that parses but is not a valid command is an error too (counted in the same row).
+//    that parses but is not a valid command is an error too (counted in the same row). The rule
+//    holds at every error, whatever the read boundaries: once wants_close() is true, feed()
+//    reads nothing more, so the client gets exactly kMaxConsecutiveErrors error answers.
 //  - States: greeted (after `< hi >`) → `< open CHANNEL >` → BCM mode → `< rawmode >` → raw
 //    mode. `open` with another channel name than the door's is an error. Frames from the bus go
 //    to the client only in raw mode.
@@ -99,7 +101,8 @@ class SocketcandSession {
   /// What the door sends on connect.
   static std::string greeting() { return std::string(kHi); }
   /// Feeds bytes from the client. Each reply element is appended to `replies` as its own
-  /// string (the door may need to send `< ok >` alone); frames to send to `to_bus`.
+  /// string (the door may need to send `< ok >` alone); frames to send to `to_bus`. Stops at
+  /// the error that makes wants_close() true; ignores everything once it is.
   void feed(std::string_view bytes, std::vector<std::string>& replies,
             std::vector<CanFrame>& to_bus);
   Mode mode() const { return m_mode; }

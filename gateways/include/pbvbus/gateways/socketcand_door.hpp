@@ -19,6 +19,12 @@
 //    buffer fixed at 32 KiB): beyond it frames are dropped and counted, never blocking the bus.
 //  - Garbage and overlong elements are answered `< error ... >`; after
 //    socketcand::kMaxConsecutiveErrors errors in a row the connection is closed (counted).
+//  - At most Options::max_clients connections at once: one more is accepted and closed at once
+//    (before `< hi >`), counted in Stats::refused and logged (throttled). Refused, not evicting
+//    an idle one as the Modbus door does: a client that only listens (can_logger) is idle by
+//    nature and must not be thrown out.
+//  - A failing accept() (out of descriptors) pauses the listener and retries on a timer instead
+//    of spinning; logged once per episode (tcp_accept.hpp).
 //  - open() returns an error text instead of throwing. Destroy (or close) the door before the
 //    runner whose io_context it uses.
 
@@ -31,6 +37,7 @@
 
 #include "pbvbus/gateways/can_frame.hpp"
 #include "pbvbus/gateways/socketcand.hpp"
+#include "pbvbus/gateways/tcp_door_limits.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;
@@ -43,6 +50,8 @@ struct SocketcandDoorOptions {
   std::uint16_t port = socketcand::kDefaultPort;  ///< 0 = an ephemeral port (see port())
   std::string channel = "can0";                 ///< the bus name `< open NAME >` must give
   std::size_t max_output = 64 * 1024;           ///< per-connection queue bound, octets
+  std::size_t max_clients = kDefaultMaxClients; ///< connections at once
+  DoorLog log{};                                ///< refused clients, accept() failures
   std::chrono::milliseconds raw_hold{100};      ///< frames held after the rawmode `< ok >`
   std::string name = "socketcand";              ///< hub port names: NAME:N
 };
@@ -59,6 +68,8 @@ class SocketcandDoor {
     std::uint64_t frames_out = 0;     ///< frames queued to clients
     std::uint64_t errors = 0;         ///< `< error >` answers
     std::uint64_t dropped = 0;        ///< frames/replies dropped: a client's queue was full
+    std::uint64_t refused = 0;        ///< connections refused: max_clients were open
+    std::uint64_t accept_pauses = 0;  ///< accept() failed (e.g. out of descriptors): paused
   };
 
   SocketcandDoor(bus::PacedRunner& runner, CanHub& hub, Options options = {});
@@ -82,7 +93,7 @@ class SocketcandDoor {
   void on_hub_frame(Link& l, const CanFrame& f, bus::Ticks now);
   void emit(Link& l, std::string_view s, bool frame);
   void release_hold(Link& l);
-  void add_link(int fd, std::uint64_t n);
+  bool accept_link(int fd, std::uint64_t n);
   void drop_link(Link& l);
 
   bus::PacedRunner& m_runner;

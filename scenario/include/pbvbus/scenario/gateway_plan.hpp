@@ -77,7 +77,9 @@ struct GwCan {
   bus::Ticks heartbeat = 1000 * bus::kTicksPerMs;
   std::optional<std::string> slcan_pty;  ///< present: an SLCAN pty; the string is its link ("" none)
   std::optional<GwEndpoint> slcan_tcp;
+  std::uint32_t slcan_max_clients = 0;  ///< 0 = the door's default
   std::optional<GwEndpoint> socketcand;
+  std::uint32_t socketcand_max_clients = 0;  ///< 0 = the door's default
   std::optional<std::string> socketcan;  ///< interface name
 };
 

@@ -21,6 +21,10 @@
 //                  "clients": int,              // connections now
 //                  "clients_total": int,        // connections accepted in the run
 //                  "clients_closed_bad": int,   // closed for a violation, flood or stall
+//                  "clients_refused": int,      // TCP: closed at once, the door was full
+//                                               // (CAN doors; Modbus only with max_clients 0)
+//                  "clients_evicted": int,      // Modbus TCP: closed to make room (longest idle)
+//                  "accept_pauses": int,        // TCP: accept() failed (out of descriptors)
 //                  "requests","exceptions": int,   // Modbus: well-framed requests, exception answers
 //                  "bad_frames": int,           // Modbus: bad MBAP header / bad CRC / overlong
 //                  "frames_in","frames_out": int,  // CAN: onto the segment / to clients
@@ -43,6 +47,9 @@ struct GatewayDoorReport {
   std::uint64_t clients = 0;
   std::uint64_t clients_total = 0;
   std::uint64_t clients_closed_bad = 0;
+  std::uint64_t clients_refused = 0;
+  std::uint64_t clients_evicted = 0;
+  std::uint64_t accept_pauses = 0;
   std::uint64_t requests = 0;
   std::uint64_t exceptions = 0;
   std::uint64_t bad_frames = 0;

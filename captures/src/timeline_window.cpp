@@ -52,10 +52,12 @@ PageWindow page_window(const Timeline& whole, std::optional<std::int64_t> from,
 
 std::string page_window_note(const Timeline& whole, const PageWindow& w, std::uint64_t max_frames) {
   if (!w.cut) return {};
-  return "This page holds " + seconds(w.from_ns) + " \u2013 " + seconds(w.to_ns) + " of the capture (" +
-         seconds(whole.from_ns) + " \u2013 " + seconds(whole.to_ns) + "): " + std::to_string(w.frames) +
-         " of " + std::to_string(w.total_frames) + " frames (--max-frames " + std::to_string(max_frames) +
-         "). Use --from/--to for another stretch, --max-frames 0 for all.";
+  return "This page holds the frames of " + seconds(w.from_ns) + " \u2013 " + seconds(w.to_ns) +
+         " only (the capture: " + seconds(whole.from_ns) + " \u2013 " + seconds(whole.to_ns) + "): " +
+         std::to_string(w.frames) + " of " + std::to_string(w.total_frames) + " frames (--max-frames " +
+         std::to_string(max_frames) +
+         "); events and the rows below the lanes cover the whole capture. Use --from/--to for another "
+         "stretch, --max-frames 0 for all.";
 }
 
 }  // namespace pbvbus::captures

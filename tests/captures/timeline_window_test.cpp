@@ -63,8 +63,9 @@ TEST(TimelineWindow, FirstFramesFromTheStartOverAllLanes) {
   EXPECT_EQ(w.frames, 4u);
   EXPECT_EQ(w.total_frames, 15u);
   EXPECT_EQ(page_window_note(tl, w, 4),
-            "This page holds 0.001000 s \u2013 0.001400 s of the capture (0.001000 s \u2013 0.002822 s): "
-            "4 of 15 frames (--max-frames 4). Use --from/--to for another stretch, --max-frames 0 for all.");
+            "This page holds the frames of 0.001000 s \u2013 0.001400 s only (the capture: 0.001000 s \u2013 "
+            "0.002822 s): 4 of 15 frames (--max-frames 4); events and the rows below the lanes cover the "
+            "whole capture. Use --from/--to for another stretch, --max-frames 0 for all.");
   // The page of that window: its frames are exactly those four, and it carries the note.
   TimelineOptions wo;
   wo.from_ns = w.from_ns;
@@ -78,7 +79,8 @@ TEST(TimelineWindow, FirstFramesFromTheStartOverAllLanes) {
   TimelineHtmlOptions ho;
   ho.note = page_window_note(tl, w, 4);
   const std::string page = to_html(part, ho);
-  EXPECT_NE(page.find("<p id=\"note\" class=\"note\"><strong>This page holds 0.001000 s"), std::string::npos);
+  EXPECT_NE(page.find("<p id=\"note\" class=\"note\"><strong>This page holds the frames of 0.001000 s"),
+            std::string::npos);
   EXPECT_NE(page.find("2 lanes \u00b7 4 frames"), std::string::npos);
   EXPECT_EQ(to_html(tl).find("id=\"note\""), std::string::npos);
 }

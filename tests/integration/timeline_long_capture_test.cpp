@@ -1,7 +1,7 @@
 // `pbvbus timeline` on a long capture (captures/timeline_window.hpp): the 10 s of
-// examples/switched-io.textproto (two lines at 1.5 Mbit/s) made a 4.4 MB page; by default the
-// page now holds a window of at most 25000 frames and says so, --max-frames 0 gives everything,
-// and --from chooses where the window starts.
+// examples/switched-io.textproto (two lines at 1.5 Mbit/s, 177044 frames) made a 4.4 MB page; by
+// default the page now holds the frames of a window of at most 50000 frames and says so,
+// --max-frames 0 gives everything, and --from chooses where the window starts.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -33,6 +33,13 @@ long frames_in_page(const std::string& page) {
   return std::stol(m[1]);
 }
 
+// The header line after the frame count: "N events · FROM – TO".
+std::string overview(const std::string& page) {
+  std::smatch m;
+  static const std::regex re(" frames \xC2\xB7 ([0-9]+ events \xC2\xB7 [^<]*)<");
+  return std::regex_search(page, m, re) ? m[1].str() : std::string();
+}
+
 class TimelineLongCapture : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -58,21 +65,29 @@ TEST_F(TimelineLongCapture, DefaultPageIsBoundedAndSaysWhatItLeavesOut) {
   std::ostringstream out, err;
   ASSERT_EQ(cmd_timeline({capture(), "-o", path("default.html")}, out, err), 0) << err.str();
   const std::string page = read(path("default.html"));
-  // At most 25000 frames: about 0.7 MB instead of 4.4 MB.
-  EXPECT_LT(page.size(), 1'500'000u);
+  // At most 50000 frames: about 1.5 MB instead of 4.4 MB.
+  EXPECT_LT(page.size(), 1'800'000u);
   const long frames = frames_in_page(page);
-  EXPECT_GT(frames, 24'000);
-  EXPECT_LE(frames, 25'000);
+  EXPECT_GT(frames, 49'000);
+  EXPECT_LE(frames, 50'000);
   // The note, in the page and on stderr: from the start of the capture, N of M frames.
-  const std::regex note("This page holds 0\\.000000 s \xE2\x80\x93 ([0-9.]+) s of the capture \\(0\\.000000 s "
-                        "\xE2\x80\x93 [0-9]+\\.[0-9]+ s\\): ([0-9]+) of ([0-9]+) frames \\(--max-frames 25000\\)\\. "
+  const std::regex note("This page holds the frames of 0\\.000000 s \xE2\x80\x93 ([0-9.]+) s only \\(the "
+                        "capture: 0\\.000000 s \xE2\x80\x93 [0-9]+\\.[0-9]+ s\\): ([0-9]+) of ([0-9]+) frames "
+                        "\\(--max-frames 50000\\); events and the rows below the lanes cover the whole capture\\. "
                         "Use --from/--to for another stretch, --max-frames 0 for all\\.");
   std::smatch m;
   const std::string e = err.str();
   ASSERT_TRUE(std::regex_search(e, m, note)) << e;
   EXPECT_EQ(std::stol(m[2]), frames);
-  EXPECT_GT(std::stol(m[3]), 100'000);  // 10 s of two lines: far more than the page holds
-  EXPECT_NE(page.find("<p id=\"note\" class=\"note\"><strong>This page holds 0.000000 s"), std::string::npos);
+  EXPECT_EQ(std::stol(m[3]), 177'044);  // 10 s of two lines at 1.5 Mbit/s
+  EXPECT_NE(page.find("<p id=\"note\" class=\"note\"><strong>This page holds the frames of 0.000000 s"),
+            std::string::npos);
+  // The overview stays whole: the same events and the same span as the page of everything (the
+  // fault script runs to 9 s, long after the window).
+  std::ostringstream out2, err2;
+  ASSERT_EQ(cmd_timeline({capture(), "-o", path("whole.html"), "--max-frames", "0"}, out2, err2), 0);
+  EXPECT_EQ(overview(page), overview(read(path("whole.html"))));
+  EXPECT_NE(overview(page), "");
 }
 
 TEST_F(TimelineLongCapture, MaxFramesZeroHoldsEverythingAndFromChoosesTheWindow) {
@@ -91,7 +106,8 @@ TEST_F(TimelineLongCapture, MaxFramesZeroHoldsEverythingAndFromChoosesTheWindow)
   EXPECT_LE(frames_in_page(w), 2000);
   EXPECT_GT(frames_in_page(w), 1900);
   EXPECT_LT(w.size(), 250'000u);
-  EXPECT_NE(err2.str().find("This page holds 5.000000 s \xE2\x80\x93 5."), std::string::npos) << err2.str();
+  EXPECT_NE(err2.str().find("This page holds the frames of 5.000000 s \xE2\x80\x93 5."), std::string::npos)
+      << err2.str();
 
   std::ostringstream out3, err3;
   EXPECT_EQ(cmd_timeline({capture(), "--max-frames", "x"}, out3, err3), 2);

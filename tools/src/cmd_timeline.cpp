@@ -9,15 +9,15 @@
 //  - HTML carries the whole capture and opens at --from/--to (so one can zoom out of the
 //    window); SVG is a picture of exactly the window.
 //  - Except for a long capture: an HTML page holds at most --max-frames frames (default
-//    captures::kDefaultMaxPageFrames, 0 = no limit), a window starting at --from
-//    (captures/timeline_window.hpp); the page and stderr say what was left out, exit 0.
+//    captures::kDefaultMaxPageFrames, 0 = no limit): the frames of a window starting at --from,
+//    with the events and rows of the whole capture (captures/timeline_window.hpp); the page and
+//    stderr say what was left out, exit 0.
 //  - T is a duration with a unit (2s, 1500ms, 250us, 100ns, 1.25s), measured on the capture's
 //    own clock (virtual time since the start of the run for pbvbus captures).
 //  - Bad input (no pcapng, truncated, empty, no line interface, --from not before --to, a bad
 //    duration) prints one line "pbvbus timeline: ..." on stderr, nothing on stdout and no
 //    output file, exit 2.
 
-#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <filesystem>
@@ -51,7 +51,7 @@ constexpr const char* kUsage =
     "                     default the whole capture. The HTML holds the whole capture and\n"
     "                     opens at the window.\n"
     "  --max-frames N     HTML of a longer capture: hold only a window of at most N frames\n"
-    "                     from --from on (default 25000, about 0.7 MB; 0: everything); the\n"
+    "                     from --from on (default 50000, about 1.5 MB; 0: everything); the\n"
     "                     page and stderr say what was left out.\n"
     "  --help             this text\n"
     "\n"
@@ -167,18 +167,24 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
     ho.title = base_name(path);
     const captures::PageWindow pw = captures::page_window(*tl, from, to, max_frames);
     if (pw.cut) {
-      // A long capture: the page holds the window only (its view clipped to it).
+      // A long capture: the frames of the window only; the overview (events, active channels,
+      // CPU rows) and the page's span stay whole (timeline_window.hpp).
       ho.note = captures::page_window_note(*tl, pw, max_frames);
       captures::TimelineOptions wo;
       wo.from_ns = pw.from_ns;
       wo.to_ns = pw.to_ns;
-      tl = captures::read_timeline_file(path, wo, error);
-      if (!tl) {
+      auto part = captures::read_timeline_file(path, wo, error);
+      if (!part) {
         err << "pbvbus timeline: " << path << ": " << error << "\n";
         return 2;
       }
-      if (from) from = std::max(*from, pw.from_ns);
-      if (to) to = std::min(*to, pw.to_ns);
+      part->from_ns = tl->from_ns;
+      part->to_ns = tl->to_ns;
+      part->events = std::move(tl->events);
+      part->active_channels = std::move(tl->active_channels);
+      part->cpu_states = std::move(tl->cpu_states);
+      part->cpu_obs = std::move(tl->cpu_obs);
+      tl = std::move(part);
       err << "pbvbus timeline: " << ho.note << "\n";
     }
     ho.view_from_ns = from;

@@ -16,9 +16,13 @@
 //    --from/--to choose the stretch and the limit bounds the page; frames starting at the same
 //    instant as the first one left out are left out too (at most max_frames, never one more).
 //    The window is never empty: it is at least 1 ns long.
-//  - Everything else of the page comes from that window too (token spans, polls, events, active
-//    channels, CPU rows); cycle times and token holders are still worked out on the whole
-//    capture (timeline.hpp), so they are the same as in a page of everything.
+//  - Only what comes with the frames is cut to the window: frames, token spans, DP polls (cycle
+//    times and token holders are still worked out on the whole capture, timeline.hpp, so they
+//    are the same as in a page of everything). The events, the active channels and the CPU rows
+//    of the whole capture stay, and the page spans the whole capture: they are few, and they are
+//    the overview a reader of a long run looks at first to find the stretch worth the frames.
+//    So the first view without --from/--to is still the whole run, with frames in the window
+//    only.
 //  - What was left out is said in the page (a note under the header) and by the command on
 //    stderr: the window, how many of how many frames it holds, and how to get another window or
 //    everything (page_window_note()).
@@ -31,9 +35,10 @@
 
 namespace pbvbus::captures {
 
-/// The default of `pbvbus timeline --max-frames`: a page of about 0.7 MB (730 kB for the
-/// switched-io example's first 1.3 s).
-inline constexpr std::uint64_t kDefaultMaxPageFrames = 25000;
+/// The default of `pbvbus timeline --max-frames`: a page of about 1.5 MB (25000 frames of the
+/// switched-io example made 735 kB). The 4 s multimaster capture of the README (29314 frames)
+/// stays whole; the 10 s of switched-io (177044 frames) do not.
+inline constexpr std::uint64_t kDefaultMaxPageFrames = 50000;
 
 struct PageWindow {
   std::int64_t from_ns = 0;  ///< the window the page holds, [from_ns, to_ns)
@@ -49,8 +54,9 @@ PageWindow page_window(const Timeline& whole, std::optional<std::int64_t> from,
                        std::optional<std::int64_t> to, std::uint64_t max_frames);
 
 /// One line saying what the page leaves out ("" when it holds everything), e.g. "This page holds
-/// 0.000000 s – 0.532170 s of the capture (0.000000 s – 10.000000 s): 25000 of 412345 frames
-/// (--max-frames 25000). Use --from/--to for another stretch, --max-frames 0 for all."
+/// the frames of 0.000000 s – 1.332524 s only (the capture: 0.000000 s – 9.999939 s): 25000 of
+/// 177044 frames (--max-frames 25000); events and the rows below the lanes cover the whole
+/// capture. Use --from/--to for another stretch, --max-frames 0 for all."
 std::string page_window_note(const Timeline& whole, const PageWindow& w, std::uint64_t max_frames);
 
 }  // namespace pbvbus::captures

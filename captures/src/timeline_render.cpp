@@ -946,7 +946,9 @@ std::string to_html(const Timeline& tl, const TimelineHtmlOptions& opts) {
   o += xml(title);
   o += "</span></h1>\n<div id=\"info\">";
   o += xml(info);
-  o += "</div>\n<div class=\"bar\"><span class=\"controls\">"
+  o += "</div>\n";
+  if (!opts.note.empty()) o += "<p id=\"note\" class=\"note\"><strong>" + xml(opts.note) + "</strong></p>\n";
+  o += "<div class=\"bar\"><span class=\"controls\">"
        "<button data-act=\"out\" title=\"zoom out (-)\">\u2212</button>"
        "<button data-act=\"in\" title=\"zoom in (+)\">+</button>"
        "<button data-act=\"left\" title=\"pan left (\u2190)\">\u25c0</button>"

@@ -17,6 +17,10 @@
 //   refuses a Set_Prm whose User_Prm_Data is led by DPV1_Status `80 00 00` (Prm_Fault).
 // - Sync/Freeze: Set_Prm with Sync_Req (Freeze_Req) is accepted when the GSD supports it and
 //   answered with Not_Supported when it does not.
+// - Min_Slave_Intervall (GSD-08) is judged on the file alone: PI 2.122 makes it mandatory for a
+//   DP slave and IEC 61158-6 gives Min_Slave_Interval the range 1..65535 (x 100 us; protocol-facts
+//   §C.2, §I.2). A missing keyword or 0 is a fault of the description, not of the device's timing:
+//   TIM-02 then runs with the smallest legal value (group_timing.cpp).
 
 #include <algorithm>
 #include <string>
@@ -228,6 +232,21 @@ void sync_freeze(TestContext& ctx, TestResult& res) {
   run.pass(msg + ", as the GSD says");
 }
 
+void min_slave_intervall_stated(TestContext& ctx, TestResult& res) {
+  const auto& gsd = *ctx.spec().gsd;
+  const std::uint16_t msi = gsd.slave_features().min_slave_intervall;
+  res.verdict = Verdict::Fail;
+  if (msi == 0) {
+    // keywords() keeps the spelling as written; the reader also takes the one-l misspelling.
+    const bool written = gsd.keyword("Min_Slave_Intervall") || gsd.keyword("Min_Slave_Interval");
+    res.message = written ? "the GSD gives Min_Slave_Intervall = 0, outside 1..65535 (x 100 us)"
+                          : "the GSD lacks the mandatory Min_Slave_Intervall";
+    return;
+  }
+  res.verdict = Verdict::Pass;
+  res.message = "Min_Slave_Intervall = " + std::to_string(msi) + " (" + std::to_string(msi * 100) + " us)";
+}
+
 }  // namespace
 
 void add_gsd_tests(std::vector<TestCase>& out) {
@@ -269,6 +288,12 @@ void add_gsd_tests(std::vector<TestCase>& out) {
       "Freeze_Mode_supp = 1 and answered with Not_Supported otherwise (PI 2.122; protocol-facts.md "
       "§D.6, §D.4)",
       {}, sync_freeze));
+  out.push_back(make_case(
+      "GSD-08", kGroup, "Min_Slave_Intervall stated",
+      "The GSD of a DP slave states the mandatory Min_Slave_Intervall, 1..65535 x 100 us, the "
+      "shortest time a master may leave between two polls of the slave (PI 2.122 "
+      "Min_Slave_Intervall; IEC 61158-6 Min_Slave_Interval; protocol-facts.md §C.2, §I.2)",
+      {}, min_slave_intervall_stated));
 }
 
 }  // namespace pbvbus::conformance::detail

@@ -12,8 +12,9 @@ TEST(GroupGsd, PassesOnEveryShippedModel) {
   for (Shipped s : kAllShipped) {
     SCOPED_TRACE(shipped_name(s));
     const auto r = run_only(shipped(s), "GSD");
-    ASSERT_EQ(r.results.size(), 7u) << describe(r);
-    for (const char* id : {"GSD-01", "GSD-02", "GSD-03", "GSD-04", "GSD-05", "GSD-06", "GSD-07"})
+    ASSERT_EQ(r.results.size(), 8u) << describe(r);
+    for (const char* id :
+         {"GSD-01", "GSD-02", "GSD-03", "GSD-04", "GSD-05", "GSD-06", "GSD-07", "GSD-08"})
       EXPECT_EQ(verdict_of(r, id), Verdict::Pass) << id << describe(r);
   }
 }
@@ -64,6 +65,52 @@ TEST(GroupGsd, UnsupportedFreezeMustGiveNotSupported) {
   ASSERT_NE(t, nullptr);
   EXPECT_EQ(t->verdict, Verdict::Pass) << t->message;
   EXPECT_NE(t->message.find("Freeze_Req Not_Supported"), std::string::npos) << t->message;
+}
+
+TEST(GroupGsd, MinSlaveIntervallStated) {
+  // PBVB0A01 writes Min_Slave_Intervall = 1: 100 us.
+  const auto r = run_only(shipped(Shipped::A01), "GSD-08");
+  const TestResult* t = find_result(r, "GSD-08");
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->verdict, Verdict::Pass);
+  EXPECT_EQ(t->message, "Min_Slave_Intervall = 1 (100 us)");
+  EXPECT_TRUE(t->evidence.empty());  // judged on the file, no telegram
+}
+
+TEST(GroupGsd, MissingMinSlaveIntervallIsAGsdFaultNotATimingFault) {
+  // The keyword removed: GSD-08 fails with the reason, TIM-02 runs with the smallest legal value
+  // (1 = 100 us) and passes on the model, since the slave answers every poll.
+  auto gsd = shipped_gsd_with("PBVB0A01.gsd", "Min_Slave_Intervall     = 1", "");
+  ASSERT_NE(gsd, nullptr);
+  ASSERT_EQ(gsd->slave_features().min_slave_intervall, 0);
+  const auto r = run_only(shipped(Shipped::A01, std::nullopt, gsd), "GSD-08");
+  const TestResult* g = find_result(r, "GSD-08");
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(g->verdict, Verdict::Fail);
+  EXPECT_EQ(g->group, "GSD");
+  EXPECT_EQ(g->message, "the GSD lacks the mandatory Min_Slave_Intervall");
+
+  const auto tr = run_only(shipped(Shipped::A01, std::nullopt, gsd), "TIM-02");
+  const TestResult* t = find_result(tr, "TIM-02");
+  ASSERT_NE(t, nullptr);
+  ASSERT_EQ(t->verdict, Verdict::Pass) << t->message;
+  // 100 us = 150 bit times at 1.5 Mbit/s is shorter than one message cycle (286 bit times, see
+  // group_timing_test.cpp), so the polls come one message cycle apart: 286 bits = 190.67 us.
+  EXPECT_EQ(t->message,
+            "20 Data_Exchanges answered, request starts 190..190 us apart (Min_Slave_Intervall 100 us); "
+            "one message cycle is longer than Min_Slave_Intervall at this baud; the GSD states no "
+            "Min_Slave_Intervall (GSD-08), so the smallest legal value 1 (100 us) was used");
+  // The slow-interval mutant still fails TIM-02 at that spacing (it needs 10 x 100 us).
+  const auto m = run_only(shipped(Shipped::A01, SlaveMutant::SlowSlaveInterval, gsd), "TIM-02");
+  EXPECT_EQ(verdict_of(m, "TIM-02"), Verdict::Fail) << describe(m);
+
+  // Written as 0: outside the standard's range 1..65535, same verdict, its own reason.
+  auto zero = shipped_gsd_with("PBVB0A01.gsd", "Min_Slave_Intervall     = 1", "Min_Slave_Intervall     = 0");
+  ASSERT_NE(zero, nullptr);
+  const auto z = run_only(shipped(Shipped::A01, std::nullopt, zero), "GSD-08");
+  ASSERT_NE(find_result(z, "GSD-08"), nullptr);
+  EXPECT_EQ(find_result(z, "GSD-08")->verdict, Verdict::Fail);
+  EXPECT_EQ(find_result(z, "GSD-08")->message, "the GSD gives Min_Slave_Intervall = 0, outside 1..65535 (x 100 us)");
 }
 
 }  // namespace

@@ -324,7 +324,7 @@ TEST_F(CmdTimeline, BadInputExits2) {
 TEST_F(CmdTimeline, Help) {
   const Result r = timeline({"--help"});
   EXPECT_EQ(r.rc, 0);
-  EXPECT_EQ(r.out.rfind("usage: pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T]\n", 0), 0u);
+  EXPECT_EQ(r.out.rfind("usage: pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T] [--max-frames N]\n", 0), 0u);
 }
 
 }  // namespace

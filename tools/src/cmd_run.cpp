@@ -10,15 +10,17 @@
 //  - `--probe first|last|ADDR` places the capture's probe on lines the scenario gives no
 //    `capture` entry (capture_probes.hpp); it needs --capture, and ADDR must be a station of
 //    every such line (exit 2 otherwise).
-//  - --quiet prints nothing but errors and the --json report.
+//  - --quiet turns off the progress line only (README "Long runs on a terminal show a progress
+//    line"): the report, warnings, the pty paths and the doors' addresses still print, since a
+//    script that asks for no progress still wants the result and where to connect.
 //  - A paced run without a duration (none in the scenario, no --duration) runs until SIGINT or
 //    SIGTERM; either signal ends any run early, and the report covers the time run so far.
 //  - Progress (virtual time, speed ratio, frames, error frames) goes to stderr only when stderr
-//    is a terminal, --quiet is not given, and the run
-//    has taken more than a second of wall time; it is erased before the report.
+//    is a terminal, --quiet is not given, and the run has taken more than a second of wall
+//    time; it is erased before the report.
 //  - A scenario with a gateway runs paced (its doors face programs in real time); --fast is
-//    refused for it. The doors print where they listen (the port an ephemeral one got) unless
-//    --quiet; a door that cannot open ends the run with exit 1 before it starts.
+//    refused for it. The doors print where they listen (the port an ephemeral one got); a door
+//    that cannot open ends the run with exit 1 before it starts.
 //  - With --json, a run that cannot start (a bad scenario, a door's port in use, a link path
 //    that is a regular file, ...) still prints one JSON object on stdout, besides the usual
 //    text on stderr: {"schema":"pbvbus.run.error/1","error":TEXT,"exit_code":N}. A program
@@ -78,7 +80,7 @@ constexpr const char* kUsage =
     "                    scenario: first (default), last, or next to station ADDR\n"
     "  --json            print the report as JSON (schema pbvbus.run.report/1); a run that\n"
     "                    cannot start prints {\"schema\":\"pbvbus.run.error/1\",\"error\":...}\n"
-    "  --quiet           print nothing but errors (and the --json report)\n"
+    "  --quiet, -q       no progress line on the terminal (the report still prints)\n"
     "  -h, --help        this text\n";
 
 /// The --json answer of a run that could not start (schema pbvbus.run.error/1).
@@ -337,16 +339,14 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   // (Ten years: far enough, and safe from overflow when the runner scales it to wall time.)
   const bus::Ticks end = duration ? *duration : 10 * 365 * 24 * 3600 * bus::kTicksPerSecond;
 
-  if (!ra.quiet) {
-    for (const auto& sp : sim->serial_ports()) {
-      err << "serial " << sp.mode << " on line " << sp.line << ": " << sp.path;
-      if (!sp.link.empty()) err << " (" << sp.link << ")";
-      err << "\n";
-    }
-    if (ra.fast && has_serial)
-      err << "pbvbus run: warning: --fast with serial attachments: the bus runs faster than real "
-             "time\n";
+  for (const auto& sp : sim->serial_ports()) {
+    err << "serial " << sp.mode << " on line " << sp.line << ": " << sp.path;
+    if (!sp.link.empty()) err << " (" << sp.link << ")";
+    err << "\n";
   }
+  if (ra.fast && has_serial)
+    err << "pbvbus run: warning: --fast with serial attachments: the bus runs faster than real "
+           "time\n";
 
   const bool show_progress = !ra.quiet && &err == &std::cerr && ::isatty(STDERR_FILENO) == 1;
   Progress progress(err, show_progress, duration.value_or(0), *sim);
@@ -362,9 +362,8 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
       return fail(1, e.what());
     }
     bus::PacedRunner& runner = *runner_ptr;
-    if (!ra.quiet)
-      for (std::size_t i = 0; i < sim->gateway_count(); ++i)
-        for (const std::string& line : sim->gateway(i).door_lines()) err << line << "\n";
+    for (std::size_t i = 0; i < sim->gateway_count(); ++i)
+      for (const std::string& line : sim->gateway(i).door_lines()) err << line << "\n";
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {
       if (!ec) {
@@ -373,7 +372,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
       }
     });
     // Said only once SIGINT is handled, so that whoever waits for it may send one.
-    if (!duration && !ra.quiet) err << "pbvbus run: running until interrupted (Ctrl-C)\n";
+    if (!duration) err << "pbvbus run: running until interrupted (Ctrl-C)\n";
     ProgressTick tick(sim->scheduler(), progress);
     tick.arm();
     runner.run_until(end);
@@ -395,7 +394,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
   }
   progress.clear();
   const double wall = progress.elapsed();
-  if (g_interrupted && !ra.quiet)
+  if (g_interrupted)
     err << "pbvbus run: interrupted at " << bus::format_duration(sim->scheduler().now()) << "\n";
 
   int rc = 0;
@@ -413,7 +412,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     std::string j = js.str();
     if (dp2) dp2->add_to_json(j);
     out << j;
-  } else if (!ra.quiet) {
+  } else {
     write_text(report, report_os);
     if (dp2) dp2->write_text(report_os);
   }

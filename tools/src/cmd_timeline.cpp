@@ -1,4 +1,4 @@
-// `pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T]`: a picture of the bus
+// `pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T] [--max-frames N]`: a picture of the bus
 // (issue 6): lanes of frames, token holders, DP cycles and events of a pcapng capture, as a
 // self-contained interactive HTML page or a static SVG. The model is captures/timeline.hpp, the
 // drawings captures/timeline_render.hpp; this file is only the command line around them.
@@ -8,12 +8,18 @@
 //    HTML goes to stdout. Another extension is a usage error rather than a guess.
 //  - HTML carries the whole capture and opens at --from/--to (so one can zoom out of the
 //    window); SVG is a picture of exactly the window.
+//  - Except for a long capture: an HTML page holds at most --max-frames frames (default
+//    captures::kDefaultMaxPageFrames, 0 = no limit): the frames of a window starting at --from,
+//    with the events and rows of the whole capture (captures/timeline_window.hpp); the page and
+//    stderr say what was left out, exit 0.
 //  - T is a duration with a unit (2s, 1500ms, 250us, 100ns, 1.25s), measured on the capture's
 //    own clock (virtual time since the start of the run for pbvbus captures).
 //  - Bad input (no pcapng, truncated, empty, no line interface, --from not before --to, a bad
 //    duration) prints one line "pbvbus timeline: ..." on stderr, nothing on stdout and no
 //    output file, exit 2.
 
+#include <charconv>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -23,6 +29,7 @@
 
 #include "pbvbus/captures/timeline.hpp"
 #include "pbvbus/captures/timeline_render.hpp"
+#include "pbvbus/captures/timeline_window.hpp"
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {
@@ -30,7 +37,7 @@ namespace pbvbus::tools {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T]\n"
+    "usage: pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T] [--max-frames N]\n"
     "\n"
     "Draws a pcapng capture: one lane per line interface (or per probe interface) with every\n"
     "frame from its first start bit to its last stop bit, coloured by type (token, request,\n"
@@ -41,8 +48,11 @@ constexpr const char* kUsage =
     "                     pan, tooltips with the decoded telegram; self-contained, no network),\n"
     "                     .svg: a static picture of the window. Default: HTML on stdout.\n"
     "  --from T, --to T   the window, e.g. --from 1.99s --to 2.05s (units s, ms, us, ns);\n"
-    "                     default the whole capture. The HTML holds the whole capture and\n"
-    "                     opens at the window.\n"
+    "                     default the whole capture. The HTML holds the whole capture (up\n"
+    "                     to --max-frames frames) and opens at the window.\n"
+    "  --max-frames N     HTML of a longer capture: hold only a window of at most N frames\n"
+    "                     from --from on (default 50000, about 1.5 MB; 0: everything); the\n"
+    "                     page and stderr say what was left out.\n"
     "  --help             this text\n"
     "\n"
     "Exit status: 0 success, 2 bad usage or a file that cannot be read as pcapng.\n";
@@ -70,6 +80,7 @@ std::string base_name(const std::string& path) {
 int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
   std::string path, output;
   std::optional<std::int64_t> from, to;
+  std::uint64_t max_frames = captures::kDefaultMaxPageFrames;
   auto usage_error = [&](const std::string& msg) {
     err << "pbvbus timeline: " << msg << "\nTry 'pbvbus timeline --help'.\n";
     return 2;
@@ -79,6 +90,13 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
     if (a == "--help" || a == "-h") {
       out << kUsage;
       return 0;
+    }
+    if (a == "--max-frames") {
+      const std::string v = i + 1 < args.size() ? args[++i] : "";
+      const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), max_frames);
+      if (v.empty() || ec != std::errc{} || p != v.data() + v.size())
+        return usage_error("--max-frames needs a number of frames, e.g. --max-frames 20000 (0: no limit)");
+      continue;
     }
     if (a == "-o" || a == "--output" || a == "--from" || a == "--to") {
       if (i + 1 >= args.size() || args[i + 1].empty())
@@ -147,6 +165,28 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
     }
     captures::TimelineHtmlOptions ho;
     ho.title = base_name(path);
+    const captures::PageWindow pw = captures::page_window(*tl, from, to, max_frames);
+    if (pw.cut) {
+      // A long capture: the frames of the window only; the overview (events, active channels,
+      // CPU rows) and the page's span stay whole (timeline_window.hpp).
+      ho.note = captures::page_window_note(*tl, pw, max_frames);
+      captures::TimelineOptions wo;
+      wo.from_ns = pw.from_ns;
+      wo.to_ns = pw.to_ns;
+      auto part = captures::read_timeline_file(path, wo, error);
+      if (!part) {
+        err << "pbvbus timeline: " << path << ": " << error << "\n";
+        return 2;
+      }
+      part->from_ns = tl->from_ns;
+      part->to_ns = tl->to_ns;
+      part->events = std::move(tl->events);
+      part->active_channels = std::move(tl->active_channels);
+      part->cpu_states = std::move(tl->cpu_states);
+      part->cpu_obs = std::move(tl->cpu_obs);
+      tl = std::move(part);
+      err << "pbvbus timeline: " << ho.note << "\n";
+    }
     ho.view_from_ns = from;
     ho.view_to_ns = to;
     if (from && !to) ho.view_to_ns = tl->to_ns;

@@ -167,12 +167,12 @@ class GsdParser {
     std::uint32_t line = 0;
   };
 
-  enum class Block { Top, Module, PrmText, ExtPrm, DiagArea, Slots, Opaque };
+  enum class Block { Top, Module, PrmText, ExtPrm, DiagArea, DiagType, Slots, Opaque, UnknownX };
   struct OpenBlock {
     Block kind = Block::Top;
     std::string end;    // the end keyword as PI 2.122 spells it
     std::uint32_t line = 0;
-    std::string title;  // Opaque blocks: the keyword that opened it
+    std::string title;  // Opaque and UnknownX blocks: the keyword that opened it
   };
 
   // --- messages
@@ -206,6 +206,11 @@ class GsdParser {
   void in_prm_text(const Stmt& s);
   void in_ext_prm(const Stmt& s);
   void in_diag_area(const Stmt& s);
+  void in_diag_type(const Stmt& s);
+  void open_diag_area(const Stmt& s);
+  bool diag_bit_text(const Stmt& s, GsdDiagBitTexts& texts, bool plain);
+  void index_statements();
+  bool unknown_x_block(const Stmt& s);
   void in_slots(const Stmt& s);
   bool scalar(const Stmt& s);
   bool baud_keyword(const Stmt& s);
@@ -254,6 +259,13 @@ class GsdParser {
   bool m_ext_f = false;  // the block is an F_ExtUserPrmData (PROFIsafe) definition
   bool m_ext_has_type = false;
   GsdUnitDiagArea m_diag_area;
+  GsdUnitDiagType m_diag_type;
+
+  // Look-ahead for unknown X_ blocks: the position of the statement being read in m_logical, the
+  // positions of every X_..._End statement by keyword (lower case), and of every block boundary.
+  std::size_t m_pos = 0;
+  std::unordered_map<std::string, std::vector<std::size_t>> m_x_ends;
+  std::vector<std::size_t> m_boundaries;
 
   std::unordered_map<std::string, std::uint32_t> m_seen;  // key(+index) -> line
   std::map<bus::Baud, std::uint32_t> m_supp_line;         // supported (= 1) rates
@@ -733,11 +745,61 @@ std::optional<std::uint16_t> GsdParser::index_value(const Stmt& s, std::uint64_t
 // ---------------------------------------------------------------------------------------------
 // Statements
 
-bool GsdParser::block_start(const Stmt& s) const {
+namespace {
+
+bool block_start_key(std::string_view key) {
   static const std::array<std::string_view, 9> kStarts = {
       "module", "prmtext", "extuserprmdata", "f_extuserprmdata", "slotdefinition", "unit_diag_area",
       "x_unit_diag_area", "unitdiagtype", "physical_interface"};
-  return std::find(kStarts.begin(), kStarts.end(), s.key) != kStarts.end();
+  return std::find(kStarts.begin(), kStarts.end(), key) != kStarts.end();
+}
+
+// The keyword a logical line starts with, lower case (the look-ahead needs no full statement).
+std::string leading_key(std::string_view text) {
+  text = trim(text);
+  std::size_t i = 0;
+  while (i < text.size() && (std::isalnum(static_cast<unsigned char>(text[i])) != 0 || text[i] == '_' || text[i] == '.'))
+    ++i;
+  return lower(text.substr(0, i));
+}
+
+}  // namespace
+
+bool GsdParser::block_start(const Stmt& s) const { return block_start_key(s.key); }
+
+// Positions for unknown_x_block(): every X_..._End statement, and every block boundary (block
+// starts and end keywords, Data_Area included), so that each look-ahead is two binary searches.
+void GsdParser::index_statements() {
+  for (std::size_t i = 0; i < m_logical.size(); ++i) {
+    const std::string key = leading_key(m_logical[i].first);
+    if (block_start_key(key) || end_keyword(key) || key == "data_area_beg" || key == "data_area_end")
+      m_boundaries.push_back(i);
+    else if (key.rfind("x_", 0) == 0 && ends_with(key, "_end"))
+      m_x_ends[key].push_back(i);
+  }
+}
+
+// An unknown X_<name> followed by X_<name>_End before the next block boundary: a block of a later
+// GSD revision (decision in gsd.hpp). One warning; the content is skipped up to its end.
+bool GsdParser::unknown_x_block(const Stmt& s) {
+  if (s.key.rfind("x_", 0) != 0 || block_start(s) || end_keyword(s.key) || top_level_keyword(s.key) ||
+      module_keyword(s.key) || s.key == "x_value" || s.key == "x_value_help" ||
+      s.key == "x_unit_diag_bit_help" || s.key == "x_unit_diag_not_bit_help")
+    return false;
+  const auto ends = m_x_ends.find(s.key + "_end");
+  if (ends == m_x_ends.end()) return false;
+  const auto end = std::upper_bound(ends->second.begin(), ends->second.end(), m_pos);
+  if (end == ends->second.end()) return false;
+  const auto boundary = std::upper_bound(m_boundaries.begin(), m_boundaries.end(), m_pos);
+  if (boundary != m_boundaries.end() && *boundary < *end) return false;
+  const auto& [end_text, end_line] = m_logical[*end];
+  const std::string_view t = trim(end_text);
+  const std::string end_keyword_written(t.substr(0, s.key.size() + 4));
+  m_result_file.m_unknown.push_back({s.keyword, s.index, s.value, s.line});
+  warning(s.line, "unknown block '" + s.keyword + "' ... '" + end_keyword_written + "' (line " +
+                      std::to_string(end_line) + ") kept, not interpreted");
+  open_block(Block::UnknownX, end_keyword_written, s.line, s.keyword);
+  return true;
 }
 
 void GsdParser::unknown(const Stmt& s, std::string_view where) {
@@ -758,6 +820,11 @@ void GsdParser::remember(const Stmt& s) {
 }
 
 void GsdParser::statement(const Stmt& s) {
+  if (block() == Block::UnknownX) {
+    if (own_end(m_open.back(), s.key)) m_open.pop_back();
+    return;  // the content of a block the reader does not know is not interpreted
+  }
+  if (unknown_x_block(s)) return;
   if (block() != Block::Top && leaves_block(s)) {
     unterminated(s);
     return;
@@ -768,10 +835,12 @@ void GsdParser::statement(const Stmt& s) {
     case Block::PrmText: in_prm_text(s); break;
     case Block::ExtPrm: in_ext_prm(s); break;
     case Block::DiagArea: in_diag_area(s); break;
+    case Block::DiagType: in_diag_type(s); break;
     case Block::Slots: in_slots(s); break;
     case Block::Opaque:
       if (own_end(m_open.back(), s.key)) m_open.pop_back();
       break;
+    case Block::UnknownX: break;  // handled above
   }
 }
 
@@ -788,7 +857,9 @@ std::string GsdParser::block_title(const OpenBlock& b) const {
     case Block::DiagArea: return m_diag_area.x_variant ? "X_Unit_Diag_Area" : "Unit_Diag_Area";
     case Block::Slots: return "SlotDefinition";
     case Block::Top:
-    case Block::Opaque: break;
+    case Block::DiagType:
+    case Block::Opaque:
+    case Block::UnknownX: break;
   }
   return b.title;
 }
@@ -806,9 +877,13 @@ bool GsdParser::own_end(const OpenBlock& b, std::string_view key) const {
 bool GsdParser::leaves_block(const Stmt& s) const {
   const OpenBlock& b = m_open.back();
   if (own_end(b, s.key)) return false;
+  // A UnitDiagType holds its diagnosis areas (GSD revision 5, gsd.hpp GsdUnitDiagType).
+  if (b.kind == Block::DiagType && (s.key == "unit_diag_area" || s.key == "x_unit_diag_area")) return false;
   if (block_start(s) || end_keyword(s.key)) return true;
   switch (b.kind) {
-    case Block::Opaque: return false;
+    case Block::Opaque:
+    case Block::DiagType:
+    case Block::UnknownX: return false;
     case Block::Module: return top_level_keyword(s.key) && !module_keyword(s.key);
     default: return top_level_keyword(s.key);
   }
@@ -1022,31 +1097,29 @@ void GsdParser::top(const Stmt& written) {
   } else if (k == "endf_extuserprmdata") {
     error(s.line, "EndF_ExtUserPrmData without F_ExtUserPrmData");
   } else if (k == "unit_diag_area" || k == "x_unit_diag_area") {
-    m_diag_area = GsdUnitDiagArea{};
-    m_diag_area.x_variant = k[0] == 'x';
-    m_diag_area.line = s.line;
-    open_block(Block::DiagArea, m_diag_area.x_variant ? "X_Unit_Diag_Area_End" : "Unit_Diag_Area_End", s.line);
-    if (!need_value(s)) return;
-    const std::size_t dash = s.value.find('-');
-    auto a = number(std::string_view(s.value).substr(0, dash), s.line);
-    if (!a) return;
-    auto b = dash == std::string::npos ? a : number(std::string_view(s.value).substr(dash + 1), s.line);
-    if (!b) return;
-    if (*a < 0 || *b < *a || *b > 0xFFFF) {
-      error(s.line, s.keyword + " " + s.value + ": bits out of order or out of range");
-      return;
-    }
-    m_diag_area.first_bit = static_cast<std::uint16_t>(*a);
-    m_diag_area.last_bit = static_cast<std::uint16_t>(*b);
+    open_diag_area(s);
   } else if (k == "unit_diag_area_end" || k == "x_unit_diag_area_end") {
     error(s.line, s.keyword + " without Unit_Diag_Area");
   } else if (k == "slotdefinition") {
     open_block(Block::Slots, "EndSlotDefinition", s.line);
   } else if (k == "endslotdefinition") {
     error(s.line, "EndSlotDefinition without SlotDefinition");
-  } else if (k == "unitdiagtype" || k == "physical_interface") {
-    open_block(Block::Opaque, k == "unitdiagtype" ? "EndUnitDiagType" : "End_Physical_Interface", s.line,
-               s.keyword);
+  } else if (k == "unitdiagtype") {
+    m_diag_type = GsdUnitDiagType{};
+    m_diag_type.line = s.line;
+    open_block(Block::DiagType, "EndUnitDiagType", s.line, s.keyword);
+    // The type octet. The block was read without interpretation before, so a value that is no
+    // octet only warns: the file stays as usable as it was.
+    const std::string_view v = trim(s.value);
+    unsigned t = 0;
+    const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), t);
+    if (ec == std::errc{} && p == v.data() + v.size() && t <= 0xFF)
+      m_diag_type.type = static_cast<std::uint8_t>(t);
+    else
+      warning(s.line, "UnitDiagType value '" + shorten(v) + "' is not a type octet (0..255); its texts are kept "
+                      "without a type");
+  } else if (k == "physical_interface") {
+    open_block(Block::Opaque, "End_Physical_Interface", s.line, s.keyword);
   } else if (k == "endunitdiagtype" || k == "end_physical_interface") {
     error(s.line, s.keyword + " without its block start");
   } else if (k == "unit_diag_bit" || k == "channel_diag") {
@@ -1055,6 +1128,8 @@ void GsdParser::top(const Stmt& written) {
     auto text = string_value(s, s.keyword);
     if (!text) return;
     (k == "unit_diag_bit" ? f.m_unit_diag_bits : f.m_channel_diag)[*idx] = *text;
+  } else if (diag_bit_text(s, f.m_x_unit_diag, false)) {
+    // X_Unit_Diag_Bit(n) and its help / Not_Bit texts outside a UnitDiagType
   } else if (k == "ext_user_prm_data_const") {
     prm_const(s, f.m_global_prm);
   } else if (k == "ext_user_prm_data_ref") {
@@ -1327,22 +1402,77 @@ void GsdParser::in_ext_prm(const Stmt& s) {
   }
 }
 
+void GsdParser::open_diag_area(const Stmt& s) {
+  m_diag_area = GsdUnitDiagArea{};
+  m_diag_area.x_variant = s.key[0] == 'x';
+  m_diag_area.line = s.line;
+  open_block(Block::DiagArea, m_diag_area.x_variant ? "X_Unit_Diag_Area_End" : "Unit_Diag_Area_End", s.line);
+  if (!need_value(s)) return;
+  const std::size_t dash = s.value.find('-');
+  auto a = number(std::string_view(s.value).substr(0, dash), s.line);
+  if (!a) return;
+  auto b = dash == std::string::npos ? a : number(std::string_view(s.value).substr(dash + 1), s.line);
+  if (!b) return;
+  if (*a < 0 || *b < *a || *b > 0xFFFF) {
+    error(s.line, s.keyword + " " + s.value + ": bits out of order or out of range");
+    return;
+  }
+  m_diag_area.first_bit = static_cast<std::uint16_t>(*a);
+  m_diag_area.last_bit = static_cast<std::uint16_t>(*b);
+}
+
+// Value(n) / X_Value(n) name a value of the area's bits; Value_Help(n) / X_Value_Help(n) explain it.
 void GsdParser::in_diag_area(const Stmt& s) {
   if (s.key == "unit_diag_area_end" || s.key == "x_unit_diag_area_end") {
-    m_result_file.m_unit_diag_areas.push_back(std::move(m_diag_area));
     m_open.pop_back();
-  } else if (s.key == "value") {
+    auto& areas = block() == Block::DiagType ? m_diag_type.areas : m_result_file.m_unit_diag_areas;
+    areas.push_back(std::move(m_diag_area));
+    m_diag_area = GsdUnitDiagArea{};
+  } else if (s.key == "value" || s.key == "x_value" || s.key == "value_help" || s.key == "x_value_help") {
     if (!s.has_index) {
-      error(s.line, "'Value' needs an index: Value(n)");
+      error(s.line, "'" + s.keyword + "' needs an index: " + s.keyword + "(n)");
       return;
     }
     auto v = number(s.index, s.line);
     if (!v) return;
-    auto t = string_value(s, "Value");
+    auto t = string_value(s, s.keyword);
     if (!t) return;
-    m_diag_area.values.emplace_back(*v, *t);
+    (ends_with(s.key, "_help") ? m_diag_area.value_help : m_diag_area.values).emplace_back(*v, *t);
   } else {
-    unknown(s, " in Unit_Diag_Area");
+    unknown(s, m_diag_area.x_variant ? " in X_Unit_Diag_Area" : " in Unit_Diag_Area");
+  }
+}
+
+// (X_)Unit_Diag_Bit(n), (X_)Unit_Diag_Bit_Help(n), (X_)Unit_Diag_Not_Bit(n),
+// (X_)Unit_Diag_Not_Bit_Help(n) into `texts`; the plain spellings only with `plain` (inside a
+// UnitDiagType, gsd.hpp). False when the statement is none of them.
+bool GsdParser::diag_bit_text(const Stmt& s, GsdDiagBitTexts& texts, bool plain) {
+  std::string_view k = s.key;
+  if (k.rfind("x_", 0) == 0)
+    k.remove_prefix(2);
+  else if (!plain)
+    return false;
+  std::map<std::uint32_t, std::string>* target = k == "unit_diag_bit"            ? &texts.bits
+                                                 : k == "unit_diag_bit_help"     ? &texts.bit_help
+                                                 : k == "unit_diag_not_bit"      ? &texts.not_bits
+                                                 : k == "unit_diag_not_bit_help" ? &texts.not_bit_help
+                                                                                 : nullptr;
+  if (target == nullptr) return false;
+  auto idx = index_value(s, 0xFFFF);
+  if (!idx) return true;
+  if (auto text = string_value(s, s.keyword)) (*target)[*idx] = *text;
+  return true;
+}
+
+void GsdParser::in_diag_type(const Stmt& s) {
+  if (s.key == "endunitdiagtype") {
+    m_result_file.m_unit_diag_types.push_back(std::move(m_diag_type));
+    m_diag_type = GsdUnitDiagType{};
+    m_open.pop_back();
+  } else if (s.key == "unit_diag_area" || s.key == "x_unit_diag_area") {
+    open_diag_area(s);
+  } else if (!diag_bit_text(s, m_diag_type.texts, true)) {
+    unknown(s, " in UnitDiagType");
   }
 }
 
@@ -1575,8 +1705,10 @@ void GsdParser::finish() {
 GsdParseResult GsdParser::run() {
   const std::string text = decode();
   split_logical(text);
-  for (const auto& [line_text, line] : m_logical) {
+  index_statements();
+  for (m_pos = 0; m_pos < m_logical.size(); ++m_pos) {
     if (too_many_errors()) break;
+    const auto& [line_text, line] = m_logical[m_pos];
     if (auto s = parse_stmt(line_text, line)) statement(*s);
   }
   if (m_section_line != 0 && !too_many_errors()) close_block_at_end();

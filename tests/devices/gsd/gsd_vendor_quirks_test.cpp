@@ -1,12 +1,17 @@
 // GSD files as vendors write them (tests/data/gsd/vendor-quirks): values outside PI 2.122 that
-// are clamped, common misspellings, PROFIsafe modules. Each test asserts the exact warnings, the
+// are clamped, common misspellings, PROFIsafe modules, revision-5 diagnosis blocks (UnitDiagType
+// with X_ keywords) and X_ blocks the reader does not know. Each test asserts the exact warnings, the
 // values the model keeps and, where bytes are assembled, bytes worked out by hand.
 // Parser robustness (duplicates, unterminated blocks) is in gsd_quirks_parser_test.cpp.
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pbvbus/gsd/gsd.hpp"
@@ -247,4 +252,132 @@ TEST(GsdVendorQuirks, ProfisafeFallbacksAndChecks) {
   EXPECT_EQ(texts(r.errors),
             (std::vector<std::string>{"p.gsd:13: F_ExtUserPrmData 1 'F_SIL' without EndF_ExtUserPrmData; "
                                       "'Module' at line 15 cannot be inside it"}));
+}
+
+// --- (f) Revision 5: UnitDiagType with X_ diagnosis keywords; unknown X_ blocks -----------------
+
+TEST(GsdVendorQuirks, UnitDiagTypeWithXKeywordsIsReadIntoTheModel) {
+  const std::string path = src("tests/data/gsd/vendor-quirks/profisafe-unit-diag-type.gsd");
+  const GsdParseResult r = load_gsd(path);
+  // The regression: "UnitDiagType without EndUnitDiagType; 'X_Unit_Diag_Area' at line 51 cannot be
+  // inside it" and "EndUnitDiagType without its block start" at line 65.
+  ASSERT_TRUE(r.ok()) << texts(r.errors).front();
+  EXPECT_TRUE(r.warnings.empty()) << texts(r.warnings).front();
+  const GsdFile& f = *r.file;
+
+  // DP-V0 texts outside the block: Unit_Diag_Bit as before, the X_ ones typed beside it.
+  EXPECT_EQ(f.unit_diag_bits(), (std::map<std::uint32_t, std::string>{{24, "Supply voltage missing"}}));
+  EXPECT_EQ(f.x_unit_diag().bits, (std::map<std::uint32_t, std::string>{{25, "Internal fault"}}));
+  EXPECT_EQ(f.x_unit_diag().bit_help, (std::map<std::uint32_t, std::string>{{25, "Replace the module"}}));
+  EXPECT_TRUE(f.x_unit_diag().not_bits.empty());
+  // The area inside the UnitDiagType belongs to it, not to the top-level areas.
+  EXPECT_TRUE(f.unit_diag_areas().empty());
+
+  ASSERT_EQ(f.unit_diag_types().size(), 1u);
+  const GsdUnitDiagType& t = f.unit_diag_types()[0];
+  EXPECT_EQ(t.type, std::optional<std::uint8_t>{0x81});  // 129: DP-V1 status message
+  EXPECT_EQ(t.line, 50u);
+  ASSERT_EQ(t.areas.size(), 1u);
+  const GsdUnitDiagArea& a = t.areas[0];
+  EXPECT_TRUE(a.x_variant);
+  EXPECT_EQ(a.first_bit, 24);
+  EXPECT_EQ(a.last_bit, 31);
+  EXPECT_EQ(a.line, 51u);
+  ASSERT_EQ(a.values.size(), 8u);  // the PROFIsafe F-parameter fault codes 64..71, in file order
+  for (std::size_t i = 0; i < a.values.size(); ++i) EXPECT_EQ(a.values[i].first, 64 + static_cast<int>(i));
+  EXPECT_EQ(a.values[0].second, "Mismatch of F_Dest_Add");
+  EXPECT_EQ(a.values[7].second, "CRC1 fault");
+  ASSERT_EQ(a.value_help.size(), 1u);
+  EXPECT_EQ(a.value_help[0], (std::pair<std::int64_t, std::string>{64, "Set F_Dest_Add to the address on the DIL switch"}));
+  EXPECT_EQ(t.texts.bits, (std::map<std::uint32_t, std::string>{{32, "Discrepancy error channel 0"}}));
+  EXPECT_EQ(t.texts.bit_help, (std::map<std::uint32_t, std::string>{{32, "Sensors of channel 0 disagree"}}));
+  EXPECT_EQ(t.texts.not_bits, (std::map<std::uint32_t, std::string>{{33, "Sensor supply off"}}));
+
+  // The rest of the file is read as before: the PROFIsafe module and its F block.
+  ASSERT_EQ(f.modules().size(), 1u);
+  ASSERT_TRUE(f.modules()[0].f.present());
+  // Const 00 40 00 01 00 00 00 00 12 34; F_SIL BitArea(2-3) = 2 -> octet 0 = 0x08;
+  // F_Dest_Add 200 at 4-5 -> 00 C8; F_WD_Time 100 at 6-7 -> 00 64.
+  EXPECT_EQ(f.f_prm_defaults(f.modules()[0]), (GsdBytes{0x08, 0x40, 0x00, 0x01, 0x00, 0xC8, 0x00, 0x64, 0x12, 0x34}));
+}
+
+namespace {
+
+// 9 lines, so that the first extra line is line 10.
+const std::string kHead =
+    "#Profibus_DP\nIdent_Number=0x1234\nStation_Type=0\n12M_supp=1\nMaxTsdr_12M=800\n"
+    "Min_Slave_Intervall=1\nMax_Diag_Data_Len=6\nModule=\"m\" 0x10\nEndModule\n";
+
+GsdParseResult parse_lines(const std::vector<std::string>& lines) {
+  std::string text = kHead;
+  for (const auto& l : lines) text += l + "\n";
+  return parse_gsd(text, "x.gsd");
+}
+
+}  // namespace
+
+TEST(GsdVendorQuirks, UnitDiagTypeMixedSpellingsAndStructureErrors) {
+  // Plain spellings inside the block count as its texts; either area end keyword closes the area.
+  GsdParseResult r = parse_lines({"UnitDiagType = 130", "Unit_Diag_Bit(8) = \"a\"", "Unit_Diag_Area = 16-23",
+                                  "Value(1) = \"one\"", "X_Unit_Diag_Area_End", "EndUnitDiagType"});
+  ASSERT_TRUE(r.ok()) << texts(r.errors).front();
+  EXPECT_TRUE(r.warnings.empty());
+  ASSERT_EQ(r.file->unit_diag_types().size(), 1u);
+  EXPECT_EQ(r.file->unit_diag_types()[0].texts.bits.at(8), "a");
+  EXPECT_FALSE(r.file->unit_diag_types()[0].areas.at(0).x_variant);
+  EXPECT_EQ(r.file->unit_diag_types()[0].areas.at(0).values.at(0).second, "one");
+  EXPECT_TRUE(r.file->unit_diag_bits().empty());
+
+  // An area inside the type without its end: one error at the area, the type still closes.
+  r = parse_lines({"UnitDiagType = 129", "X_Unit_Diag_Area = 24-31", "X_Value(64) = \"x\"", "EndUnitDiagType",
+                   "Max_User_Prm_Data_Len = 4"});
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(texts(r.errors), (std::vector<std::string>{"x.gsd:11: X_Unit_Diag_Area without X_Unit_Diag_Area_End; "
+                                                       "'EndUnitDiagType' at line 13 ends another kind of block"}));
+
+  // A value that is no type octet warns; the block's texts are kept without a type.
+  r = parse_lines({"UnitDiagType = 0x181", "X_Unit_Diag_Bit(3) = \"b\"", "EndUnitDiagType"});
+  ASSERT_TRUE(r.ok()) << texts(r.errors).front();
+  EXPECT_EQ(texts(r.warnings), (std::vector<std::string>{"x.gsd:10: UnitDiagType value '0x181' is not a type octet "
+                                                         "(0..255); its texts are kept without a type"}));
+  EXPECT_FALSE(r.file->unit_diag_types().at(0).type.has_value());
+  EXPECT_EQ(r.file->unit_diag_types().at(0).texts.bits.at(3), "b");
+}
+
+TEST(GsdVendorQuirks, UnknownXBlocksAreWarningsNotStructureErrors) {
+  // At the top level and inside a UnitDiagType: one warning each, the content is not read (the
+  // Module-looking and garbage lines inside would otherwise be errors), the file is usable.
+  GsdParseResult r = parse_lines({"X_Vendor_Diag_Block = 3",     // 10
+                                  "Text_Ref(1) = \"x\"",           // 11
+                                  "X_Vendor_Diag_Block_End",       // 12
+                                  "UnitDiagType = 129",            // 13
+                                  "X_Unit_Diag_Type_Ext = 1",      // 14
+                                  "X_Value(2) = 5",                // 15: would be an error if read
+                                  "X_UNIT_DIAG_TYPE_EXT_END",      // 16
+                                  "X_Unit_Diag_Bit(1) = \"kept\"", // 17
+                                  "EndUnitDiagType"});             // 18
+  ASSERT_TRUE(r.ok()) << texts(r.errors).front();
+  EXPECT_EQ(texts(r.warnings),
+            (std::vector<std::string>{
+                "x.gsd:10: unknown block 'X_Vendor_Diag_Block' ... 'X_Vendor_Diag_Block_End' (line 12) kept, not "
+                "interpreted",
+                "x.gsd:14: unknown block 'X_Unit_Diag_Type_Ext' ... 'X_UNIT_DIAG_TYPE_EXT_END' (line 16) kept, not "
+                "interpreted"}));
+  ASSERT_EQ(r.file->unknown_keywords().size(), 2u);
+  EXPECT_EQ(r.file->unknown_keywords()[0].name, "X_Vendor_Diag_Block");
+  EXPECT_EQ(r.file->unknown_keywords()[0].value, "3");
+  EXPECT_EQ(r.file->unit_diag_types().at(0).texts.bits.at(1), "kept");
+
+  // No matching end before the next block boundary: not a block, each line an unknown keyword,
+  // and the Module in between is read.
+  r = parse_lines({"X_Vendor_Thing = 1", "Module = \"n\" 0x20", "EndModule", "X_Vendor_Thing_End"});
+  ASSERT_TRUE(r.ok()) << texts(r.errors).front();
+  EXPECT_EQ(texts(r.warnings), (std::vector<std::string>{"x.gsd:10: unknown keyword 'X_Vendor_Thing' kept",
+                                                         "x.gsd:13: unknown keyword 'X_Vendor_Thing_End' kept"}));
+  EXPECT_EQ(r.file->modules().size(), 2u);
+  // Known X_ keywords are never taken for unknown blocks.
+  r = parse_lines({"X_Unit_Diag_Bit(4) = \"d\"", "X_Unit_Diag_Bit_End"});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.file->x_unit_diag().bits.at(4), "d");
+  EXPECT_EQ(texts(r.warnings), (std::vector<std::string>{"x.gsd:11: unknown keyword 'X_Unit_Diag_Bit_End' kept"}));
 }

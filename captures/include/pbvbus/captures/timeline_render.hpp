@@ -58,6 +58,9 @@ struct TimelineHtmlOptions {
   std::string title;                      ///< shown in the page header (e.g. the file name)
   std::optional<std::int64_t> view_from_ns;  ///< first view; default: the Timeline's window
   std::optional<std::int64_t> view_to_ns;
+  /// Shown under the header in <p id="note">, e.g. what a page of a long capture leaves out
+  /// (timeline_window.hpp); nothing when empty.
+  std::string note;
 };
 std::string to_html(const Timeline& tl, const TimelineHtmlOptions& opts = {});
 

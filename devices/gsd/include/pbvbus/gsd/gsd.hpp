@@ -26,8 +26,14 @@
 //   at the line that opened it, naming the statement that showed the end missing: a block start,
 //   another block's end keyword, or a top-level keyword the block cannot contain (a Module keeps
 //   the keywords PI 2.122 allows in modules; UnitDiagType, Physical_Interface and Data_Area
-//   contents are not interpreted, so only a block boundary ends them). The statement then counts
-//   where it belongs, and the missing end keyword, if it comes later, is not reported again.
+//   contents are not interpreted, so only a block boundary ends them; X_Unit_Diag_Area and
+//   Unit_Diag_Area blocks nest inside a UnitDiagType). The statement then counts where it
+//   belongs, and the missing end keyword, if it comes later, is not reported again.
+// - A keyword X_<name> the reader does not know, followed by X_<name>_End before the next block
+//   boundary (a block start or end keyword), is an unknown block of a later GSD revision: one
+//   warning at its start, its content is skipped, and the file stays usable. GSD revision 5 adds
+//   its extensions as X_ keywords (X_Unit_Diag_*, X_Ext_Module_Prm_Data_*); an X_ keyword
+//   without such an end is an unknown keyword like any other.
 // - User_Prm_Data assembly (user_prm_data()): the global area is User_Prm_Data_Len bytes (or, when
 //   absent, as long as its data), initialised from User_Prm_Data, then the
 //   Ext_User_Prm_Data_Const(o) overlays, then the Ext_User_Prm_Data_Ref(o) defaults; every
@@ -233,12 +239,51 @@ struct GsdModule {
   std::uint32_t line = 0;
 };
 
-/// Unit_Diag_Area = first-last / Value(n) = "..." / Unit_Diag_Area_End (also X_Unit_Diag_Area).
+/// Unit_Diag_Area = first-last / Value(n) = "..." / Unit_Diag_Area_End, and the X_ variant
+/// X_Unit_Diag_Area / X_Value(n) / X_Unit_Diag_Area_End (see GsdUnitDiagType).
 struct GsdUnitDiagArea {
   std::uint16_t first_bit = 0;
   std::uint16_t last_bit = 0;
-  std::vector<std::pair<std::int64_t, std::string>> values;
+  std::vector<std::pair<std::int64_t, std::string>> values;      ///< Value(n) / X_Value(n)
+  std::vector<std::pair<std::int64_t, std::string>> value_help;  ///< Value_Help(n) / X_Value_Help(n)
   bool x_variant = false;
+  std::uint32_t line = 0;
+};
+
+/// Texts for single bits of the device-related diagnosis: (X_)Unit_Diag_Bit(n),
+/// (X_)Unit_Diag_Bit_Help(n), (X_)Unit_Diag_Not_Bit(n), (X_)Unit_Diag_Not_Bit_Help(n). A "Not_Bit"
+/// text is shown while the bit is 0 (PI 2.122).
+struct GsdDiagBitTexts {
+  std::map<std::uint32_t, std::string> bits;
+  std::map<std::uint32_t, std::string> bit_help;
+  std::map<std::uint32_t, std::string> not_bits;
+  std::map<std::uint32_t, std::string> not_bit_help;
+  bool empty() const { return bits.empty() && bit_help.empty() && not_bits.empty() && not_bit_help.empty(); }
+};
+
+/// UnitDiagType = n ... EndUnitDiagType (GSD revision 4 and later): the texts of a DP-V1
+/// device-related diagnosis block whose type octet (Alarm_Type, or Status_Type with bit 7 set,
+/// the octet after the block's header; §E) is n — e.g. 129 = 0x81, a status message, which
+/// PROFIsafe devices use for the F-parameter faults 64..71. Inside the block the file writes the
+/// X_ keywords: X_Unit_Diag_Bit(n), X_Unit_Diag_Bit_Help(n), X_Unit_Diag_Not_Bit(n),
+/// X_Unit_Diag_Not_Bit_Help(n) and X_Unit_Diag_Area = a-b / X_Value(v) / X_Value_Help(v) /
+/// X_Unit_Diag_Area_End.
+///
+/// Decisions (PI 2.122 revision 5's keyword list as seen in vendor files and open-source readers;
+/// the spec's own text was not consulted) [U]:
+/// - Bit numbers are kept as written: like Unit_Diag_Bit they count from bit 0 of the first octet
+///   after the block's header octet, so a PROFIsafe code area 24-31 is the first octet after
+///   type, slot and specifier. The reader does not interpret them against a telegram.
+/// - Inside the block the plain spellings (Unit_Diag_Bit, Unit_Diag_Area, Value, ...) count as
+///   their X_ variants, as files mix them (like the two diagnosis-area end keywords).
+/// - The X_ keywords are also accepted outside any UnitDiagType (GsdFile::x_unit_diag(), and
+///   X_Unit_Diag_Area in unit_diag_areas() with x_variant set), as older revision-4 files do.
+/// - A type value that is not a number 0..255 is a warning; the block's texts are kept with
+///   `type` unset.
+struct GsdUnitDiagType {
+  std::optional<std::uint8_t> type;
+  GsdDiagBitTexts texts;
+  std::vector<GsdUnitDiagArea> areas;
   std::uint32_t line = 0;
 };
 
@@ -430,7 +475,13 @@ class GsdFile {
   const std::map<std::uint16_t, GsdExtUserPrmData>& f_prm_defs() const { return m_f_defs; }
 
   const std::map<std::uint32_t, std::string>& unit_diag_bits() const { return m_unit_diag_bits; }
+  /// Unit_Diag_Area blocks outside any UnitDiagType (X_Unit_Diag_Area ones with x_variant).
   const std::vector<GsdUnitDiagArea>& unit_diag_areas() const { return m_unit_diag_areas; }
+  /// X_Unit_Diag_Bit(n), X_Unit_Diag_Bit_Help(n), X_Unit_Diag_Not_Bit(n), ..._Help(n) outside any
+  /// UnitDiagType block.
+  const GsdDiagBitTexts& x_unit_diag() const { return m_x_unit_diag; }
+  /// UnitDiagType blocks in file order.
+  const std::vector<GsdUnitDiagType>& unit_diag_types() const { return m_unit_diag_types; }
   const std::map<std::uint32_t, std::string>& channel_diag() const { return m_channel_diag; }
   const std::vector<GsdSlot>& slots() const { return m_slots; }
 
@@ -485,6 +536,8 @@ class GsdFile {
   std::map<std::uint16_t, GsdExtUserPrmData> m_f_defs;
   std::map<std::uint32_t, std::string> m_unit_diag_bits;
   std::vector<GsdUnitDiagArea> m_unit_diag_areas;
+  GsdDiagBitTexts m_x_unit_diag;
+  std::vector<GsdUnitDiagType> m_unit_diag_types;
   std::map<std::uint32_t, std::string> m_channel_diag;
   std::vector<GsdSlot> m_slots;
   std::vector<GsdKeyword> m_keywords;

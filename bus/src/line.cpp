@@ -39,6 +39,9 @@ struct Line::Transmission {
   bool cut_counted = false;  // counted in LineStats::partial already
   Mask rx;
   std::uint64_t probes = 0;  // probe taps (bits of m_probes) still hearing it
+  /// What the layers above worked out from `bytes` (frame_memo.hpp): handed to every receiver
+  /// and tap; emptied whenever `bytes` change.
+  mutable FrameMemo memo;
   /// Idle time each receiver had seen when this frame started (valid where rx is set).
   std::array<Ticks, kMaxAttachments> idle_before{};
 };
@@ -389,6 +392,7 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
   t->end = end;
   t->flags = babble ? kRxBabble : 0;
   t->cut_counted = false;
+  t->memo.clear();
   // Everyone listening on the sender's segment (the sender is listening: it got this far).
   t->rx = m_listening[static_cast<std::size_t>(from.segment)];
   t->probes = m_probe_by_segment[static_cast<std::size_t>(from.segment)];
@@ -412,6 +416,7 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
     t->flags |= kRxCollision;
     garble(o->bytes, o->start, char_ticks, now, std::min(o->end, t->end), next_random());
     garble(t->bytes, t->start, char_ticks, now, std::min(o->end, t->end), next_random());
+    o->memo.clear();  // a cut-short view of `o` may have been decoded already
   }
   apply_noise(*t);
   m_sched.schedule(t->end, *this, t->id);
@@ -426,6 +431,7 @@ void Line::deliver(Transmission& t, std::size_t to, std::size_t len, std::uint16
   f.end = end;
   f.idle_before = t.idle_before[to];
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
+  f.memo = &t.memo;
   dev.on_frame(f);
   refresh_filter(to);
 }
@@ -440,6 +446,7 @@ TapFrame Line::tap_view(const Transmission& t, std::size_t len, std::uint16_t ex
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
   f.sender = static_cast<std::uint16_t>(t.from->id);
   f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  f.memo = &t.memo;
   return f;
 }
 
@@ -576,6 +583,8 @@ void Line::join_in_flight() {
       y.flags |= kRxCollision;
       garble(x.bytes, x.start, char_ticks, now, std::min(x.end, y.end), next_random());
       garble(y.bytes, y.start, char_ticks, now, std::min(x.end, y.end), next_random());
+      x.memo.clear();
+      y.memo.clear();
     }
   }
 }

@@ -8,6 +8,7 @@
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"
+#include "pbvbus/fdl/decoded_frame.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::captures {
@@ -444,8 +445,8 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
   // Fast path: an intact frame that decodes needs neither flags nor comment.
   std::uint32_t flags = 0;
   std::string_view comment;
-  fdl::Telegram t;
-  if (f.flags != 0 || fdl::decode(f.bytes, t) != fdl::DecodeError::None) {
+  fdl::DecodedFrame scratch;
+  if (f.flags != 0 || !fdl::decode_once(f, scratch).ok()) {
     flags = classify_frame(f.bytes, f.flags, f.sent_len, m_comment);
     comment = m_comment;
   }

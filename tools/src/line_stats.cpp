@@ -3,6 +3,7 @@
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
+#include "pbvbus/fdl/decoded_frame.hpp"
 
 namespace pbvbus::tools {
 
@@ -67,8 +68,10 @@ void LineStats::on_frame(const bus::TapFrame& f) {
     if (f.flags & bus::kRxBabble) ++babble;
     return;
   }
-  fdl::Telegram t;
-  const fdl::DecodeError e = fdl::decode(f.bytes, t);
+  fdl::DecodedFrame scratch;
+  const fdl::DecodedFrame& d = fdl::decode_once(f, scratch);
+  const fdl::DecodeError e = d.error;
+  const fdl::Telegram& t = d.telegram;
   if (e != fdl::DecodeError::None) {
     settle(f, nullptr);
     ++m_error_frames;

@@ -5,10 +5,29 @@
 
 namespace pbvbus::bus {
 
+// The queue is a 4-ary min-heap on (when, seq) in m_heap: half the depth of a binary heap, and
+// the four children of a node share a cache line or two. (when, seq) is a total order, so the
+// order in which events run is the same as with any other correct priority queue.
+namespace {
+constexpr std::size_t kArity = 4;
+template <class E>
+bool runs_before(const E& a, const E& b) {
+  return a.when != b.when ? a.when < b.when : a.seq < b.seq;
+}
+}  // namespace
+
 void Scheduler::schedule(Ticks when, EventTarget& target, std::uint64_t tag) {
   if (when < m_now) when = m_now;
-  m_heap.push_back(Entry{when, m_seq++, &target, tag});
-  std::push_heap(m_heap.begin(), m_heap.end(), Later{});
+  const Entry e{when, m_seq++, &target, tag};
+  std::size_t i = m_heap.size();
+  m_heap.push_back(e);
+  while (i > 0) {
+    const std::size_t parent = (i - 1) / kArity;
+    if (!runs_before(e, m_heap[parent])) break;
+    m_heap[i] = m_heap[parent];
+    i = parent;
+  }
+  m_heap[i] = e;
 }
 
 void Scheduler::schedule(Ticks when, std::function<void()> fn) {
@@ -34,9 +53,25 @@ void Scheduler::FnTarget::on_event(Ticks, std::uint64_t tag) {
 
 bool Scheduler::step() {
   if (m_heap.empty()) return false;
-  std::pop_heap(m_heap.begin(), m_heap.end(), Later{});
-  Entry e = m_heap.back();
+  const Entry e = m_heap.front();
+  const Entry last = m_heap.back();
   m_heap.pop_back();
+  if (const std::size_t n = m_heap.size(); n > 0) {
+    // Sift `last` down from the root.
+    std::size_t i = 0;
+    for (;;) {
+      const std::size_t first = i * kArity + 1;
+      if (first >= n) break;
+      std::size_t best = first;
+      const std::size_t end = std::min(first + kArity, n);
+      for (std::size_t c = first + 1; c < end; ++c)
+        if (runs_before(m_heap[c], m_heap[best])) best = c;
+      if (!runs_before(m_heap[best], last)) break;
+      m_heap[i] = m_heap[best];
+      i = best;
+    }
+    m_heap[i] = last;
+  }
   m_now = e.when;
   ++m_events_run;
   e.target->on_event(e.when, e.tag);

@@ -18,16 +18,18 @@ bool runs_before(const E& a, const E& b) {
 
 void Scheduler::schedule(Ticks when, EventTarget& target, std::uint64_t tag) {
   if (when < m_now) when = m_now;
-  const Entry e{when, m_seq++, &target, tag};
+  // The new entry has the highest sequence number, so it goes before a parent only if it is
+  // due strictly earlier.
   std::size_t i = m_heap.size();
-  m_heap.push_back(e);
+  m_heap.emplace_back();
+  Entry* h = m_heap.data();
   while (i > 0) {
     const std::size_t parent = (i - 1) / kArity;
-    if (!runs_before(e, m_heap[parent])) break;
-    m_heap[i] = m_heap[parent];
+    if (h[parent].when <= when) break;
+    h[i] = h[parent];
     i = parent;
   }
-  m_heap[i] = e;
+  h[i] = Entry{when, m_seq++, &target, tag};
 }
 
 void Scheduler::schedule(Ticks when, std::function<void()> fn) {
@@ -53,11 +55,11 @@ void Scheduler::FnTarget::on_event(Ticks, std::uint64_t tag) {
 
 bool Scheduler::step() {
   if (m_heap.empty()) return false;
-  const Entry e = m_heap.front();
-  const Entry last = m_heap.back();
-  m_heap.pop_back();
-  if (const std::size_t n = m_heap.size(); n > 0) {
-    // Sift `last` down from the root.
+  Entry* h = m_heap.data();
+  const Entry e = h[0];
+  if (const std::size_t n = m_heap.size() - 1; n > 0) {
+    // Sift the last entry down from the root (over the first n entries).
+    const Entry last = h[n];
     std::size_t i = 0;
     for (;;) {
       const std::size_t first = i * kArity + 1;
@@ -65,13 +67,14 @@ bool Scheduler::step() {
       std::size_t best = first;
       const std::size_t end = std::min(first + kArity, n);
       for (std::size_t c = first + 1; c < end; ++c)
-        if (runs_before(m_heap[c], m_heap[best])) best = c;
-      if (!runs_before(m_heap[best], last)) break;
-      m_heap[i] = m_heap[best];
+        if (runs_before(h[c], h[best])) best = c;
+      if (!runs_before(h[best], last)) break;
+      h[i] = h[best];
       i = best;
     }
-    m_heap[i] = last;
+    h[i] = last;
   }
+  m_heap.pop_back();
   m_now = e.when;
   ++m_events_run;
   e.target->on_event(e.when, e.tag);

@@ -418,7 +418,10 @@ void PcapngWriter::put_epb(bus::Ticks ts, bus::Ticks now, std::uint32_t if_id,
   put32(p + 24, len);
   if (!data.empty()) std::memcpy(p + 28, data.data(), data.size());
   std::size_t o = 28 + data.size();
-  while (o & 3) p[o++] = 0;
+  // Zero padding to 32 bits in one store: the block always ends with its 4-octet length, which
+  // is written after this, so the store never leaves the block.
+  put32(p + o, 0);
+  o = pad4(o);
   if (opts) {
     if (flags) {
       std::uint8_t v[4];

@@ -16,9 +16,10 @@
 //                               millisecond records PacedRunner::virtual_now() - now.
 //                               Counters lag_min_us, lag_median_us, lag_p99_us, lag_max_us over
 //                               those samples, report_max_lag_us (the runner's own worst
-//                               wake-up), late_wakeups (> 1 ms late) and cpu_share (CPU time of
-//                               the thread / wall time: the part of one core the plant needs at
-//                               1x).
+//                               wake-up), late_wakeups (> 1 ms late), wakeups_per_s (loop
+//                               iterations that ran events, per wall second) and cpu_share (CPU
+//                               time of the thread / wall time: the part of one core the plant
+//                               needs at 1x).
 
 #include <benchmark/benchmark.h>
 #include <malloc.h>
@@ -157,6 +158,8 @@ void BM_PlantPaced(benchmark::State& state) {
     state.counters["report_max_lag_us"] =
         static_cast<double>(runner.report().max_lag.count()) / 1000.0;
     state.counters["late_wakeups"] = static_cast<double>(runner.report().late_wakeups);
+    state.counters["wakeups_per_s"] =
+        wall > 0 ? static_cast<double>(runner.report().wakeups) / wall : 0;
     state.counters["cpu_share"] = wall > 0 ? cpu / wall : 0;
     // No probe event is left in the queue: the last one ran at from + run and scheduled none.
   }

@@ -15,6 +15,12 @@ constexpr std::uint64_t kTagTimer = 0, kTagTxStart = 1, kTagBabble = 2;
 /// repair (babble off) takes effect within a few character times.
 constexpr std::size_t kBabbleBurst = 32;
 
+/// Idle time at `start` of a receiver that last heard something until `heard` (kNeverHeard:
+/// nothing since power-on).
+Ticks idle_since(Ticks heard, Ticks start) {
+  return heard == kNeverHeard ? kIdleForever : std::max<Ticks>(0, start - heard);
+}
+
 /// Destination address octet of an FDL frame, or -1 if the frame has none (SC, garbage).
 int frame_da(std::span<const std::uint8_t> b) {
   if (b.empty()) return -1;
@@ -39,7 +45,15 @@ struct Line::Transmission {
   bool cut_counted = false;  // counted in LineStats::partial already
   Mask rx;
   std::uint64_t probes = 0;  // probe taps (bits of m_probes) still hearing it
-  /// Idle time each receiver had seen when this frame started (valid where rx is set).
+  /// What the layers above worked out from `bytes` (frame_memo.hpp): handed to every receiver
+  /// and tap; emptied whenever `bytes` change.
+  mutable FrameMemo memo;
+  /// How receivers' idle time before this frame is known (see Line::settle_heard()):
+  ///  - lazy (the usual case): from m_heard_until[i] and `seg_heard_before`, the end of the
+  ///    latest activity on the sender's segment in the current epoch before this frame;
+  ///  - eager (after a fault in flight): `idle_before[i]`, valid where rx is set.
+  bool lazy_idle = true;
+  Ticks seg_heard_before = 0;
   std::array<Ticks, kMaxAttachments> idle_before{};
 };
 
@@ -166,6 +180,7 @@ Line::~Line() = default;
 
 AttachmentId Line::attach(Device& dev, std::string label) {
   if (m_atts.size() >= kMaxAttachments) throw std::length_error("line " + m_name + ": too many attachments");
+  settle_heard();
   const int id = static_cast<int>(m_atts.size());
   m_atts.push_back(std::make_unique<Attachment>(*this, id, dev, std::move(label)));
   dev.bind(m_atts.back()->port);
@@ -308,10 +323,29 @@ bool Line::accepts(std::size_t i, int da) const {
 
 void Line::refresh_listening() {
   m_listening.assign(m_atts.empty() ? 1 : static_cast<std::size_t>(m_atts.back()->segment) + 1, Mask{});
+  m_seg_heard.assign(m_listening.size(), kNeverHeard);  // a new epoch (settle_heard() came first)
   refresh_probes();
   if (m_short) return;
   for (auto& a : m_atts)
     if (a->powered && a->xcvr_ok) m_listening[static_cast<std::size_t>(a->segment)].set(static_cast<std::size_t>(a->id));
+}
+
+void Line::settle_heard() {
+  // Frames on the wire get their receivers' idle times now, from the epoch's values.
+  for (auto& t : m_in_flight) {
+    if (!t->lazy_idle) continue;
+    t->rx.for_each([&](std::size_t i) {
+      t->idle_before[i] = idle_since(std::max(m_heard_until[i], t->seg_heard_before), t->start);
+    });
+    t->lazy_idle = false;
+  }
+  // Listeners have heard their segment's latest activity.
+  for (std::size_t s = 0; s < m_listening.size(); ++s) {
+    const Ticks h = m_seg_heard[s];
+    if (h == kNeverHeard) continue;
+    m_listening[s].for_each([&](std::size_t i) { m_heard_until[i] = std::max(m_heard_until[i], h); });
+  }
+  m_seg_heard.assign(m_listening.size(), kNeverHeard);
 }
 
 void Line::recompute_segments() {
@@ -389,19 +423,19 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
   t->end = end;
   t->flags = babble ? kRxBabble : 0;
   t->cut_counted = false;
+  t->memo.clear();
   // Everyone listening on the sender's segment (the sender is listening: it got this far).
   t->rx = m_listening[static_cast<std::size_t>(from.segment)];
   t->probes = m_probe_by_segment[static_cast<std::size_t>(from.segment)];
   const auto self = static_cast<std::size_t>(from.id);
   t->rx.reset(self);
-  t->rx.for_each([&](std::size_t i) {
-    // Idle as this receiver's UART saw it when the first start bit arrived: zero if it was
-    // still hearing something (a collision), "forever" if nothing since power-on.
-    const Ticks h = m_heard_until[i];
-    t->idle_before[i] = h == kNeverHeard ? kIdleForever : std::max<Ticks>(0, now - h);
-    m_heard_until[i] = std::max(h, end);
-  });
-  m_heard_until[self] = std::max(m_heard_until[self], end);  // RS-485 transceivers hear themselves
+  // Everyone listening on the segment hears this frame until `end`, the sender included (RS-485
+  // transceivers hear themselves): one per-segment value instead of one per listener
+  // (settle_heard()). What each receiver had heard before it is what its idle time is made of.
+  Ticks& seg_heard = m_seg_heard[static_cast<std::size_t>(from.segment)];
+  t->lazy_idle = true;
+  t->seg_heard_before = seg_heard;
+  seg_heard = std::max(seg_heard, end);
 
   // Overlap with anything else on the same segment corrupts both.
   for (auto& o : m_in_flight) {
@@ -412,6 +446,7 @@ void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes
     t->flags |= kRxCollision;
     garble(o->bytes, o->start, char_ticks, now, std::min(o->end, t->end), next_random());
     garble(t->bytes, t->start, char_ticks, now, std::min(o->end, t->end), next_random());
+    o->memo.clear();  // a cut-short view of `o` may have been decoded already
   }
   apply_noise(*t);
   m_sched.schedule(t->end, *this, t->id);
@@ -424,8 +459,12 @@ void Line::deliver(Transmission& t, std::size_t to, std::size_t len, std::uint16
   f.bytes = std::span<const std::uint8_t>(t.bytes.data(), len);
   f.start = t.start;
   f.end = end;
-  f.idle_before = t.idle_before[to];
+  // Idle as this receiver's UART saw it when the first start bit arrived: zero if it was still
+  // hearing something (a collision), "forever" if nothing since power-on.
+  f.idle_before = t.lazy_idle ? idle_since(std::max(m_heard_until[to], t.seg_heard_before), t.start)
+                              : t.idle_before[to];
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
+  f.memo = &t.memo;
   dev.on_frame(f);
   refresh_filter(to);
 }
@@ -440,6 +479,7 @@ TapFrame Line::tap_view(const Transmission& t, std::size_t len, std::uint16_t ex
   f.flags = static_cast<std::uint16_t>(t.flags | extra_flags);
   f.sender = static_cast<std::uint16_t>(t.from->id);
   f.sent_len = static_cast<std::uint32_t>(t.sent_len);
+  f.memo = &t.memo;
   return f;
 }
 
@@ -576,6 +616,8 @@ void Line::join_in_flight() {
       y.flags |= kRxCollision;
       garble(x.bytes, x.start, char_ticks, now, std::min(x.end, y.end), next_random());
       garble(y.bytes, y.start, char_ticks, now, std::min(x.end, y.end), next_random());
+      x.memo.clear();
+      y.memo.clear();
     }
   }
 }
@@ -588,6 +630,7 @@ void Line::emit_event(LineEventKind k, int a, int b, std::uint64_t v) {
 void Line::set_cut_after(AttachmentId a, bool cut) {
   auto& att = *m_atts.at(static_cast<std::size_t>(a));
   if (att.cut_after == cut) return;
+  settle_heard();
   att.cut_after = cut;
   recompute_segments();
   refresh_listening();
@@ -603,6 +646,7 @@ void Line::set_cut_between(AttachmentId a, AttachmentId b, bool cut) {
 
 void Line::set_short_circuit(bool on) {
   if (m_short == on) return;
+  settle_heard();
   m_short = on;
   refresh_listening();
   if (on) truncate_in_flight();
@@ -617,6 +661,7 @@ void Line::set_noise(std::uint64_t errors_per_billion) {
 void Line::set_power(AttachmentId id, bool on) {
   auto& a = *m_atts.at(static_cast<std::size_t>(id));
   if (a.powered == on) return;
+  settle_heard();
   const Ticks now = m_sched.now();
   if (!on) {
     a.powered = false;
@@ -647,6 +692,7 @@ void Line::set_power(AttachmentId id, bool on) {
 void Line::set_transceiver_ok(AttachmentId id, bool ok) {
   auto& a = *m_atts.at(static_cast<std::size_t>(id));
   if (a.xcvr_ok == ok) return;
+  settle_heard();
   a.xcvr_ok = ok;
   refresh_listening();
   if (!ok) truncate_in_flight();

@@ -8,6 +8,7 @@
 
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/bus/line.hpp"
+#include "pbvbus/fdl/decoded_frame.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::captures {
@@ -417,7 +418,10 @@ void PcapngWriter::put_epb(bus::Ticks ts, bus::Ticks now, std::uint32_t if_id,
   put32(p + 24, len);
   if (!data.empty()) std::memcpy(p + 28, data.data(), data.size());
   std::size_t o = 28 + data.size();
-  while (o & 3) p[o++] = 0;
+  // Zero padding to 32 bits in one store: the block always ends with its 4-octet length, which
+  // is written after this, so the store never leaves the block.
+  put32(p + o, 0);
+  o = pad4(o);
   if (opts) {
     if (flags) {
       std::uint8_t v[4];
@@ -444,8 +448,8 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
   // Fast path: an intact frame that decodes needs neither flags nor comment.
   std::uint32_t flags = 0;
   std::string_view comment;
-  fdl::Telegram t;
-  if (f.flags != 0 || fdl::decode(f.bytes, t) != fdl::DecodeError::None) {
+  fdl::DecodedFrame scratch;
+  if (f.flags != 0 || !fdl::decode_once(f, scratch).ok()) {
     flags = classify_frame(f.bytes, f.flags, f.sent_len, m_comment);
     comment = m_comment;
   }

@@ -22,7 +22,7 @@ std::vector<dp::SlaveParams> slave_params(const DpMasterPlan& plan,
 DpMasterNode::DpMasterNode(const DpMasterPlan& plan, const std::vector<DpSlavePlan>& slaves,
                            const fdl::BusParams& params)
     : m_master(plan.params, slave_params(plan, slaves)), m_program(plan.outputs),
-      m_program_off(plan.gateway_outputs) {
+      m_program_off(plan.gateway_outputs), m_addresses(m_master.addresses()) {
   m_station = std::make_unique<fdl::ActiveStation>(plan.params.address, params, *this);
 }
 
@@ -49,7 +49,7 @@ void DpMasterNode::on_token(bus::Ticks now, bus::Ticks trr) {
   // The "PLC program": one output update per token receipt, i.e. per bus cycle.
   const auto value =
       static_cast<std::uint8_t>(m_program == scenario::DpMaster::COUNT ? (m_tokens & 0xFF) : 0);
-  for (std::uint8_t a : m_master.addresses()) {
+  for (std::uint8_t a : m_addresses) {
     dp::MasterImage& img = m_master.image(a);
     for (std::size_t mod = 0; mod < img.modules(); ++mod) {
       const std::size_t n = img.module(mod).out_len;

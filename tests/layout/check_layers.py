@@ -11,7 +11,7 @@ Checks, from the source tree alone:
      reaches through its dependencies (a header-only upward include links, so CMake alone would
      not catch it);
   4. the tests mirror the tree: every tests/<folder>/ with *_test.cpp files belongs to a target of
-     the same folder (or is one of the cross-cutting suites: integration, support, fuzz, layout).
+     the same folder (or is one of the cross-cutting suites: integration, hotpath, support, fuzz, layout).
 Exit status 0 when all hold; otherwise each problem on its own line and exit status 1.
 """
 import pathlib
@@ -19,7 +19,7 @@ import re
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-CROSS_CUTTING = {"integration", "support", "fuzz", "layout", "data"}
+CROSS_CUTTING = {"integration", "support", "fuzz", "layout", "data", "hotpath"}
 
 
 def cmake_targets():

@@ -1,5 +1,7 @@
 #include "pbvbus/fdl_traffic/fdl_poller.hpp"
 
+#include "pbvbus/fdl_traffic/fdl_responder.hpp"
+
 namespace pbvbus::devices {
 
 FdlPoller::FdlPoller(std::vector<PollItem> items)
@@ -49,7 +51,7 @@ bool FdlPoller::next_request(fdl::Priority prio, bus::Ticks, fdl::Request& out) 
     out.ssap.reset();
     out.data.resize(it.length);
     const std::uint8_t seq = m_seq[k]++;
-    for (std::size_t j = 0; j < it.length; ++j) out.data[j] = static_cast<std::uint8_t>(seq + j);
+    fill_counting(out.data, seq);
     out.tag = k;
     return true;
   }

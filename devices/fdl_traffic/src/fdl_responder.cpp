@@ -13,7 +13,7 @@ void FdlResponder::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
         return;
       }
       const auto c = static_cast<std::uint8_t>(m_cycle++);
-      for (std::size_t i = 0; i < m_data.size(); ++i) m_data[i] = static_cast<std::uint8_t>(c + i);
+      fill_counting(m_data, c);
       reply.respond(fdl::ResponseStatus::DL, m_data);
       return;
     }

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "pbvbus/fdl/decoded_frame.hpp"
+
 namespace pbvbus::fdl {
 
 std::string_view to_string(MacState s) {
@@ -250,8 +252,10 @@ void ActiveStation::on_frame(const bus::RxFrame& f) {
   if (!m_powered) return;
   const bus::Ticks now = f.end;
   m_last_activity = std::max(m_last_activity, f.end);
-  Telegram t;
-  const bool valid = f.intact() && decode(f.bytes, t) == DecodeError::None;
+  DecodedFrame scratch;  // stays "not decoded" for a damaged frame
+  const DecodedFrame& d = f.intact() ? decode_once(f, scratch) : scratch;
+  const bool valid = d.ok();
+  const Telegram& t = d.telegram;
 
   if (valid && t.type != FrameType::SC && t.sa == m_ts) {
     // Someone else sends with our address.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "pbvbus/fdl/decoded_frame.hpp"
+
 namespace pbvbus::fdl {
 
 PassiveStation::PassiveStation(std::uint8_t address, const BusParams& params, ResponderUser& user,
@@ -66,11 +68,13 @@ void PassiveStation::on_frame(const bus::RxFrame& frame) {
     ++m_stats.dropped_errors;
     return;
   }
-  Telegram t;
-  if (decode(frame.bytes, t) != DecodeError::None) {
+  DecodedFrame scratch;
+  const DecodedFrame& d = decode_once(frame, scratch);
+  if (!d.ok()) {
     ++m_stats.dropped_errors;
     return;
   }
+  const Telegram& t = d.telegram;
   // Tokens, acknowledgements and responses are no business of a passive station.
   if (!t.is_request()) return;
   if (t.da != m_address && t.da != kBroadcast) return;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <span>
 
+#include "pbvbus/bus/frame_memo.hpp"
 #include "pbvbus/bus/time.hpp"
 
 namespace pbvbus::bus {
@@ -32,6 +33,10 @@ struct RxFrame {
   /// kIdleForever if the receiver has seen no activity since power-on.
   Ticks idle_before = 0;
   std::uint16_t flags = 0;  ///< RxFlag bits; 0 = every character arrived intact
+  /// The transmission's slot for a decoded view of `bytes`, shared with every other receiver
+  /// and tap of the same frame (frame_memo.hpp); nullptr for frames that come from no line
+  /// (a unit test driving a device by hand). Valid only during the call.
+  FrameMemo* memo = nullptr;
   bool intact() const { return flags == 0; }
 };
 inline constexpr Ticks kIdleForever = INT64_MAX / 4;

@@ -201,6 +201,10 @@ class Line final : private EventTarget {
   void recompute_segments();
   /// Rebuilds m_listening after any change of power, transceiver, cut or short.
   void refresh_listening();
+  /// Ends an epoch of the idle-time bookkeeping: writes every listener's m_heard_until from
+  /// m_seg_heard and gives the frames on the wire their receivers' idle times. Called before
+  /// anything changes who listens on which segment (attach, power, transceiver, cut, short).
+  void settle_heard();
   /// After a topology or power change: cut short every in-flight frame for receivers that can
   /// no longer hear its sender.
   void truncate_in_flight();
@@ -234,10 +238,16 @@ class Line final : private EventTarget {
   std::vector<Device*> m_devs;
   /// End of the last activity an attachment has heard or is hearing (frames received, cut
   /// short for it or still on the wire, its own transmissions); the start of its idle time.
+  /// For a listener, only up to the start of the current epoch (see m_seg_heard).
   std::vector<Ticks> m_heard_until;
   /// Per segment: attachments that are powered and have a working transceiver (none while
   /// the line is shorted).
   std::vector<Mask> m_listening;
+  /// Per segment: end of the latest activity on it in the current epoch (kNeverHeard: none).
+  /// Between two changes of who listens where (an epoch), every listener of a segment hears
+  /// every frame on it, so a listener has heard until max(m_heard_until, this): a frame costs
+  /// one update instead of one per listener. settle_heard() folds it into m_heard_until.
+  std::vector<Ticks> m_seg_heard;
   /// Cached receive filters (kReceiveAll or 0..126) and the masks built from them, so that a
   /// frame reaches its addressee without asking 32 other stations whether they want it.
   std::vector<int> m_filter;

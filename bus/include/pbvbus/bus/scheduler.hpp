@@ -3,7 +3,7 @@
 //
 // Events at the same tick run in the order they were scheduled, so a run is a pure function of
 // its inputs. There is no cancel: owners that may change their mind keep a generation counter
-// in the tag and ignore stale events, which keeps the queue a plain binary heap.
+// in the tag and ignore stale events, which keeps the queue a plain (4-ary) heap.
 
 #include <cstdint>
 #include <functional>

@@ -14,6 +14,7 @@
 #include <span>
 #include <string_view>
 
+#include "pbvbus/bus/frame_memo.hpp"
 #include "pbvbus/bus/time.hpp"
 
 namespace pbvbus::bus {
@@ -32,6 +33,9 @@ struct TapFrame {
   /// Cable position (attachment index) of the probe that saw it; -1 for a whole-line tap.
   std::int16_t probe = -1;
   std::uint32_t sent_len = 0;           ///< octets the transmitter intended to send
+  /// The transmission's decoded-view slot, shared with its receivers (frame_memo.hpp); nullptr
+  /// for frames that come from no line. Valid only during the call.
+  FrameMemo* memo = nullptr;
 };
 
 enum class LineEventKind : std::uint8_t {

@@ -66,6 +66,9 @@ class DpMasterNode final : public fdl::InitiatorUser {
   std::uint64_t m_tokens = 0;
   std::uint64_t m_global_controls = 0;
   std::vector<std::uint8_t> m_buf;
+  /// The master's slaves (fixed when the master is built): the program walks them at every
+  /// token receipt, without building the list each time.
+  std::vector<std::uint8_t> m_addresses;
 };
 
 /// The I/O behaviours of a planned slave (its `inputs` default per input module, then its `io`

@@ -11,12 +11,33 @@
 //  - Other services (Ident, LSAP status, ...) keep the station's default reply RS ("SAP not
 //    activated"); FDL status requests are answered by the station itself.
 
+#include <bit>
 #include <cstdint>
+#include <cstring>
+#include <span>
 #include <vector>
 
 #include "pbvbus/fdl/station.hpp"
 
 namespace pbvbus::devices {
+
+/// The data pattern of the FDL traffic users (this responder's replies, FdlPoller's requests):
+/// out[i] = (first + i) mod 256. Eight octets per step (it is written for every frame): each
+/// octet of a word is added to separately, so a carry never crosses into the next octet.
+inline void fill_counting(std::span<std::uint8_t> out, std::uint8_t first) {
+  constexpr std::uint64_t kHigh = 0x8080808080808080ULL;
+  // Octet-wise a + b for b < 0x80 in every octet: add the low seven bits, put bit 7 back.
+  auto add = [](std::uint64_t a, std::uint64_t b) { return ((a & ~kHigh) + b) ^ (a & kHigh); };
+  std::uint64_t w = add(first * 0x0101010101010101ULL, 0x0706050403020100ULL);
+  std::size_t i = 0;
+  if constexpr (std::endian::native == std::endian::little) {  // octet k of w is out[i + k]
+    for (; i + 8 <= out.size(); i += 8) {
+      std::memcpy(out.data() + i, &w, 8);
+      w = add(w, 0x0808080808080808ULL);
+    }
+  }
+  for (; i < out.size(); ++i) out[i] = static_cast<std::uint8_t>(first + i);
+}
 
 class FdlResponder final : public fdl::ResponderUser {
  public:

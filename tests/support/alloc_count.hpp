@@ -1,6 +1,7 @@
 #pragma once
 // Counts heap allocations made through global operator new in this test binary
-// (alloc_count_helpers.cpp replaces it), so that tests can check a hot path allocates nothing.
+// (each suite that counts has an alloc_count_helpers.cpp that replaces it: tests/bus,
+// tests/hotpath), so that tests can check a hot path allocates nothing.
 
 #include <cstdint>
 

@@ -39,7 +39,6 @@ void add_flag_reasons(std::uint32_t flags, std::vector<std::string>& out) {
   for (std::string_view r : names::flag_reasons(flags)) out.emplace_back(r);
 }
 
-using names::format_time_ns;
 
 std::string format_speed(std::uint64_t s) {
   if (s == 0) return "speed unknown";
@@ -281,15 +280,15 @@ std::string to_text(const CaptureSummary& s) {
   o += "Records: " + std::to_string(s.records) + " (" + std::to_string(s.events.size()) +
        " events)\n";
   if (s.first_ns)
-    o += "Time span: " + format_time_ns(*s.first_ns) + " .. " + format_time_ns(*s.last_ns) + " (" +
-         format_time_ns(*s.last_ns - *s.first_ns) + ")\n";
+    o += "Time span: " + names::format_time_ns(*s.first_ns) + " .. " + names::format_time_ns(*s.last_ns) + " (" +
+         names::format_time_ns(*s.last_ns - *s.first_ns) + ")\n";
   for (std::size_t i = 0; i < s.interfaces.size(); ++i) {
     const InterfaceSummary& is = s.interfaces[i];
     o += "Interface " + std::to_string(i) + " '" + is.name + "' (" + link_name(is.link_type) +
          ", " + format_speed(is.speed) + "): " + std::to_string(is.frames) + " records, " +
          std::to_string(is.octets) + " octets\n";
     if (is.first_ns)
-      o += "  time span: " + format_time_ns(*is.first_ns) + " .. " + format_time_ns(*is.last_ns) + "\n";
+      o += "  time span: " + names::format_time_ns(*is.first_ns) + " .. " + names::format_time_ns(*is.last_ns) + "\n";
     if (!is_line_link(is.link_type)) continue;
     o += "  frame types: " + text_map(is.by_type) + "\n";
     o += "  requests: " + text_map(is.by_request) + "\n";
@@ -305,7 +304,7 @@ std::string to_text(const CaptureSummary& s) {
   }
   o += "Events: " + std::to_string(s.events.size()) + "\n";
   for (const EventSummary& e : s.events)
-    o += "  " + format_time_ns(e.ts_ns) + "  [" + e.category + "] " + e.text + "\n";
+    o += "  " + names::format_time_ns(e.ts_ns) + "  [" + e.category + "] " + e.text + "\n";
   if (s.bad_event_records)
     o += "Unreadable event records: " + std::to_string(s.bad_event_records) + "\n";
   return o;

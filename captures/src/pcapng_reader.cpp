@@ -6,21 +6,13 @@
 #include <limits>
 
 #include "pbvbus/captures/pcapng_format.hpp"
+#include "saturate.hpp"
 
 namespace pbvbus::captures {
 
 namespace {
-__extension__ typedef __int128 i128;
 
-constexpr std::size_t pad4(std::size_t n) {
-  return (n + 3) & ~std::size_t{3};
-}
-
-std::int64_t saturate(i128 v) {
-  if (v > std::numeric_limits<std::int64_t>::max()) return std::numeric_limits<std::int64_t>::max();
-  if (v < std::numeric_limits<std::int64_t>::min()) return std::numeric_limits<std::int64_t>::min();
-  return static_cast<std::int64_t>(v);
-}
+using pcapng::pad4;
 
 std::int64_t to_ns(std::uint64_t ts, std::uint8_t tsresol, std::int64_t offset_s) {
   const int n = tsresol & 0x7F;

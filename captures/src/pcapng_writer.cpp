@@ -32,9 +32,7 @@ inline void put64(std::uint8_t* p, std::uint64_t v) {
 static_assert(std::endian::native == std::endian::little,
               "the writer emits native-order (little-endian) sections");
 
-constexpr std::size_t pad4(std::size_t n) {
-  return (n + 3) & ~std::size_t{3};
-}
+using pcapng::pad4;
 constexpr std::size_t option_size(std::size_t value_len) {
   return 4 + pad4(value_len);
 }

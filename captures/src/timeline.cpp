@@ -11,23 +11,18 @@
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
+#include "saturate.hpp"
 #include "capture_names.hpp"
 
 namespace pbvbus::captures {
 
 namespace {
-__extension__ typedef __int128 i128;
 
 constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
 constexpr std::int64_t kMin = std::numeric_limits<std::int64_t>::min();
 /// if_speed values above this are treated as unknown (keeps every product inside i128).
 constexpr std::uint64_t kMaxSpeed = 1'000'000'000'000ULL;
 
-std::int64_t saturate(i128 v) {
-  if (v > kMax) return kMax;
-  if (v < kMin) return kMin;
-  return static_cast<std::int64_t>(v);
-}
 std::int64_t sat_sub(std::int64_t a, std::int64_t b) {
   return saturate(static_cast<i128>(a) - static_cast<i128>(b));
 }

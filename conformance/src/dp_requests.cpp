@@ -35,8 +35,6 @@ std::vector<std::uint8_t> encode_request(std::uint8_t da, std::uint8_t sa, std::
   return {b.begin(), b.end()};
 }
 
-std::string hex(std::span<const std::uint8_t> b) { return hex_octets(b); }
-
 }  // namespace
 
 std::vector<std::uint8_t> srd(std::uint8_t da, std::uint8_t sa, std::optional<std::uint8_t> dsap,
@@ -70,7 +68,7 @@ std::string Reply::describe() const {
     case Kind::Sc: return "SC";
     case Kind::Telegram: {
       std::string s(fdl::to_string(status));
-      if (!data.empty()) s += " " + hex(data);
+      if (!data.empty()) s += " " + hex_octets(data);
       return s;
     }
   }
@@ -82,14 +80,14 @@ Reply reply_of(const Exchange& e) {
   if (!e.answered) return r;
   if (e.response_flags != 0) {
     r.kind = Reply::Kind::Bad;
-    r.error = "receive errors (flags " + std::to_string(e.response_flags) + "): " + hex(e.response);
+    r.error = "receive errors (flags " + std::to_string(e.response_flags) + "): " + hex_octets(e.response);
     return r;
   }
   fdl::Telegram t;
   const fdl::DecodeError err = fdl::decode(e.response, t);
   if (err != fdl::DecodeError::None) {
     r.kind = Reply::Kind::Bad;
-    r.error = std::string(fdl::to_string(err)) + ": " + hex(e.response);
+    r.error = std::string(fdl::to_string(err)) + ": " + hex_octets(e.response);
     return r;
   }
   if (t.type == fdl::FrameType::SC) {
@@ -98,7 +96,7 @@ Reply reply_of(const Exchange& e) {
   }
   if (t.type == fdl::FrameType::SD4 || t.is_request()) {
     r.kind = Reply::Kind::Bad;
-    r.error = "not a response: " + hex(e.response);
+    r.error = "not a response: " + hex_octets(e.response);
     return r;
   }
   r.kind = Reply::Kind::Telegram;

@@ -22,7 +22,7 @@ namespace {
 
 using devices::SlaveMutant;
 
-constexpr const char* kGroup = "Chk_Cfg";
+constexpr const char* kChkCfgGroup = "Chk_Cfg";
 
 void right_config(TestContext& ctx, TestResult& r) {
   auto s = open_session(ctx, r);
@@ -93,19 +93,19 @@ void chk_cfg_in_wait_prm(TestContext& ctx, TestResult& r) {
 }  // namespace
 
 void add_chk_cfg_tests(std::vector<TestCase>& out) {
-  out.push_back({"CFG-01", kGroup, "Right configuration accepted",
+  out.push_back({"CFG-01", kChkCfgGroup, "Right configuration accepted",
                  "Chk_Cfg with the slave's real configuration (the GSD modules' identifiers in order) "
                  "after a good Set_Prm brings it to Data_Exch (§D.3, §D.8)",
                  right_config, {}});
-  out.push_back({"CFG-02", kGroup, "Wrong identifier refused",
+  out.push_back({"CFG-02", kChkCfgGroup, "Wrong identifier refused",
                  "Chk_Cfg with one identifier changed sets Cfg_Fault (diag octet 1 bit 2) and the "
                  "slave goes back to Wait_Prm (§D.3, §D.8)",
                  wrong_identifier, {SlaveMutant::AcceptWrongCfg}});
-  out.push_back({"CFG-03", kGroup, "Wrong configuration length refused",
+  out.push_back({"CFG-03", kChkCfgGroup, "Wrong configuration length refused",
                  "Chk_Cfg with more or fewer identifier octets than the real configuration sets "
                  "Cfg_Fault (§D.3)",
                  wrong_length, {SlaveMutant::AcceptWrongCfg}});
-  out.push_back({"CFG-04", kGroup, "Chk_Cfg in Wait_Prm refused",
+  out.push_back({"CFG-04", kChkCfgGroup, "Chk_Cfg in Wait_Prm refused",
                  "Before a Set_Prm, Chk_Cfg does not bring the slave to data exchange (Wait_Prm accepts "
                  "only Set_Prm, Slave_Diag, Get_Cfg, Set_Slave_Add; §D.8)",
                  chk_cfg_in_wait_prm, {}});

@@ -22,7 +22,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Class 2";
+constexpr const char* kClass2Group = "Class 2";
 
 bool data_answer(const TestContext& ctx, const Reply& r) {
   return r.ok_with_data() || (r.kind == Reply::Kind::Sc && ctx.input_len() == 0);
@@ -152,25 +152,25 @@ void takes_control_after_watchdog(TestContext& ctx, TestResult& res) {
 void add_class2_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "C2-01", kGroup, "Class-2 reads of a locked slave",
+      "C2-01", kClass2Group, "Class-2 reads of a locked slave",
       "While another master owns the slave, a class-2 master gets Slave_Diag (Master_Add = the "
       "owner), Get_Cfg, Rd_Inp and Rd_Outp answered (IEC 61158-6 DP; protocol-facts.md §D.8 "
       "Locking, §D.4, §D.7)",
       {SlaveMutant::WrongGetCfg}, reads_while_locked));
   out.push_back(make_case(
-      "C2-02", kGroup, "Class-2 Set_Prm has no effect while locked",
+      "C2-02", kClass2Group, "Class-2 Set_Prm has no effect while locked",
       "A Set_Prm or Chk_Cfg from a master other than the owner has no effect on a locked slave; "
       "its Data_Exchange is refused (IEC 61158-6 DP locking; protocol-facts.md §D.8, §D.2)",
       {SlaveMutant::IgnoreLock}, foreign_set_prm));
   out.push_back(make_case(
-      "C2-03", kGroup, "Class 2 takes control after unlock",
+      "C2-03", kClass2Group, "Class 2 takes control after unlock",
       "After the owner's Set_Prm with Unlock_Req the slave accepts another master's Set_Prm and "
       "Chk_Cfg; Master_Add becomes that master (IEC 61158-6 DP; protocol-facts.md §D.2 "
       "Lock/Unlock, "
       "§D.8)",
       {}, takes_control_after_unlock));
   out.push_back(make_case(
-      "C2-04", kGroup, "Class 2 takes control after the owner's watchdog",
+      "C2-04", kClass2Group, "Class 2 takes control after the owner's watchdog",
       "After the owner's watchdog has expired the slave is unlocked and accepts another master's "
       "parameterisation (IEC 61158-6 DP response monitoring; protocol-facts.md §D.8)",
       {SlaveMutant::IgnoreWatchdog}, takes_control_after_watchdog));

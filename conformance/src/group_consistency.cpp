@@ -25,7 +25,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Consistency";
+constexpr const char* kConsistencyGroup = "Consistency";
 constexpr int kCycles = 200;
 
 bool words_equal(std::span<const std::uint8_t> m, std::size_t width) {
@@ -111,7 +111,7 @@ void consistent_module(TestContext& ctx, TestResult& res) {
 void add_consistency_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "CON-01", kGroup, "Module consistent over its whole length",
+      "CON-01", kConsistencyGroup, "Module consistent over its whole length",
       "The input octets of a module whose identifier says \"consistent over the whole length\" "
       "come from one sampling instant, and its outputs are applied together (IEC 61158-6 DP "
       "configuration identifier bit 7; protocol-facts.md §D.3, §F)",

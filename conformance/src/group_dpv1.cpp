@@ -36,7 +36,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "DP-V1";
+constexpr const char* kDpv1Group = "DP-V1";
 
 bool dpv1_slave(Run& run) {
   if (!run.ctx().spec().gsd->dpv1().dpv1_slave) {
@@ -217,33 +217,33 @@ void alarm_ack(TestContext& ctx, TestResult& res) {
 void add_dpv1_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "V1-01", kGroup, "Set_Prm with DPV1_Enable",
+      "V1-01", kDpv1Group, "Set_Prm with DPV1_Enable",
       "A DP-V1 slave accepts Set_Prm whose User_Prm_Data starts with DPV1_Status_1..3 and "
       "DPV1_Enable set, and enters data exchange (IEC 61158-6 DP-V1; protocol-facts.md §D.2)",
       {}, dpv1_start_up));
   out.push_back(make_case(
-      "V1-02", kGroup, "MSAC_C1 Read of a known record",
+      "V1-02", kDpv1Group, "MSAC_C1 Read of a known record",
       "MSAC_C1 Read of an existing record is answered `5E Slot Index Length Data` in the same SRD "
       "(or after polls) (IEC 61158-6 DP-V1 MSAC_C1; protocol-facts.md §E.2, §E.4)",
       {}, read_known));
   out.push_back(make_case(
-      "V1-03", kGroup, "MSAC_C1 Read of an unknown index",
+      "V1-03", kDpv1Group, "MSAC_C1 Read of an unknown index",
       "MSAC_C1 Read of an index the slave does not have is answered with the negative response "
       "`DE 80 B0 xx` (Error_Decode DP-V1, access class, invalid index) (IEC 61158-6 DP-V1; "
       "protocol-facts.md §E.2, §E.3)",
       {SlaveMutant::Dpv1BadIndexAccepted}, read_unknown_index));
   out.push_back(make_case(
-      "V1-04", kGroup, "MSAC_C1 Write with a wrong length",
+      "V1-04", kDpv1Group, "MSAC_C1 Write with a wrong length",
       "MSAC_C1 Write whose Length disagrees with the data is answered `DF 80 B1 xx` (write length "
       "error) (IEC 61158-6 DP-V1; protocol-facts.md §E.2, §E.3)",
       {}, write_wrong_length));
   out.push_back(
-      make_case("V1-05", kGroup, "MSAC_C1 without DPV1_Enable refused",
+      make_case("V1-05", kDpv1Group, "MSAC_C1 without DPV1_Enable refused",
                 "MSAC_C1 is open only when Set_Prm set DPV1_Enable; otherwise Read/Write get RS "
                 "(IEC 61158-6 DP-V1; protocol-facts.md §D.2 DPV1_Status_1, docs/dp-slave.md)",
                 {}, not_enabled));
   out.push_back(make_case(
-      "V1-06", kGroup, "Alarm and Alarm_Ack",
+      "V1-06", kDpv1Group, "Alarm and Alarm_Ack",
       "An enabled alarm makes the owner's Data_Exchange answer DH and appears in the diagnosis "
       "until the master acknowledges it with Alarm_Ack (slot, type, Seq_Nr), which is echoed; an "
       "Alarm_Ack for no outstanding alarm gets `DC 80 B5 xx` (IEC 61158-6 DP-V1 alarms; "

@@ -20,7 +20,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Fail-safe";
+constexpr const char* kFailSafeGroup = "Fail-safe";
 
 void zero_length_outputs(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
@@ -96,14 +96,14 @@ void wrong_output_length(TestContext& ctx, TestResult& res) {
 void add_fail_safe_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(
-      make_case("FS-01", kGroup, "Data_Exchange without output data (Fail_Safe)",
+      make_case("FS-01", kFailSafeGroup, "Data_Exchange without output data (Fail_Safe)",
                 "A slave with GSD Fail_Safe = 1 accepts, in the master's Clear state, "
                 "Data_Exchange with zero "
                 "output octets: it answers with its inputs and sets its outputs to the safe state "
                 "(IEC 61158-6 DP; protocol-facts.md §D.8 Fail_Safe, §D.9 Output_Clear)",
                 {SlaveMutant::RejectFailSafe}, zero_length_outputs));
   out.push_back(make_case(
-      "FS-02", kGroup, "Wrong output length",
+      "FS-02", kFailSafeGroup, "Wrong output length",
       "A Data_Exchange whose output length differs from the configuration is refused and the slave "
       "returns to Wait_Prm with its outputs safe (IEC 61158-6 DP; protocol-facts.md §D.7, "
       "docs/dp-slave.md)",

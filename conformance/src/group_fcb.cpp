@@ -21,7 +21,7 @@ namespace {
 
 using devices::SlaveMutant;
 
-constexpr const char* kGroup = "FCB/FCV";
+constexpr const char* kFcbGroup = "FCB/FCV";
 constexpr std::uint8_t kReader = 2;
 
 bool setup(TestContext& ctx, TestResult& r, std::unique_ptr<Session>& s) {
@@ -112,16 +112,16 @@ void restart_after_set_prm(TestContext& ctx, TestResult& r) {
 }  // namespace
 
 void add_fcb_tests(std::vector<TestCase>& out) {
-  out.push_back({"FCB-01", kGroup, "Repeat not executed",
+  out.push_back({"FCB-01", kFcbGroup, "Repeat not executed",
                  "A Data_Exchange with FCV=1 and the same FCB as the previous one from that master is "
                  "a repeat: the slave resends its stored reply and does not take the new outputs "
                  "(IEC 61158-4-3 frame count bit; §C.6)",
                  repeat_not_executed, {SlaveMutant::IgnoreFcb}});
-  out.push_back({"FCB-02", kGroup, "Toggled FCB executed",
+  out.push_back({"FCB-02", kFcbGroup, "Toggled FCB executed",
                  "A Data_Exchange with FCV=1 and the FCB toggled is a new request: its outputs are "
                  "taken (§C.6)",
                  toggle_executed, {}});
-  out.push_back({"FCB-03", kGroup, "FCB restart after Set_Prm",
+  out.push_back({"FCB-03", kFcbGroup, "FCB restart after Set_Prm",
                  "After re-parameterisation the first frame (FCV=0, FCB=1) is executed and starts the "
                  "FCB sequence again: the next toggled frame is new, its repeat is not (§C.6)",
                  restart_after_set_prm, {SlaveMutant::IgnoreFcb}});

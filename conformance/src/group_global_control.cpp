@@ -26,7 +26,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Global_Control";
+constexpr const char* kGlobalControlGroup = "Global_Control";
 constexpr std::uint8_t kClearData = 0x02;
 constexpr std::uint8_t kUnfreeze = 0x04;
 constexpr std::uint8_t kFreeze = 0x08;
@@ -285,37 +285,37 @@ void sync_freeze_unsupported(TestContext& ctx, TestResult& res) {
 void add_global_control_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "GC-01", kGroup, "Clear_Data sets the outputs safe",
+      "GC-01", kGlobalControlGroup, "Clear_Data sets the outputs safe",
       "Global_Control with Clear_Data (Control_Command bit 1) sets the outputs to the safe state "
       "and holds them there until a Global_Control without Clear_Data; outputs received meanwhile "
       "are not applied (IEC 61158-6 DP Global_Control; protocol-facts.md §D.6, §D.9 Clear)",
       {SlaveMutant::IgnoreClearData}, clear_data));
   out.push_back(make_case(
-      "GC-02", kGroup, "Sync holds the outputs, Unsync releases them",
+      "GC-02", kGlobalControlGroup, "Sync holds the outputs, Unsync releases them",
       "With Sync_Req in Set_Prm, Sync applies the last received outputs and holds later ones "
       "until the next Sync; the diagnosis shows Sync_Mode; Unsync returns to immediate output "
       "(IEC 61158-6 DP Global_Control; protocol-facts.md §D.6, §D.4)",
       {SlaveMutant::IgnoreSync}, sync_unsync));
   out.push_back(make_case(
-      "GC-03", kGroup, "Freeze holds the inputs, Unfreeze releases them",
+      "GC-03", kGlobalControlGroup, "Freeze holds the inputs, Unfreeze releases them",
       "With Freeze_Req in Set_Prm, Freeze samples the inputs and Data_Exchange returns that "
       "sample until the next Freeze or Unfreeze; the diagnosis shows Freeze_Mode (IEC 61158-6 DP "
       "Global_Control; protocol-facts.md §D.6, §D.4)",
       {SlaveMutant::IgnoreFreeze}, freeze_unfreeze));
   out.push_back(make_case(
-      "GC-04", kGroup, "Group_Select",
+      "GC-04", kGlobalControlGroup, "Group_Select",
       "A Global_Control applies only if Group_Select & Group_Ident != 0 or Group_Select = 0; a "
       "command to another group is ignored (IEC 61158-6 DP Global_Control; protocol-facts.md "
       "§D.6, §D.2 octet 7)",
       {}, group_select));
   out.push_back(make_case(
-      "GC-05", kGroup, "Sync and Freeze need enabling in Set_Prm",
+      "GC-05", kGlobalControlGroup, "Sync and Freeze need enabling in Set_Prm",
       "Sync and Freeze act only when Set_Prm enabled them with Sync_Req/Freeze_Req; otherwise "
       "they have no effect (IEC 61158-6 DP Set_Prm Station_Status; protocol-facts.md §D.6 "
       "\"Prior enabling\")",
       {}, sync_freeze_not_enabled));
   out.push_back(make_case(
-      "GC-06", kGroup, "Unsupported Sync/Freeze refused with Not_Supported",
+      "GC-06", kGlobalControlGroup, "Unsupported Sync/Freeze refused with Not_Supported",
       "A slave that does not support Sync or Freeze (GSD Sync_Mode_supp/Freeze_Mode_supp = 0) "
       "answers a Set_Prm with Sync_Req/Freeze_Req by setting Not_Supported (diag octet 1 bit 4) "
       "(IEC 61158-6 DP Slave_Diag; protocol-facts.md §D.6, §D.4)",

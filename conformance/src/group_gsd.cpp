@@ -32,7 +32,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "GSD";
+constexpr const char* kGsdGroup = "GSD";
 
 std::vector<std::uint8_t> ident_octets(std::uint16_t id) {
   return {static_cast<std::uint8_t>(id >> 8), static_cast<std::uint8_t>(id & 0xFF)};
@@ -252,44 +252,44 @@ void min_slave_intervall_stated(TestContext& ctx, TestResult& res) {
 void add_gsd_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "GSD-01", kGroup, "Diagnosis ident = Ident_Number",
+      "GSD-01", kGsdGroup, "Diagnosis ident = Ident_Number",
       "Slave_Diag octets 5..6 carry the GSD's Ident_Number in every state (PI 2.122 Ident_Number; "
       "protocol-facts.md §D.4, §I.2)",
       {SlaveMutant::WrongDiagIdent}, diag_ident));
   out.push_back(make_case(
-      "GSD-02", kGroup, "Get_Cfg = the modules' identifiers",
+      "GSD-02", kGsdGroup, "Get_Cfg = the modules' identifiers",
       "Get_Cfg returns the real configuration: the identifiers of the configured GSD modules "
       "(PI 2.122 Module; protocol-facts.md §D.3, §I.1)",
       {SlaveMutant::WrongGetCfg}, get_cfg_is_gsd_cfg));
   out.push_back(
-      make_case("GSD-03", kGroup, "Data_Exchange lengths",
+      make_case("GSD-03", kGsdGroup, "Data_Exchange lengths",
                 "Data_Exchange takes as many output octets and returns as many input octets as the "
                 "configuration identifiers add up to (protocol-facts.md §D.3, §D.7)",
                 {}, io_lengths));
   out.push_back(make_case(
-      "GSD-04", kGroup, "User_Prm_Data length",
+      "GSD-04", kGsdGroup, "User_Prm_Data length",
       "The slave accepts exactly the User_Prm_Data the GSD assembles (User_Prm_Data_Len plus the "
       "modules' parameters) and sets Prm_Fault for any other length (PI 2.122; protocol-facts.md "
       "§I.1, §D.2, §D.4)",
       {}, user_prm_len));
   out.push_back(make_case(
-      "GSD-05", kGroup, "Max_Diag_Data_Len",
+      "GSD-05", kGsdGroup, "Max_Diag_Data_Len",
       "No diagnosis is longer than the GSD's Max_Diag_Data_Len (PI 2.122; protocol-facts.md §I.2, "
       "§D.4 Ext_Diag_Overflow)",
       {}, max_diag_len));
   out.push_back(
-      make_case("GSD-06", kGroup, "DP-V1 Set_Prm iff DPV1_Slave",
+      make_case("GSD-06", kGsdGroup, "DP-V1 Set_Prm iff DPV1_Slave",
                 "A Set_Prm with DPV1_Status (DPV1_Enable) is accepted exactly when the GSD says "
                 "DPV1_Slave = 1 (PI 2.122; protocol-facts.md §D.2, §I.2)",
                 {}, dpv1_prm));
   out.push_back(make_case(
-      "GSD-07", kGroup, "Sync/Freeze iff supported",
+      "GSD-07", kGsdGroup, "Sync/Freeze iff supported",
       "Set_Prm with Sync_Req/Freeze_Req is accepted when the GSD says Sync_Mode_supp/"
       "Freeze_Mode_supp = 1 and answered with Not_Supported otherwise (PI 2.122; protocol-facts.md "
       "§D.6, §D.4)",
       {}, sync_freeze));
   out.push_back(make_case(
-      "GSD-08", kGroup, "Min_Slave_Intervall stated",
+      "GSD-08", kGsdGroup, "Min_Slave_Intervall stated",
       "The GSD of a DP slave states the mandatory Min_Slave_Intervall, 1..65535 x 100 us, the "
       "shortest time a master may leave between two polls of the slave (PI 2.122 "
       "Min_Slave_Intervall; IEC 61158-6 Min_Slave_Interval; protocol-facts.md §C.2, §I.2)",

@@ -27,7 +27,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Interruption";
+constexpr const char* kInterruptionGroup = "Interruption";
 
 /// The context's parameters with a 100 ms watchdog (10 ms for an outside slave).
 dp::SlaveParams with_short_watchdog(const TestContext& ctx, bus::Ticks& twd) {
@@ -186,24 +186,24 @@ void master_power_off(TestContext& ctx, TestResult& res) {
 void add_interruption_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "INT-01", kGroup, "Bus interruption longer than the watchdog",
+      "INT-01", kInterruptionGroup, "Bus interruption longer than the watchdog",
       "With WD_On, a slave that hears no frame from its master for the watchdog time TWD sets its "
       "outputs safe and returns to Wait_Prm; a new start-up then succeeds (IEC 61158-6 DP "
       "response monitoring; protocol-facts.md §D.8, §D.2)",
       {SlaveMutant::IgnoreWatchdog}, long_interruption));
   out.push_back(make_case(
-      "INT-02", kGroup, "Bus interruption shorter than the watchdog",
+      "INT-02", kInterruptionGroup, "Bus interruption shorter than the watchdog",
       "A silence shorter than TWD does not end data exchange (IEC 61158-6 DP response monitoring; "
       "protocol-facts.md §D.8)",
       {}, short_interruption));
   out.push_back(make_case(
-      "INT-03", kGroup, "Power off/on of the device",
+      "INT-03", kInterruptionGroup, "Power off/on of the device",
       "After power off/on the slave starts in Wait_Prm with Prm_Req and no master, diagnosis "
       "`02 05 00 FF idH idL`, its outputs safe (IEC 61158-6 DP slave state machine; "
       "protocol-facts.md §D.8, §D.4)",
       {SlaveMutant::KeepStateOnPowerCycle}, dut_power_cycle));
   out.push_back(
-      make_case("INT-04", kGroup, "Power off of the master",
+      make_case("INT-04", kInterruptionGroup, "Power off of the master",
                 "When the master goes silent the watchdog expires: outputs safe, back to Wait_Prm "
                 "(IEC 61158-6 DP response monitoring; protocol-facts.md §D.8)",
                 {SlaveMutant::IgnoreWatchdog}, master_power_off));

@@ -22,8 +22,7 @@ namespace {
 
 using devices::SlaveMutant;
 
-constexpr const char* kGroup = "Read services";
-constexpr std::uint8_t kOtherMaster = 2;
+constexpr const char* kReadServicesGroup = "Read services";
 
 /// White box: a model's inputs set to a pattern (module by module, whole modules).
 void set_model_inputs(Session& s, std::uint8_t seed) {
@@ -102,19 +101,19 @@ void rd_by_other_master(TestContext& ctx, TestResult& r) {
 }  // namespace
 
 void add_read_service_tests(std::vector<TestCase>& out) {
-  out.push_back({"RD-01", kGroup, "Get_Cfg = the GSD configuration",
+  out.push_back({"RD-01", kReadServicesGroup, "Get_Cfg = the GSD configuration",
                  "Get_Cfg answers the real configuration: the configured GSD modules' identifier "
                  "octets in module order, in any state and to any master (§D.3, §D.8)",
                  get_cfg_matches_gsd, {SlaveMutant::WrongGetCfg}});
-  out.push_back({"RD-02", kGroup, "Rd_Inp",
+  out.push_back({"RD-02", kReadServicesGroup, "Rd_Inp",
                  "Rd_Inp (SAP 56) answers the slave's inputs: those of the last Data_Exchange reply, "
                  "with the configured input length (§D.7)",
                  [](TestContext& c, TestResult& r) { rd_inp_test(c, r, std::nullopt); }, {}});
-  out.push_back({"RD-03", kGroup, "Rd_Outp",
+  out.push_back({"RD-03", kReadServicesGroup, "Rd_Outp",
                  "Rd_Outp (SAP 57) answers the outputs last written by Data_Exchange, with the "
                  "configured output length (§D.7)",
                  [](TestContext& c, TestResult& r) { rd_outp_test(c, r, std::nullopt); }, {}});
-  out.push_back({"RD-04", kGroup, "Rd_Inp / Rd_Outp for another master",
+  out.push_back({"RD-04", kReadServicesGroup, "Rd_Inp / Rd_Outp for another master",
                  "A master that does not own the slave may read its inputs and outputs (Rd_Inp, "
                  "Rd_Outp are answered to any master; §D.8 locking)",
                  rd_by_other_master, {}});

@@ -31,8 +31,7 @@ namespace {
 
 using devices::SlaveMutant;
 
-constexpr const char* kGroup = "Set_Prm";
-constexpr std::uint8_t kOtherMaster = 2;
+constexpr const char* kSetPrmGroup = "Set_Prm";
 
 /// Wait_Prm after a refused Set_Prm: Prm_Fault + Station_Not_Ready (Wait_Prm itself is shown by
 /// the Data_Exchange that follows getting RS; Prm_Req and the ident are the Start-up group's).
@@ -294,35 +293,35 @@ void min_tsdr_honoured(TestContext& ctx, TestResult& r) {
 }  // namespace
 
 void add_set_prm_tests(std::vector<TestCase>& out) {
-  out.push_back({"PRM-01", kGroup, "Wrong Ident_Number refused",
+  out.push_back({"PRM-01", kSetPrmGroup, "Wrong Ident_Number refused",
                  "A Set_Prm whose Ident_Number is not the slave's is refused: Prm_Fault (diag octet 1 "
                  "bit 6), the slave stays in Wait_Prm (§D.2, §D.4, §D.8)",
                  wrong_ident, {SlaveMutant::AcceptWrongIdent}});
-  out.push_back({"PRM-02", kGroup, "Wrong User_Prm_Data length refused",
+  out.push_back({"PRM-02", kSetPrmGroup, "Wrong User_Prm_Data length refused",
                  "A Set_Prm whose User_Prm_Data length differs from the GSD's is refused with Prm_Fault",
                  wrong_length, {}});
-  out.push_back({"PRM-03", kGroup, "Wrong User_Prm_Data content refused",
+  out.push_back({"PRM-03", kSetPrmGroup, "Wrong User_Prm_Data content refused",
                  "A parameter value outside its ExtUserPrmData range is refused with Prm_Fault (GSD "
                  "PI 2.122; §D.2)",
                  wrong_content, {}});
-  out.push_back({"PRM-04", kGroup, "Lock against another master",
+  out.push_back({"PRM-04", kSetPrmGroup, "Lock against another master",
                  "A slave locked by its master ignores a Set_Prm from another master (SC without "
                  "effect); Diag.Master_Add stays its master and data exchange goes on (§D.8)",
                  lock_against_other_master, {SlaveMutant::IgnoreLock}});
-  out.push_back({"PRM-05", kGroup, "Unlock",
+  out.push_back({"PRM-05", kSetPrmGroup, "Unlock",
                  "Set_Prm with Lock_Req 0, Unlock_Req 1 from the master releases the slave: back to "
                  "Wait_Prm, Master_Add 0xFF (§D.2)",
                  unlock, {SlaveMutant::NoPrmReqBit}});
-  out.push_back({"PRM-06", kGroup, "Watchdog expiry",
+  out.push_back({"PRM-06", kSetPrmGroup, "Watchdog expiry",
                  "With WD_On, a slave that hears nothing from its master for TWD = WD_Fact_1 × "
                  "WD_Fact_2 × 10 ms goes back to Wait_Prm (Prm_Req, no master); before TWD it stays in "
                  "Data_Exch (§D.2, §D.8)",
                  watchdog_expiry, {SlaveMutant::IgnoreWatchdog, SlaveMutant::NoPrmReqBit}});
-  out.push_back({"PRM-07", kGroup, "Watchdog off",
+  out.push_back({"PRM-07", kSetPrmGroup, "Watchdog off",
                  "Without WD_On the slave stays in Data_Exch however long its master is silent, and "
                  "WD_On is clear in its diagnosis (§D.2)",
                  watchdog_off, {}});
-  out.push_back({"PRM-08", kGroup, "Min TSDR honoured",
+  out.push_back({"PRM-08", kSetPrmGroup, "Min TSDR honoured",
                  "After a Set_Prm with min TSDR 60 every reply starts at least 60 bit times after the "
                  "end of its request (Set_Prm octet 4; §C.1, §D.2)",
                  min_tsdr_honoured, {SlaveMutant::IgnoreMinTsdr}});

@@ -23,7 +23,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Set_Slave_Add";
+constexpr const char* kSetSlaveAddGroup = "Set_Slave_Add";
 
 std::uint8_t other_address(std::uint8_t a) {
   return a == 100 ? 101 : 100;
@@ -113,7 +113,7 @@ void no_add_chg(TestContext& ctx, TestResult& res) {
   run.pass("after No_Add_Chg = 1 a second change was refused (" + r2.describe() + ")");
 }
 
-void wrong_ident(TestContext& ctx, TestResult& res) {
+void wrong_ident_refused(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
@@ -163,23 +163,23 @@ void in_data_exchange(TestContext& ctx, TestResult& res) {
 
 void add_set_slave_add_tests(std::vector<TestCase>& out) {
   out.push_back(make_case(
-      "ADD-01", kGroup, "New address taken",
+      "ADD-01", kSetSlaveAddGroup, "New address taken",
       "Set_Slave_Add in Wait_Prm with the right Ident_Number changes the station address: the "
       "slave answers at the new address and no longer at the old one; with No_Add_Chg = 0 it may "
       "be changed again (IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7, §D.8)",
       {}, new_address_taken));
   out.push_back(make_case(
-      "ADD-02", kGroup, "No_Add_Chg forbids a second change",
+      "ADD-02", kSetSlaveAddGroup, "No_Add_Chg forbids a second change",
       "After Set_Slave_Add with No_Add_Chg != 0 a further Set_Slave_Add is refused until a reset "
       "(IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7)",
       {}, no_add_chg));
   out.push_back(
-      make_case("ADD-03", kGroup, "Wrong ident refused",
+      make_case("ADD-03", kSetSlaveAddGroup, "Wrong ident refused",
                 "Set_Slave_Add whose Ident_Number is not the slave's is refused; the address stays "
                 "(IEC 61158-6 DP Set_Slave_Add; protocol-facts.md §D.7)",
-                {}, wrong_ident));
+                {}, wrong_ident_refused));
   out.push_back(make_case(
-      "ADD-04", kGroup, "Refused in Data_Exch",
+      "ADD-04", kSetSlaveAddGroup, "Refused in Data_Exch",
       "Set_Slave_Add is accepted only in Power_On/Wait_Prm; in Data_Exch it is refused and data "
       "exchange goes on (IEC 61158-6 DP slave state machine; protocol-facts.md §D.7, §D.8)",
       {}, in_data_exchange));

@@ -18,7 +18,7 @@ namespace {
 
 using devices::SlaveMutant;
 
-constexpr const char* kGroup = "Start-up";
+constexpr const char* kStartupGroup = "Start-up";
 
 std::uint16_t ident(TestContext& ctx) { return ctx.spec().gsd->ident_number(); }
 
@@ -104,25 +104,25 @@ void fdl_status_of_a_slave(TestContext& ctx, TestResult& r) {
 }  // namespace
 
 void add_startup_tests(std::vector<TestCase>& out) {
-  out.push_back({"STA-01", kGroup, "Power-on diagnosis",
+  out.push_back({"STA-01", kStartupGroup, "Power-on diagnosis",
                  "After power-on a slave answers Slave_Diag with 02 05 00 FF and its Ident_Number: "
                  "Station_Not_Ready, Prm_Req and the always-1 bit of Station_Status_2, no master "
                  "(IEC 61158-6 DP Slave_Diag; §D.4)",
                  power_on_diag, {SlaveMutant::NoPrmReqBit, SlaveMutant::WrongDiagIdent}});
-  out.push_back({"STA-02", kGroup, "Start-up sequence",
+  out.push_back({"STA-02", kStartupGroup, "Start-up sequence",
                  "Slave_Diag, Set_Prm (SC), Chk_Cfg (SC), Slave_Diag (ready, Prm_Req cleared, "
                  "Master_Add = the master), then Data_Exchange answered DL/DH with the configured "
                  "input length (§D.8, §D.9)",
                  full_start_up, {SlaveMutant::NoPrmReqBit, SlaveMutant::WrongDiagIdent}});
-  out.push_back({"STA-03", kGroup, "Diagnosis in each state",
+  out.push_back({"STA-03", kStartupGroup, "Diagnosis in each state",
                  "Station_Status octets in Wait_Prm (02 05), Wait_Cfg (02 0C with WD_On) and "
                  "Data_Exch (00 0C), Master_Add and Ident_Number as parameterised (§D.4)",
                  diag_in_each_state, {SlaveMutant::NoPrmReqBit, SlaveMutant::WrongDiagIdent}});
-  out.push_back({"STA-04", kGroup, "Data_Exchange refused before parameterisation",
+  out.push_back({"STA-04", kStartupGroup, "Data_Exchange refused before parameterisation",
                  "In Wait_Prm a slave rejects Data_Exchange (RS, the default SAP is not active) "
                  "and stays in Wait_Prm (§D.7, §D.8)",
                  data_exchange_refused_before_prm, {SlaveMutant::NoPrmReqBit, SlaveMutant::WrongDiagIdent}});
-  out.push_back({"STA-05", kGroup, "FDL_Status of a passive station",
+  out.push_back({"STA-05", kStartupGroup, "FDL_Status of a passive station",
                  "Request FDL Status is answered by the FDL layer with FC 0x00 (station type "
                  "slave, OK), SD1 (§B.3)",
                  fdl_status_of_a_slave, {}});

@@ -34,7 +34,7 @@
 namespace pbvbus::conformance::detail {
 namespace {
 
-constexpr const char* kGroup = "Timing";
+constexpr const char* kTimingGroup = "Timing";
 
 bool is_answer(const Reply& r) {
   return r.kind == Reply::Kind::Sc || r.kind == Reply::Kind::Telegram;
@@ -178,19 +178,19 @@ void tsyn(TestContext& ctx, TestResult& res) {
 void add_timing_tests(std::vector<TestCase>& out) {
   using devices::SlaveMutant;
   out.push_back(make_case(
-      "TIM-01", kGroup, "TSDR at every supported baud rate",
+      "TIM-01", kTimingGroup, "TSDR at every supported baud rate",
       "The responder answers no earlier than min TSDR (11 bit times, or what Set_Prm octet 4 set) "
       "and no later than the GSD's MaxTsdr for the baud, at every baud the GSD supports "
       "(IEC 61158-4-3 station delay; protocol-facts.md §C.1, §C.2, §D.2)",
       {SlaveMutant::TsdrTooLate}, tsdr_every_baud));
   out.push_back(make_case(
-      "TIM-02", kGroup, "Min_Slave_Interval",
+      "TIM-02", kTimingGroup, "Min_Slave_Interval",
       "A slave polled with Data_Exchange at its GSD Min_Slave_Intervall (request start to request "
       "start) answers every poll (IEC 61158-6 DP bus parameter Min_Slave_Interval; "
       "protocol-facts.md §C.2)",
       {SlaveMutant::SlowSlaveInterval}, min_slave_interval));
   out.push_back(make_case(
-      "TIM-03", kGroup, "Request after TSYN answered",
+      "TIM-03", kTimingGroup, "Request after TSYN answered",
       "A station is ready to receive once the line has been idle for TSYN = 33 bit times; a "
       "request "
       "that follows the slave's reply after exactly 33 bit times is answered (IEC 61158-4-3 "

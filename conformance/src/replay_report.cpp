@@ -10,7 +10,7 @@ namespace pbvbus::conformance {
 
 namespace {
 
-std::string hex(const std::vector<std::uint8_t>& b) {
+std::string replay_hex(const std::vector<std::uint8_t>& b) {
   std::string s;
   char buf[4];
   for (std::size_t i = 0; i < b.size(); ++i) {
@@ -21,7 +21,7 @@ std::string hex(const std::vector<std::uint8_t>& b) {
   return s;
 }
 
-std::string json_str(const std::string& s) {
+std::string replay_json_str(const std::string& s) {
   std::string o = "\"";
   for (unsigned char c : s) {
     if (c == '"' || c == '\\') {
@@ -183,7 +183,7 @@ std::string replay_text(const ReplayResult& r, std::size_t max_diffs) {
 
 std::string replay_json(const ReplayResult& r, std::size_t max_diffs) {
   std::ostringstream o;
-  o << "{\"schema\":\"pbvbus.replay/1\",\"line\":" << json_str(r.line)
+  o << "{\"schema\":\"pbvbus.replay/1\",\"line\":" << replay_json_str(r.line)
     << ",\"baud\":" << static_cast<std::uint32_t>(r.baud) << ",\"target\":"
     << (r.station ? std::to_string(*r.station) : std::string("\"all\"")) << ",\"pacing\":\""
     << replay_pacing_name(r.pacing) << "\",\"totals\":{\"recorded_frames\":" << r.recorded_frames
@@ -196,25 +196,25 @@ std::string replay_json(const ReplayResult& r, std::size_t max_diffs) {
     << ",\"unusable\":" << r.unusable.size() << ",\"pacing_slips\":" << r.pacing_slips << "}";
   o << ",\"tsdr_window\":[" << r.min_tsdr << "," << r.max_tsdr << "],\"masks\":[";
   for (std::size_t i = 0; i < r.masks.size(); ++i)
-    o << (i ? "," : "") << "{\"rule\":" << json_str(r.masks[i].first)
+    o << (i ? "," : "") << "{\"rule\":" << replay_json_str(r.masks[i].first)
       << ",\"octets_masked\":" << r.masks[i].second << "}";
   o << "],\"unusable\":[";
   for (std::size_t i = 0; i < r.unusable.size(); ++i) {
     const ReplayFrame* f = r.unusable[i];
     o << (i ? "," : "") << "{\"record\":" << f->record << ",\"offset\":" << f->offset
-      << ",\"time_ns\":" << bus::ticks_to_ns(f->start) << ",\"reason\":" << json_str(f->unusable_reason) << "}";
+      << ",\"time_ns\":" << bus::ticks_to_ns(f->start) << ",\"reason\":" << replay_json_str(f->unusable_reason) << "}";
   }
   o << "]";
-  if (!r.read_error.empty()) o << ",\"read_error\":" << json_str(r.read_error);
+  if (!r.read_error.empty()) o << ",\"read_error\":" << replay_json_str(r.read_error);
   o << ",\"differences\":[";
   const std::size_t n = std::min(max_diffs, r.diffs.size());
   for (std::size_t i = 0; i < n; ++i) {
     const ReplayDiff& d = r.diffs[i];
     o << (i ? "," : "") << "{\"kind\":\"" << diff_kind_key(d.kind) << "\",\"time_ns\":"
       << bus::ticks_to_ns(d.time) << ",\"station\":" << int(d.station)
-      << ",\"service\":" << json_str(d.service) << ",\"request\":\"" << hex(d.request) << "\""
-      << ",\"recorded\":" << (d.recorded ? "\"" + hex(*d.recorded) + "\"" : std::string("null"))
-      << ",\"replayed\":" << (d.replayed ? "\"" + hex(*d.replayed) + "\"" : std::string("null"))
+      << ",\"service\":" << replay_json_str(d.service) << ",\"request\":\"" << replay_hex(d.request) << "\""
+      << ",\"recorded\":" << (d.recorded ? "\"" + replay_hex(*d.recorded) + "\"" : std::string("null"))
+      << ",\"replayed\":" << (d.replayed ? "\"" + replay_hex(*d.replayed) + "\"" : std::string("null"))
       << ",\"frame_offsets\":[";
     for (std::size_t k = 0; k < d.frame_offsets.size(); ++k) o << (k ? "," : "") << d.frame_offsets[k];
     o << "],\"du_offsets\":[";

@@ -29,6 +29,9 @@
 
 namespace pbvbus::conformance::detail {
 
+/// The FDL address the tester uses as a second master (locking, class-2 reads).
+inline constexpr std::uint8_t kOtherMaster = 2;
+
 /// Octets as "02 05 00 FF 0A 01".
 std::string hex(std::span<const std::uint8_t> b);
 

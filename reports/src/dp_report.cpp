@@ -10,12 +10,6 @@
 
 namespace pbvbus::tools {
 
-namespace {
-
-std::string hex(const std::vector<std::uint8_t>& v) { return hex_octets(v); }
-
-}  // namespace
-
 void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os) {
   for (const auto& m : r) {
     const auto bit = bus::ticks_per_bit(m.baud);
@@ -26,14 +20,14 @@ void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os) {
       os << "  dp slave " << static_cast<int>(s.address) << " \"" << s.model << "\" [";
       for (std::size_t i = 0; i < s.modules.size(); ++i) os << (i ? ", " : "") << s.modules[i];
       os << "]: " << s.state << " (slave: " << s.slave_state << ")\n";
-      os << "    diagnosis " << hex(s.diag);
+      os << "    diagnosis " << hex_octets(s.diag);
       if (!s.diag_bits.empty()) {
         os << " (";
         for (std::size_t i = 0; i < s.diag_bits.size(); ++i) os << (i ? ", " : "") << s.diag_bits[i];
         os << ")";
       }
-      os << "\n    inputs " << s.input_len << " octets: " << (s.inputs.empty() ? "-" : hex(s.inputs))
-         << "\n    outputs " << s.output_len << " octets: " << (s.outputs.empty() ? "-" : hex(s.outputs))
+      os << "\n    inputs " << s.input_len << " octets: " << (s.inputs.empty() ? "-" : hex_octets(s.inputs))
+         << "\n    outputs " << s.output_len << " octets: " << (s.outputs.empty() ? "-" : hex_octets(s.outputs))
          << "\n";
       const auto& st = s.stats;
       if (st.cycle_count > 0) {
@@ -64,10 +58,10 @@ void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os) {
          << ",\"model\":" << json_quote(s.model) << ",\"modules\":[";
       for (std::size_t k = 0; k < s.modules.size(); ++k) os << (k ? "," : "") << json_quote(s.modules[k]);
       os << "],\"state\":" << json_quote(s.state) << ",\"slave_state\":" << json_quote(s.slave_state)
-         << ",\"diag\":" << json_quote(hex(s.diag)) << ",\"diag_bits\":[";
+         << ",\"diag\":" << json_quote(hex_octets(s.diag)) << ",\"diag_bits\":[";
       for (std::size_t k = 0; k < s.diag_bits.size(); ++k) os << (k ? "," : "") << json_quote(s.diag_bits[k]);
       os << "],\"input_len\":" << s.input_len << ",\"output_len\":" << s.output_len
-         << ",\"inputs\":" << json_quote(hex(s.inputs)) << ",\"outputs\":" << json_quote(hex(s.outputs))
+         << ",\"inputs\":" << json_quote(hex_octets(s.inputs)) << ",\"outputs\":" << json_quote(hex_octets(s.outputs))
          << ",\"cycle\":{\"count\":" << st.cycle_count << ",\"min_ns\":" << bus::ticks_to_ns(st.cycle_min)
          << ",\"median_ns\":" << bus::ticks_to_ns(s.cycle_median)
          << ",\"max_ns\":" << bus::ticks_to_ns(st.cycle_max) << ",\"min_bits\":" << st.cycle_min / bit
@@ -102,15 +96,15 @@ void write_dp_slaves_text(const std::vector<DpSlaveView>& r, std::ostream& os) {
                     : std::string("no pbvbus master"))
        << "), watchdog "
        << (v.watchdog ? std::to_string(*v.watchdog / bus::kTicksPerMs) + " ms" : std::string("off")) << "\n";
-    os << "    diagnosis " << hex(v.diag);
+    os << "    diagnosis " << hex_octets(v.diag);
     if (!v.diag_bits.empty()) {
       os << " (";
       for (std::size_t i = 0; i < v.diag_bits.size(); ++i) os << (i ? ", " : "") << v.diag_bits[i];
       os << ")";
     }
-    os << "\n    inputs " << v.input_len << " octets: " << (v.inputs.empty() ? "-" : hex(v.inputs))
+    os << "\n    inputs " << v.input_len << " octets: " << (v.inputs.empty() ? "-" : hex_octets(v.inputs))
        << " (sent last), outputs " << v.output_len
-       << " octets: " << (v.outputs.empty() ? "-" : hex(v.outputs)) << " (received last)\n";
+       << " octets: " << (v.outputs.empty() ? "-" : hex_octets(v.outputs)) << " (received last)\n";
     const auto& s = v.stats;
     os << "    answered: Set_Prm " << s.set_prm << ", Chk_Cfg " << s.chk_cfg << ", Slave_Diag "
        << s.slave_diag << ", Data_Exchange " << s.data_exchange << ", Global_Control "
@@ -138,10 +132,10 @@ void write_dp_slaves_json(const std::vector<DpSlaveView>& r, std::ostream& os) {
     os << "],\"master\":" << opt_json(v.master) << ",\"state\":" << json_quote(v.state)
        << ",\"owner\":" << opt_json(v.owner) << ",\"watchdog_ns\":"
        << (v.watchdog ? std::to_string(bus::ticks_to_ns(*v.watchdog)) : std::string("null"))
-       << ",\"diag\":" << json_quote(hex(v.diag)) << ",\"diag_bits\":[";
+       << ",\"diag\":" << json_quote(hex_octets(v.diag)) << ",\"diag_bits\":[";
     for (std::size_t k = 0; k < v.diag_bits.size(); ++k) os << (k ? "," : "") << json_quote(v.diag_bits[k]);
     os << "],\"input_len\":" << v.input_len << ",\"output_len\":" << v.output_len
-       << ",\"inputs\":" << json_quote(hex(v.inputs)) << ",\"outputs\":" << json_quote(hex(v.outputs))
+       << ",\"inputs\":" << json_quote(hex_octets(v.inputs)) << ",\"outputs\":" << json_quote(hex_octets(v.outputs))
        << ",\n \"requests\":{\"set_prm\":" << s.set_prm << ",\"chk_cfg\":" << s.chk_cfg
        << ",\"slave_diag\":" << s.slave_diag << ",\"data_exchange\":" << s.data_exchange
        << ",\"global_control\":" << s.global_control << ",\"get_cfg\":" << s.get_cfg

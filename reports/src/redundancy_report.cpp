@@ -10,8 +10,6 @@ namespace pbvbus::tools {
 
 namespace {
 
-std::string hex(const std::vector<std::uint8_t>& v) { return hex_octets(v); }
-
 std::string code_text(std::uint16_t code) {
   char b[16];
   std::snprintf(b, sizeof b, "W#16#%04X", code);
@@ -36,7 +34,7 @@ void write_redundancy_text(const std::vector<RedundancyReport>& reports, std::os
       os << "  switched station " << int(s.address) << " " << s.model << ": active "
          << (s.active.empty() ? "none" : "line " + s.active) << " (interfaces " << s.roles[0]
          << " / " << s.roles[1] << ")" << (s.redundancy_lost ? ", redundancy lost" : "")
-         << (s.failed ? ", FAILED" : "") << ", outputs " << (s.outputs.empty() ? "-" : hex(s.outputs))
+         << (s.failed ? ", FAILED" : "") << ", outputs " << (s.outputs.empty() ? "-" : hex_octets(s.outputs))
          << (s.outputs_held ? " (held)" : "");
       if (s.t_slave_um) os << ", T_SLAVE_UM " << ms(*s.t_slave_um);
       os << ", bound " << ms(s.bound[0]) << " / " << ms(s.bound[1]) << "\n";
@@ -90,7 +88,7 @@ void write_redundancy_json(const std::vector<RedundancyReport>& reports, std::os
          << "," << json_quote(s.roles[1]) << "],\"redundancy_lost\":"
          << (s.redundancy_lost ? "true" : "false") << ",\"failed\":" << (s.failed ? "true" : "false")
          << ",\"outputs_held\":" << (s.outputs_held ? "true" : "false") << ",\"outputs\":"
-         << json_quote(hex(s.outputs)) << ",\"t_slave_um_ns\":";
+         << json_quote(hex_octets(s.outputs)) << ",\"t_slave_um_ns\":";
       if (s.t_slave_um) os << bus::ticks_to_ns(*s.t_slave_um);
       else os << "null";
       os << ",\"bound_ns\":[" << bus::ticks_to_ns(s.bound[0]) << "," << bus::ticks_to_ns(s.bound[1])

@@ -119,7 +119,7 @@ Where at_field(const Where& w, const pb::Descriptor* d, const char* name, int in
   return r;
 }
 
-std::string quoted(std::string_view s) { return "\"" + std::string(s) + "\""; }
+std::string in_quotes(std::string_view s) { return "\"" + std::string(s) + "\""; }
 
 std::string baud_list() {
   std::string s;
@@ -219,7 +219,7 @@ class Planner {
   std::optional<Ticks> duration(const Where& w, const std::string& text) {
     auto t = bus::parse_duration(text);
     if (!t) {
-      error(w, "bad duration " + quoted(text) +
+      error(w, "bad duration " + in_quotes(text) +
                    " (expected a number and a unit: ns, us, ms, s, min, h, e.g. \"250ms\")");
     }
     return t;
@@ -261,13 +261,13 @@ class Planner {
       if (l.name().empty()) {
         error(w, "line needs a name");
       } else if (m_line_index.count(l.name())) {
-        error(at_field(w, ld, "name"), "line " + quoted(l.name()) + " is defined twice");
+        error(at_field(w, ld, "name"), "line " + in_quotes(l.name()) + " is defined twice");
       }
       if (l.speed_case() == scenario::Line::kBaud) {
         if (auto b = bus::parse_baud(l.baud())) {
           pl.baud = *b;
         } else {
-          error(at_field(w, ld, "baud"), quoted(l.baud()) + " is not a PROFIBUS baud rate (" +
+          error(at_field(w, ld, "baud"), in_quotes(l.baud()) + " is not a PROFIBUS baud rate (" +
                                              baud_list() + ")");
         }
       } else if (l.speed_case() == scenario::Line::kBitRate) {
@@ -284,7 +284,7 @@ class Planner {
         const Where bw = nested(w, ld, "bus_params");
         apply(bw, l.bus_params(), pl.params);
         if (std::string why = pl.params.validate(); !why.empty())
-          error(bw, "bus parameters of line " + quoted(l.name()) + ": " + why);
+          error(bw, "bus parameters of line " + in_quotes(l.name()) + ": " + why);
       }
       m_line_index.emplace(l.name(), static_cast<int>(plan.lines.size()));
       plan.lines.push_back(std::move(pl));
@@ -303,7 +303,7 @@ class Planner {
     }
     auto it = m_line_index.find(name);
     if (it == m_line_index.end()) {
-      error(at_field(w, d, "line"), "unknown line " + quoted(name));
+      error(at_field(w, d, "line"), "unknown line " + in_quotes(name));
       return -1;
     }
     return it->second;
@@ -394,7 +394,7 @@ class Planner {
         auto [it, fresh] = used.emplace(std::pair(li, *e.address), aw);
         if (!fresh) {
           error(aw, "address " + std::to_string(*e.address) + " is already used on line " +
-                        quoted(line.name) + " (at " + std::to_string(it->second.line + 1) + ":" +
+                        in_quotes(line.name) + " (at " + std::to_string(it->second.line + 1) + ":" +
                         std::to_string(it->second.column + 1) + ")");
         }
       }
@@ -416,7 +416,7 @@ class Planner {
     if (ps.address && *ps.address >= ps.params.hsa) {
       error(at_field(e.where, md, "address"),
             "master address " + std::to_string(*ps.address) + " is not below HSA " +
-                std::to_string(ps.params.hsa) + " of line " + quoted(line.name));
+                std::to_string(ps.params.hsa) + " of line " + in_quotes(line.name));
     }
     const auto* pd = scenario::Poll::descriptor();
     for (int i = 0; i < m.poll_size(); ++i) {
@@ -448,7 +448,7 @@ class Planner {
             "response_delay " + std::to_string(p.response_delay()) +
                 " bit times is outside [min TSDR, max TSDR] = [" +
                 std::to_string(line.params.min_tsdr) + ", " + std::to_string(line.params.max_tsdr) +
-                "] of line " + quoted(line.name));
+                "] of line " + in_quotes(line.name));
     }
     if (p.response_length() > kMaxData)
       error(at_field(e.where, pd, "response_length"),
@@ -465,14 +465,14 @@ class Planner {
       if (pos >= 0) return pos;
       for (const auto& other : plan.lines) {
         if (other.position_of(static_cast<std::uint8_t>(addr)) >= 0) {
-          error(w, std::string(what) + " on line " + quoted(line.name) + ": station " +
-                       std::to_string(addr) + " is on line " + quoted(other.name));
+          error(w, std::string(what) + " on line " + in_quotes(line.name) + ": station " +
+                       std::to_string(addr) + " is on line " + in_quotes(other.name));
           return -1;
         }
       }
     }
     error(w, std::string(what) + ": no station " + std::to_string(addr) + " on line " +
-                 quoted(line.name));
+                 in_quotes(line.name));
     return -1;
   }
 
@@ -500,8 +500,8 @@ class Planner {
         const std::string first = " (at " + std::to_string(it->second.line + 1) + ":" +
                                   std::to_string(it->second.column + 1) + ")";
         error(pw, p.address ? "capture: a probe at station " + std::to_string(*p.address) +
-                                  " on line " + quoted(line.name) + " is already given" + first
-                            : "capture: line " + quoted(line.name) +
+                                  " on line " + in_quotes(line.name) + " is already given" + first
+                            : "capture: line " + in_quotes(line.name) +
                                   " already has a probe at the default position" + first);
         continue;
       }
@@ -529,7 +529,7 @@ class Planner {
       if (d.switched < 0 && d.line == li && d.address == s.address()) sp = &d;
     if (sp == nullptr) {
       error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_slave " +
-                                             std::to_string(s.address()) + " on line " + quoted(ln));
+                                             std::to_string(s.address()) + " on line " + in_quotes(ln));
       return false;
     }
     pf.slave = sp->address;
@@ -574,7 +574,7 @@ class Planner {
     } else if (s.has_module()) {
       const auto it = std::find(sp->module_names.begin(), sp->module_names.end(), s.module());
       if (it == sp->module_names.end()) {
-        error(at_field(kw, kd, "module"), std::string(kind_field) + ": module " + quoted(s.module()) +
+        error(at_field(kw, kd, "module"), std::string(kind_field) + ": module " + in_quotes(s.module()) +
                                               " is not one of the modules of dp_slave " +
                                               std::to_string(sp->address));
         return false;
@@ -642,7 +642,7 @@ class Planner {
       ++matches;
     }
     const std::string where =
-        li >= 0 ? " on line " + quoted(plan.lines[static_cast<std::size_t>(li)].name) : std::string();
+        li >= 0 ? " on line " + in_quotes(plan.lines[static_cast<std::size_t>(li)].name) : std::string();
     if (found < 0) {
       error(at_field(kw, kd, "address"), std::string(kind_field) + ": no switched_station " +
                                              std::to_string(sf.address()) + where);
@@ -779,11 +779,11 @@ class Planner {
       for (std::size_t k = 0; k < plan.h_systems.size(); ++k)
         if (plan.h_systems[k].name == h_name && found < 0) found = static_cast<int>(k);
       if (found < 0) {
-        error(at_field(kw, kd, "h_system"), kind + ": no h_system " + quoted(h_name));
+        error(at_field(kw, kd, "h_system"), kind + ": no h_system " + in_quotes(h_name));
         return false;
       }
       if (!plan.h_systems[static_cast<std::size_t>(found)].runtime) {
-        error(at_field(kw, kd, "h_system"), kind + ": h_system " + quoted(h_name) +
+        error(at_field(kw, kd, "h_system"), kind + ": h_system " + in_quotes(h_name) +
                                                 " has no cpu part (it is timing input only)");
         return false;
       }
@@ -841,7 +841,7 @@ class Planner {
       const auto& x = f.expansion_rack_failure();
       if (!x.has_number()) {
         error(kw, "expansion_rack_failure needs a number: number: 1..21 (an expansion_rack of " +
-                      quoted(plan.h_systems[static_cast<std::size_t>(found)].name) + ")");
+                      in_quotes(plan.h_systems[static_cast<std::size_t>(found)].name) + ")");
         return false;
       }
       const devices::HExpansionRack* r = nullptr;
@@ -850,7 +850,7 @@ class Planner {
       if (r == nullptr) {
         error(at_field(kw, kd, "number"),
               "expansion_rack_failure: h_system " +
-                  quoted(plan.h_systems[static_cast<std::size_t>(found)].name) +
+                  in_quotes(plan.h_systems[static_cast<std::size_t>(found)].name) +
                   " has no expansion_rack " + std::to_string(x.number()));
         return false;
       }
@@ -891,7 +891,7 @@ class Planner {
     int simulated = 0;
     for (const auto& hp : plan.h_systems) simulated += hp.runtime ? 1 : 0;
     if (simulated > 1)
-      pf.description += " (h_system " + quoted(plan.h_systems[static_cast<std::size_t>(found)].name) + ")";
+      pf.description += " (h_system " + in_quotes(plan.h_systems[static_cast<std::size_t>(found)].name) + ")";
     return good;
   }
 
@@ -1063,7 +1063,7 @@ class Planner {
           if (pf.dp_master < 0) {
             error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_master " +
                                                    std::to_string(mf.address()) + " on line " +
-                                                   quoted(ln));
+                                                   in_quotes(ln));
             continue;
           }
           for (std::size_t k = 0; k < plan.redundant_systems.size(); ++k)

@@ -37,7 +37,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kConformanceUsage =
     "usage: pbvbus conformance --gsd FILE [--module NAME]... [--address N] [--baud B]\n"
     "                          [--mutant NAME] [--pty PATH --speed N/M] [--only ID|GROUP]...\n"
     "                          [--json] [--junit FILE]\n"
@@ -212,7 +212,7 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
       return args[++i];
     };
     if (a == "-h" || a == "--help") {
-      out << kUsage;
+      out << kConformanceUsage;
       return 0;
     } else if (a == "--gsd") {
       auto v = value("--gsd");
@@ -283,7 +283,7 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
     } else if (a == "--markdown") {
       o.markdown = true;
     } else {
-      err << "pbvbus conformance: unknown argument '" << a << "'\n" << kUsage;
+      err << "pbvbus conformance: unknown argument '" << a << "'\n" << kConformanceUsage;
       return 2;
     }
   }
@@ -297,7 +297,7 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
     return run_mutation(o, out, err);
   }
   if (o.gsd.has_value() == o.scenario.has_value()) {
-    err << "pbvbus conformance: give either --gsd FILE or --scenario FILE --station ADDR|NAME\n" << kUsage;
+    err << "pbvbus conformance: give either --gsd FILE or --scenario FILE --station ADDR|NAME\n" << kConformanceUsage;
     return 2;
   }
   if (o.scenario && !o.station) {

@@ -29,7 +29,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kGatewayUsage =
     "usage: pbvbus gateway map SCENARIO [--json | --csv] [--gateway NAME]\n"
     "\n"
     "Prints the register map of each gateway of SCENARIO (Modbus units, tables, addresses,\n"
@@ -50,7 +50,7 @@ int cmd_gateway(const Args& args, std::ostream& out, std::ostream& err) {
   };
   if (args.empty()) return usage_error("missing subcommand (map)");
   if (args[0] == "-h" || args[0] == "--help") {
-    out << kUsage;
+    out << kGatewayUsage;
     return 0;
   }
   if (args[0] != "map") return usage_error("unknown subcommand '" + args[0] + "' (expected map)");
@@ -59,7 +59,7 @@ int cmd_gateway(const Args& args, std::ostream& out, std::ostream& err) {
   for (std::size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      out << kUsage;
+      out << kGatewayUsage;
       return 0;
     } else if (a == "--json") {
       json = true;

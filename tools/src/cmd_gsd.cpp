@@ -22,7 +22,7 @@ namespace {
 using devices::GsdBytes;
 using devices::GsdFile;
 
-constexpr const char* kUsage =
+constexpr const char* kGsdUsage =
     "usage: pbvbus gsd FILE [--json]\n"
     "\n"
     "Reads a GSD device description (PI 2.122, ISO-8859-1) and prints its ident number,\n"
@@ -51,7 +51,7 @@ std::string hex_list(const GsdBytes& bytes, const char* sep) {
   return s;
 }
 
-std::string hex_plain(const GsdBytes& bytes) { return hex_octets(bytes); }
+std::string gsd_hex(const GsdBytes& bytes) { return hex_octets(bytes); }
 
 std::string hex16(std::uint16_t v) {
   char buf[8];
@@ -92,7 +92,7 @@ std::string type_text(const devices::GsdExtUserPrmData& e) {
 // A PROFIsafe module's F-parameter block (defaults) and its description CRCs, under its module.
 void print_f_parameters(const GsdFile& f, const devices::GsdModule& m, std::ostream& out) {
   const GsdBytes block = f.f_prm_defaults(m);
-  out << "      F-parameters " << (block.empty() ? std::string("(none)") : hex_plain(block))
+  out << "      F-parameters " << (block.empty() ? std::string("(none)") : gsd_hex(block))
       << "; F_Ext_Module_Prm_Data_Len "
       << (m.f.prm.declared_len ? std::to_string(*m.f.prm.declared_len) : std::string("-"));
   if (m.f.param_desc_crc) out << ", F_ParamDescCRC " << hex16(*m.f.param_desc_crc);
@@ -154,7 +154,7 @@ void print_text(const GsdFile& f, std::ostream& out) {
     out << ": cfg " << hex_list(m.config, ",") << ", in " << m.input_len << ", out " << m.output_len;
     if (m.consistent) out << ", consistent";
     const GsdBytes prm = f.prm_area_defaults(m.prm);
-    if (!prm.empty()) out << ", prm " << hex_plain(prm);
+    if (!prm.empty()) out << ", prm " << gsd_hex(prm);
     out << "\n";
     if (m.f.present()) print_f_parameters(f, m, out);
   }
@@ -164,7 +164,7 @@ void print_text(const GsdFile& f, std::ostream& out) {
   out << "  User_Prm_Data_Len "
       << (g.declared_len ? std::to_string(*g.declared_len) : std::string("-"))
       << ", Max_User_Prm_Data_Len " << int(f.max_user_prm_data_len()) << "\n";
-  out << "  station defaults: " << (hex_plain(f.prm_area_defaults(g)).empty() ? "(none)" : hex_plain(f.prm_area_defaults(g))) << "\n";
+  out << "  station defaults: " << (gsd_hex(f.prm_area_defaults(g)).empty() ? "(none)" : gsd_hex(f.prm_area_defaults(g))) << "\n";
   print_ext_user_prm_data(f, "ExtUserPrmData", f.ext_user_prm_data(), out);
   print_ext_user_prm_data(f, "F_ExtUserPrmData", f.f_ext_user_prm_data(), out);
 
@@ -398,13 +398,13 @@ int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err) {
   std::string file;
   for (const auto& a : args) {
     if (a == "--help" || a == "-h") {
-      out << kUsage;
+      out << kGsdUsage;
       return 0;
     }
     if (a == "--json") {
       json = true;
     } else if (!a.empty() && a[0] == '-' && a != "-") {
-      err << "pbvbus gsd: unknown option '" << a << "'\n" << kUsage;
+      err << "pbvbus gsd: unknown option '" << a << "'\n" << kGsdUsage;
       return 2;
     } else if (!file.empty()) {
       err << "pbvbus gsd: only one FILE, got '" << file << "' and '" << a << "'\n";
@@ -414,7 +414,7 @@ int cmd_gsd(const Args& args, std::ostream& out, std::ostream& err) {
     }
   }
   if (file.empty()) {
-    err << kUsage;
+    err << kGsdUsage;
     return 2;
   }
   const devices::GsdParseResult r = devices::load_gsd(file);

@@ -23,7 +23,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kInspectUsage =
     "usage: pbvbus inspect CAPTURE [--json]\n"
     "\n"
     "Summarises a pcapng capture (pbvbus's own, or any pcapng with USER0 (147) or\n"
@@ -44,13 +44,13 @@ int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err) {
   std::string path;
   for (const std::string& a : args) {
     if (a == "--help" || a == "-h") {
-      out << kUsage;
+      out << kInspectUsage;
       return 0;
     }
     if (a == "--json") {
       json = true;
     } else if (a.size() > 1 && a[0] == '-') {
-      err << "pbvbus inspect: unknown option '" << a << "'\n" << kUsage;
+      err << "pbvbus inspect: unknown option '" << a << "'\n" << kInspectUsage;
       return 2;
     } else if (path.empty()) {
       path = a;
@@ -60,7 +60,7 @@ int cmd_inspect(const Args& args, std::ostream& out, std::ostream& err) {
     }
   }
   if (path.empty()) {
-    err << "pbvbus inspect: no capture file given\n" << kUsage;
+    err << "pbvbus inspect: no capture file given\n" << kInspectUsage;
     return 2;
   }
   std::error_code ec;

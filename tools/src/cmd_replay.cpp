@@ -52,7 +52,7 @@ namespace {
 
 namespace cf = conformance;
 
-constexpr const char* kUsage =
+constexpr const char* kReplayUsage =
     "usage: pbvbus replay CAPTURE --scenario FILE [--station ADDR] [--mutant ADDR:NAME]...\n"
     "                     [--line NAME] [--paced-as-recorded | --fast] [--mask RULE]...\n"
     "                     [--max-diffs N] [--min-tsdr N] [--max-tsdr N] [--json]\n"
@@ -107,7 +107,7 @@ std::optional<T> number(const std::string& s, T max) {
   return static_cast<T>(v);
 }
 
-std::optional<bus::Speed> parse_speed(const std::string& v) {
+std::optional<bus::Speed> parse_replay_speed(const std::string& v) {
   const auto slash = v.find('/');
   auto n = number<std::uint32_t>(v.substr(0, slash), 1'000'000'000);
   auto d = slash == std::string::npos ? std::optional<std::uint32_t>(1)
@@ -195,7 +195,7 @@ std::string parse_args(const Args& args, ReplayArgs& out) {
       (a == "--min-tsdr" ? out.min_tsdr : out.max_tsdr) = *n;
     } else if (a == "--speed") {
       auto v = value("--speed");
-      auto sp = v ? parse_speed(*v) : std::nullopt;
+      auto sp = v ? parse_replay_speed(*v) : std::nullopt;
       if (!sp) return "--speed needs N or N/M with positive integers, e.g. 1/1000";
       out.speed = *sp;
     } else if (a.size() > 1 && a[0] == '-') {
@@ -441,11 +441,11 @@ int run_scenario(const ReplayArgs& ra, const std::vector<std::uint8_t>& data, st
 int cmd_replay(const Args& args, std::ostream& out, std::ostream& err) {
   ReplayArgs ra;
   if (std::string e = parse_args(args, ra); !e.empty()) {
-    err << "pbvbus replay: " << e << "\n" << kUsage;
+    err << "pbvbus replay: " << e << "\n" << kReplayUsage;
     return 2;
   }
   if (ra.help) {
-    out << kUsage;
+    out << kReplayUsage;
     return 0;
   }
   std::string e;

@@ -59,7 +59,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kRunUsage =
     "usage: pbvbus run [SCENARIO] [options]\n"
     "\n"
     "Runs a scenario (Protocol Buffers text format, see scenario/proto/scenario.proto); without\n"
@@ -267,7 +267,7 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     return 2;
   }
   if (ra.help) {
-    out << kUsage << kClass2Usage;
+    out << kRunUsage << kClass2Usage;
     return 0;
   }
 

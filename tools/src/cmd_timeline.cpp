@@ -36,7 +36,7 @@ namespace pbvbus::tools {
 
 namespace {
 
-constexpr const char* kUsage =
+constexpr const char* kTimelineUsage =
     "usage: pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T] [--max-frames N]\n"
     "\n"
     "Draws a pcapng capture: one lane per line interface (or per probe interface) with every\n"
@@ -88,7 +88,7 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--help" || a == "-h") {
-      out << kUsage;
+      out << kTimelineUsage;
       return 0;
     }
     if (a == "--max-frames") {

@@ -86,7 +86,7 @@ using redundancy::CycleBits;
 using redundancy::LinePlan;
 using redundancy::SwitchoverPlan;
 
-constexpr const char* kUsage =
+constexpr const char* kTimingUsage =
     "usage: pbvbus timing SCENARIO [--json]\n"
     "\n"
     "Plans the DP rotation and switchover times of a scenario (docs/switchover-timing.md).\n"
@@ -514,13 +514,13 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
   std::string file;
   for (const auto& a : args) {
     if (a == "--help" || a == "-h") {
-      out << kUsage;
+      out << kTimingUsage;
       return 0;
     }
     if (a == "--json") {
       json = true;
     } else if (!a.empty() && a[0] == '-') {
-      err << "pbvbus timing: unknown option '" << a << "'\n" << kUsage;
+      err << "pbvbus timing: unknown option '" << a << "'\n" << kTimingUsage;
       return 2;
     } else if (!file.empty()) {
       err << "pbvbus timing: only one SCENARIO, got '" << file << "' and '" << a << "'\n";
@@ -530,7 +530,7 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
     }
   }
   if (file.empty()) {
-    err << "pbvbus timing: no SCENARIO given\n" << kUsage;
+    err << "pbvbus timing: no SCENARIO given\n" << kTimingUsage;
     return 2;
   }
   const LoadResult loaded = load_scenario_file(file);

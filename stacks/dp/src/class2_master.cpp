@@ -1,5 +1,6 @@
 // DP master class 2 (protocol-facts.md §D.7, §E.6); decisions are listed in class2_master.hpp.
 #include "pbvbus/dp/class2_master.hpp"
+#include "confirmation_kind.hpp"
 
 #include <algorithm>
 
@@ -25,13 +26,6 @@ std::string_view to_string(Class2Service s) {
 
 namespace {
 constexpr std::uint8_t kIdlePdu[] = {kFnIdle, 0x00};
-bool is_data(const Confirmation& con) {
-  return !con.short_ack && (con.status == ResponseStatus::DL || con.status == ResponseStatus::DH);
-}
-bool is_empty_ack(const Confirmation& con) {
-  return con.short_ack || ((con.status == ResponseStatus::OK || con.status == ResponseStatus::DL) &&
-                           con.data.empty());
-}
 bool is_c2(Class2Service s) {
   return s == Class2Service::C2Initiate || s == Class2Service::C2Read ||
          s == Class2Service::C2Write || s == Class2Service::C2Abort;

@@ -1,5 +1,6 @@
 // DP master class 1 (protocol-facts.md §D.9, §D.6, §E); decisions are listed in master.hpp.
 #include "pbvbus/dp/master.hpp"
+#include "confirmation_kind.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -82,14 +83,6 @@ std::vector<std::uint8_t> SlaveParams::chk_cfg_du() const {
 namespace {
 constexpr std::uint8_t kFaultsRestart = kDiagCfgFault | kDiagPrmFault | kDiagNotSupported;
 
-bool is_data(const Confirmation& con) {
-  return !con.short_ack && (con.status == ResponseStatus::DL || con.status == ResponseStatus::DH);
-}
-/// SC, or a response without data and a positive status: what Set_Prm/Chk_Cfg expect.
-bool is_empty_ack(const Confirmation& con) {
-  return con.short_ack || ((con.status == ResponseStatus::OK || con.status == ResponseStatus::DL) &&
-                           con.data.empty());
-}
 std::uint64_t make_tag(int kind, int slave) {
   return (static_cast<std::uint64_t>(kind) << 16) | static_cast<std::uint64_t>(slave & 0xFFFF);
 }

@@ -2,6 +2,7 @@
 #include "pbvbus/dp/slave_application.hpp"
 
 #include "pbvbus/dp/prm.hpp"
+#include "record_key.hpp"
 
 #include <algorithm>
 
@@ -16,12 +17,6 @@ std::string_view to_string(SlaveState s) {
   }
   return "?";
 }
-
-namespace {
-constexpr std::uint16_t record_key(std::uint8_t slot, std::uint8_t index) {
-  return static_cast<std::uint16_t>((slot << 8) | index);
-}
-}  // namespace
 
 SlaveApplication::SlaveApplication(const SlaveLayout& layout)
     : m_image(layout), m_module_states(layout.modules.size(), ModuleState::Ok) {

@@ -6,6 +6,7 @@
 
 #include "pbvbus/dp/dpv1_pdu.hpp"
 #include "pbvbus/dp/sap.hpp"
+#include "record_key.hpp"
 
 namespace pbvbus::dp {
 
@@ -22,9 +23,6 @@ SlaveLayout checked_layout(const SlaveConfig& cfg) {
   return l;
 }
 bool is_srd(RequestFn fn) { return fn == RequestFn::SrdHigh || fn == RequestFn::SrdLow; }
-constexpr std::uint16_t record_key(std::uint8_t slot, std::uint8_t index) {
-  return static_cast<std::uint16_t>((slot << 8) | index);
-}
 }  // namespace
 
 SlaveEngine::SlaveEngine(SlaveConfig cfg)

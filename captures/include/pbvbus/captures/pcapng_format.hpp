@@ -3,9 +3,13 @@
 // writes and reads: Section Header, Interface Description and Enhanced Packet blocks, and the
 // options of design.md "Captures".
 
+#include <cstddef>
 #include <cstdint>
 
 namespace pbvbus::captures::pcapng {
+
+/// Block bodies and option values are padded to 32 bits.
+constexpr std::size_t pad4(std::size_t n) { return (n + 3) & ~std::size_t{3}; }
 
 inline constexpr std::uint32_t kBlockShb = 0x0A0D0D0A;
 inline constexpr std::uint32_t kBlockIdb = 0x00000001;

@@ -1,4 +1,4 @@
-// Issue 10: what device testing costs (docs/benchmarks.md "Replay and conformance").
+// docs/conformance.md: what device testing costs (docs/benchmarks.md "Replay and conformance").
 //
 //   BM_ConformanceBattery/<gsd>  one whole battery (every group, every test) on a shipped GSD's
 //                                slave model — fast mode, a fresh model per test

@@ -1,4 +1,4 @@
-// DP master system speed and footprint (issue 3 "Must show"): one DP master class 1 (address 0)
+// DP master system speed and footprint (docs/benchmarks.md): one DP master class 1 (address 0)
 // and 125 DP slaves (addresses 1..125), each with 32 octets of inputs and 32 of outputs
 // (one configuration identifier 0xFF: 16 words in and out, consistent; a minimal GSD with that
 // one module is parsed from text below; inputs = a DP cycle counter), at 12 Mbit/s, built

@@ -1,4 +1,4 @@
-// Gateway benchmarks (issue 9): what a Modbus client costs the bus and how fast its writes
+// Gateway benchmarks (docs/gateway-modbus.md): what a Modbus client costs the bus and how fast its writes
 // reach a slave. Both run a real master system at 1.5 Mbit/s paced at real time (speed 1/1):
 // bus::Line + fdl::ActiveStation + dp::Master + one devices::SlaveModel from PBVB0A01.gsd
 // (module "16DI/16DO DC24V": 2 octets in, 2 out, as the first slave of examples/dp-basic),
@@ -19,7 +19,7 @@
 //                           cycle_max_us (virtual, dp::Master), max_lag_us, late_wakeups,
 //                           wakeups (PacedReport), req_per_s. The virtual DP cycle must be the
 //                           same with and without clients; the lag figures comparable.
-// Figures and command: docs/benchmarks.md, "Gateways (issue 9)".
+// Figures and command: docs/benchmarks.md, "Gateways (docs/gateway-modbus.md)".
 
 #include <arpa/inet.h>
 #include <benchmark/benchmark.h>

@@ -1,4 +1,4 @@
-// The full seeded H-system fault campaign (issue 8 "Must show"; devices/h_campaign.hpp): >= 1000
+// The full seeded H-system fault campaign (docs/h-system.md; devices/h_campaign.hpp): >= 1000
 // injections of CPU (power, STOP, comparison error, one-sided OB 121, operator swap), sync-link
 // (one fibre, both fibres at once), IM, line (short circuit) and DP master module faults, the
 // link-up/update faults (master HOLD, load-memory error, sync error, update timeout, standby

@@ -1,4 +1,4 @@
-// The H-system's user program (issue 8, deliverable 1; devices/h_program.hpp,
+// The H-system's user program (docs/h-system.md; devices/h_program.hpp,
 // devices/h_redundant_execution.hpp). Figures go to docs/benchmarks.md ("H programs").
 //
 //   BM_HProgramScan          one devices::Program::scan() (one OB 1) of a program with

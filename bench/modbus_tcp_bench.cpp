@@ -1,4 +1,4 @@
-// Modbus TCP door throughput (issue 9 "Must show": requests per second through pbvbus beside a
+// Modbus TCP door throughput (docs/gateway-modbus.md: requests per second through pbvbus beside a
 // minimal libmodbus server with the same client; goal >= 90 % of it).
 //
 // Both servers run on their own thread in this process, on loopback; the client is libmodbus

@@ -1,4 +1,4 @@
-// Switched I/O (issue 7): the redundant DP master system on two lines against the same stations
+// Switched I/O (docs/redundancy.md): the redundant DP master system on two lines against the same stations
 // as plain DP slaves on one line, measured in one run so that the ratio means something on the
 // shared 2-core machine. Figures and the command are in docs/benchmarks.md ("Switched I/O").
 //

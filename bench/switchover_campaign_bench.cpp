@@ -1,4 +1,4 @@
-// The full seeded random fault campaign for switched I/O (issue 7 "Must show";
+// The full seeded random fault campaign for switched I/O (docs/redundancy.md;
 // devices/switchover_campaign.hpp): >= 1000 faults and repairs drawn over interfaces (F10, F11,
 // F24), masters (F9, F14 stop), lines (F13 cut, F14 short) and their repairs, on two lines at
 // 1.5 Mbit/s with 4 switched stations (one of them PBVB0A11) and one one-sided slave per line,

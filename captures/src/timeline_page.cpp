@@ -50,7 +50,7 @@ const DX_OK = '#3f9b57', DX_MISS = '#e03131';
 // Colours of the lanes in the active-channel rows (by lane index).
 const LANE_COLOURS = ['#1c7ed6', '#f59f00', '#0ca678', '#ae3ec9', '#d6336c', '#74b816'];
 const ROW_AC = 14;
-// CPU rows (issue 8): colours by state number (cpu_event.hpp), as the SVG's.
+// CPU rows (docs/h-system.md): colours by state number (cpu_event.hpp), as the SVG's.
 const CPU_STATE_COLOURS = ['#ced4da', '#e03131', '#fab005', '#2f9e44', '#74c0fc', '#1971c2', '#f76707',
   '#9c36b5', '#5c0a0a', '#15aabf'];
 const ROW_CPU = 22, OB_COLOUR = '#212529';

@@ -18,7 +18,7 @@
 namespace pbvbus::tools {
 
 namespace {
-constexpr char kDefault[] = R"pb(# pbvbus scenario: an S7-400H-style H-system, the seeds' story (issue 8; docs/h-scenarios.md).
+constexpr char kDefault[] = R"pb(# pbvbus scenario: an S7-400H-style H-system, the seeds' story (docs/h-scenarios.md).
 #
 # A CPU pair (rack 0 and rack 1, sync link of two fibres) drives one redundant DP master system
 # "H-DP 1" on two lines at 1.5 Mbit/s: DP_A belongs to rack 0, DP_B to rack 1. Two switched

@@ -124,7 +124,7 @@ TEST(PcapngReader, GarbageGetsAClearErrorWithTheOffset) {
   EXPECT_EQ(error_of(g), "offset 12: unsupported pcapng major version 2");
 }
 
-// Replay's input (issue 10): the four broken-file cases the fuzz target's seeds also hold.
+// Replay's input (docs/replay.md): the four broken-file cases the fuzz target's seeds also hold.
 TEST(PcapngReader, ReplayInputCasesGetClearErrors) {
   const Bytes f = sample_capture();
   // An EPB claiming a captured length of 0xFFFFFFF0: an error, never a 4 GiB read or allocation

@@ -1,4 +1,4 @@
-// The CPU rows of an H system in the timeline model (timeline.hpp "CPU rows", issue 8): a
+// The CPU rows of an H system in the timeline model (timeline.hpp "CPU rows", docs/h-system.md): a
 // capture written here with one line interface and hand-made Cpu event records
 // (cpu_event_record) at known times; the (state, role) spans per CPU exactly, the OB marks, the
 // window, and the rows in the HTML data and the SVG.

@@ -1,4 +1,4 @@
-// The active channel of switched stations in the timeline model (timeline.hpp, issue 7): a
+// The active channel of switched stations in the timeline model (timeline.hpp, docs/redundancy.md): a
 // capture written here with two line interfaces and hand-made Redundancy event records at known
 // times; the spans per station exactly (start, end, line, lane), the mapping of line indices to
 // lanes, the window, and the rows in the HTML data and the SVG.

@@ -1,4 +1,4 @@
-// libFuzzer target for the capture reader as replay's input (issue 10 "must show": truncated
+// libFuzzer target for the capture reader as replay's input (docs/replay.md: truncated
 // blocks, wrong lengths, unknown block types, huge captured lengths): the bytes go through
 // captures::read_pcapng AND through the whole path `pbvbus replay` takes with them
 // (build_replay_input, replay_plan, the report's field names). Either a clear error or results

@@ -1,4 +1,4 @@
-// Modbus consistency under concurrency (issue 9 "must show"): four libmodbus TCP clients, each
+// Modbus consistency under concurrency (docs/gateway-modbus.md): four libmodbus TCP clients, each
 // on its own connection and thread, write the 16 holding registers of a consistent 16-word
 // module (PBVB0A04.gsd, identifier 0xFF) and read them back while the bus runs paced on the test
 // thread. Every value a client writes is one pattern in all 16 registers:

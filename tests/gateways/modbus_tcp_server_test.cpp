@@ -1,5 +1,5 @@
 // The Modbus TCP door with raw-socket clients: golden ADUs worked out by hand, pipelining, and
-// every robustness case of issue 9 (slow, stalled, half-open, flooding, garbage, wrong MBAP
+// every robustness case of docs/gateway-modbus.md (slow, stalled, half-open, flooding, garbage, wrong MBAP
 // length, no client allowed). The bus is a Scheduler + PacedRunner driven on the test thread;
 // each client runs on its own thread with blocking sockets.
 //

@@ -1,7 +1,7 @@
 // End-to-end: `pbvbus run` (the binary, a child process) on a scenario with a gateway, and
 // unmodified Debian clients — mbpoll and pymodbus over Modbus TCP and over RTU on the pty,
 // python-can over SLCAN (pty and TCP) and socketcand. Each reads an input the slave model
-// produces and writes an output that the slave model then sees (issue 9, "Must show").
+// produces and writes an output that the slave model then sees (docs/gateway-modbus.md).
 //
 // The station: examples/gsd/PBVB0A04.gsd at address 6 (one module, 32 octets in / 32 out,
 // consistent), inputs ECHO (input octet k = output octet k) except input octets 0..1, a constant

@@ -1,4 +1,4 @@
-// The capture of the built-in default scenario (examples/h-system.textproto, issue 8
+// The capture of the built-in default scenario (examples/h-system.textproto, docs/h-system.md
 // deliverable 5: "... and in the capture's event interface"), read by Debian's tshark with the
 // pbvbus Lua dissector: the CPU pair's state changes and OB 72s as Cpu records with their
 // fields, the H faults as Note records before their reactions, the OB 85s of the program as Cpu

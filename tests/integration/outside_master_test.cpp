@@ -1,4 +1,4 @@
-// A DP master outside pbvbus (issue 6, parts 3-5): tests/integration/outside_master.py, a small
+// A DP master outside pbvbus (docs/architecture.md "Masters outside pbvbus"): tests/integration/outside_master.py, a small
 // but real class-1 master written in Python, runs over a pty against two pbvbus DP slaves that
 // name no master. `pbvbus run` runs in a child process (cmd_run after fork(), so the test needs
 // no built binary), ends with SIGINT like a user's Ctrl-C, and its JSON report is compared with

@@ -1,4 +1,4 @@
-// An outside DP slave behind a pty (issue 10, "must show": a slave written for the test in
+// An outside DP slave behind a pty (docs/conformance.md: a slave written for the test in
 // Python with pyserial, one deliberately broken behaviour of it caught by the battery).
 // tests/integration/outside_slave.py is a small DP-V0 slave for examples/gsd/PBVB0A01.gsd; the
 // conformance battery creates a pty at the slave's address (bus::PtyStation, Interface timing)

@@ -1,4 +1,4 @@
-// `pbvbus replay` through the built binary (issue 10 "must show"): a capture of
+// `pbvbus replay` through the built binary (docs/replay.md): a capture of
 // examples/dp-basic.textproto replayed against the same scenario gives 0 differences with
 // every request compared, in both pacings; against a mutant station 4 the differences are
 // exactly the mutant's; captures with a cut-short frame or a bad FCS are read and reported;

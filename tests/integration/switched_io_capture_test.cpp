@@ -1,4 +1,4 @@
-// The capture of examples/switched-io.textproto (issue 7, "Captures and dissector"): both lines
+// The capture of examples/switched-io.textproto (docs/redundancy.md): both lines
 // in one pcapng (one interface each, named after the line), the redundancy events on the events
 // interface with their S7 ids, and Debian's tshark with the pbvbus Lua dissector reading it all:
 // the PrmCmd Set_Prms on the wire (start-up and every commanded switchover) and the events.

@@ -3,8 +3,8 @@
 // zlib) and dumps the DOM after the page script ran (body data-rendered="1", the lane group, the
 // DP cycle table, the fault marker); opened at a window of 150 µs through the URL fragment, the
 // page shows a bit-time axis, which it does not at the wide first view. The page of a
-// switched-io run (10 s) draws one active-channel row per switched station (issue 7), and the
-// page of the built-in default scenario (an H system) one row per CPU (issue 8).
+// switched-io run (10 s) draws one active-channel row per switched station (docs/redundancy.md), and the
+// page of the built-in default scenario (an H system) one row per CPU (docs/h-system.md).
 //
 // Skipped, with the reason, when no Chromium is installed (Debian: apt-get install chromium);
 // PBVBUS_CHROMIUM may name the browser binary.

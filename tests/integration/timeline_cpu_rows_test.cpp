@@ -1,4 +1,4 @@
-// The CPU rows in `pbvbus timeline` of the built-in default scenario's capture (issue 8, "a
+// The CPU rows in `pbvbus timeline` of the built-in default scenario's capture (docs/h-system.md, "a
 // timeline of states, roles and events per CPU"; examples/h-system.textproto): the real binary
 // runs `pbvbus run --capture X --quiet`, then `pbvbus timeline X -o X.svg` and `-o X.html`, as a
 // user would. Both CPUs get a row with their spans and OB ticks; the times are the scenario's

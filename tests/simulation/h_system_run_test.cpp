@@ -1,5 +1,5 @@
 // The built-in default scenario (examples/h-system.textproto) run through the Simulation: the
-// seeds' story of issue 8 deliverable 7, asserted from the run's report (the H-system part and
+// seeds' story of docs/h-system.md, asserted from the run's report (the H-system part and
 // the redundancy part) with the times worked out from the scenario:
 //   pair defaults in the file: startup 1 s, link-up 2 s (the first 1 s copying the load memory),
 //   update W = MAX(75 ms + 0.7 ms x 100 KB, 50 ms + T_PH 30 ms) = MAX(145, 80) = 145 ms,

@@ -207,7 +207,7 @@ TEST_F(CmdTimeline, SvgOfTheCut) {
   EXPECT_EQ(rc2, 0) << out2;
 }
 
-// The active channel of the switched stations (issue 7) in the page of a real run of
+// The active channel of the switched stations (docs/redundancy.md) in the page of a real run of
 // examples/switched-io.textproto (10 s). Every row starts with the station's start-up record
 // (DP_A, within the first few ms: the first Set_Prm carries Primary_Request); then 3 goes to
 // DP_B at F10 (1 s), 4 at F11 (2 s, no channel 2.3 s .. 2.6 s), 6 at F13 (3.5 s), 5 at F9

@@ -1,4 +1,4 @@
-// The simulated H-system in scenarios (issue 8; docs/h-scenarios.md): an h_system's `cpu` part
+// The simulated H-system in scenarios (docs/h-system.md; docs/h-scenarios.md): an h_system's `cpu` part
 // and `program` planned into HSystemPlan::runtime, the H faults planned into PlanFault, and
 // every refusal with its FILE:LINE:COLUMN (columns counted by hand in the comments). Also
 // built into sanitize_tools (ASan+UBSan): bad input must never crash.

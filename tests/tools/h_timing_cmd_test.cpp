@@ -1,4 +1,4 @@
-// `pbvbus timing` on h_system entries (issue 8, deliverable 6): the S7-400H manual's worked
+// `pbvbus timing` on h_system entries (docs/h-system.md): the S7-400H manual's worked
 // example (examples/h-update-example.textproto) reproduced exactly, text and JSON, with every
 // figure worked out by hand here from seeds-digest.md §3.1; the configured H parameters checked;
 // an h_system that takes its DP master system from a redundant_master_system; loader errors.

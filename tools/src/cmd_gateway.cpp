@@ -1,4 +1,4 @@
-// `pbvbus gateway map SCENARIO [--json|--csv] [--gateway NAME]` (issue 9): the register map of
+// `pbvbus gateway map SCENARIO [--json|--csv] [--gateway NAME]` (docs/gateway-modbus.md): the register map of
 // each gateway of a scenario, something an HMI engineer can import, and the CAN node/PDO map.
 //
 // Decisions:

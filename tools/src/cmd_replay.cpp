@@ -1,4 +1,4 @@
-// `pbvbus replay CAPTURE ...` (issue 10 item 1; docs/replay.md): the command line around the
+// `pbvbus replay CAPTURE ...` (docs/replay.md): the command line around the
 // replay core in conformance/ (replay_input.hpp, replay.hpp, replay_serial.hpp).
 //
 // Three forms:

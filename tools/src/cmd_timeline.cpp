@@ -1,5 +1,5 @@
 // `pbvbus timeline CAPTURE [-o FILE.html|FILE.svg] [--from T] [--to T] [--max-frames N]`: a picture of the bus
-// (issue 6): lanes of frames, token holders, DP cycles and events of a pcapng capture, as a
+// (README.md "A picture of the bus"): lanes of frames, token holders, DP cycles and events of a pcapng capture, as a
 // self-contained interactive HTML page or a static SVG. The model is captures/timeline.hpp, the
 // drawings captures/timeline_render.hpp; this file is only the command line around them.
 //

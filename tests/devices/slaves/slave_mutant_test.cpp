@@ -35,7 +35,7 @@ TEST(SlaveMutant, NamesRoundTrip) {
     EXPECT_EQ(parse_slave_mutant(slave_mutant_name(i.mutant)), i.mutant) << i.name;
     EXPECT_EQ(slave_mutant_name(i.mutant), i.name);
   }
-  // The spellings scenarios use (issue 10, docs/mutants.md), checked by hand.
+  // The spellings scenarios use (docs/mutants.md), checked by hand.
   EXPECT_EQ(parse_slave_mutant("tsdr_too_late"), SlaveMutant::TsdrTooLate);
   EXPECT_EQ(parse_slave_mutant("ignore_fcb"), SlaveMutant::IgnoreFcb);
   EXPECT_EQ(parse_slave_mutant("keep_state_on_power_cycle"), SlaveMutant::KeepStateOnPowerCycle);

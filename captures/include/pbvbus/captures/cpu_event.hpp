@@ -1,5 +1,5 @@
 #pragma once
-// The H-system CPU pair's events in a capture (EventCategory::Cpu; issue 8, deliverable 5;
+// The H-system CPU pair's events in a capture (EventCategory::Cpu; docs/h-system.md;
 // docs/h-scenarios.md). The captures layer does not depend on devices/, so the fields are
 // plain numbers here; their meaning is that of devices::HEvent (devices/h_cpu_pair.hpp), and
 // tools/h_report.cpp (h_event_record) checks with static_asserts that the numbers below match

@@ -1,8 +1,8 @@
 #pragma once
-// The model behind `pbvbus timeline CAPTURE` (issue 6, "a picture of the bus"): a capture read
+// The model behind `pbvbus timeline CAPTURE` (README.md "A picture of the bus"): a capture read
 // into lanes of frames with their times on the wire, who held the token when, the DP cycle of
-// every slave, the events, and (issue 7) the active channel of every switched station.
-// and (issue 8) the states, roles and OBs of the CPUs of an H system. timeline_render.hpp
+// every slave, the events, and (docs/redundancy.md) the active channel of every switched station.
+// and (docs/h-system.md) the states, roles and OBs of the CPUs of an H system. timeline_render.hpp
 // draws it as HTML or SVG.
 //
 // Decisions:
@@ -45,7 +45,7 @@
 //    do not decode are counted in `bad_event_records`. Line events that inject a fault (cable cut,
 //    short circuit, noise on, power off, transceiver failure, babbling on) are faults; their
 //    opposites are repairs; everything else is a plain event.
-//  - Active channel of a switched station (issue 7): from the Redundancy event records
+//  - Active channel of a switched station (docs/redundancy.md): from the Redundancy event records
 //    (category 4; code = redundancy::SystemEvent::Kind, a = station address, line = the line's
 //    index, Line::index()). A station gets a row if it has at least one switchover record
 //    (code 6, "station a's active channel is now line `line`", also at start-up); stations
@@ -63,7 +63,7 @@
 //    before '@' in interface order (pbvbus declares each line's interfaces together, in line
 //    index order) and the Nth group's first lane is line N's. A line index with no such lane
 //    keeps its index with line_lane = -1. Worked out on the whole capture like the token spans.
-//  - CPU rows of an H system (issue 8, "a timeline of states, roles and events per CPU"): from
+//  - CPU rows of an H system (docs/h-system.md): from
 //    the Cpu event records (category 5, cpu_event.hpp). A CPU gets a row if it has at least one
 //    State record (kind 0); a row is (system, rack): `system` is the name before ": CPU <rack>:"
 //    in the record's text (pbvbus writes "H-CPU: CPU 0: STOP -> STARTUP"; "" when the text does

@@ -16,7 +16,7 @@
 //             times (differences), "c0" cycle of the first poll (-1 none), "m" masters, "un"
 //             indices of unanswered polls
 //   "ev"      events: [time, style, category, text]
-//   "cpu"     CPU rows (issue 8): "states" and "roles" the names of the numbers; "rows" per CPU
+//   "cpu"     CPU rows (docs/h-system.md): "states" and "roles" the names of the numbers; "rows" per CPU
 //             "label" ("CPU 0 (rack 0)", with the system's name when several H systems are in
 //             the capture), "sys", "r" rack, spans "s" [start, end, state, role] and OB marks
 //             "ob" [time, OB number, event ID, reason, text]

@@ -1,5 +1,5 @@
 #pragma once
-// The conformance battery (issue 10): tests of a DP slave against the rules of IEC 61158-6 DP /
+// The conformance battery (docs/conformance.md): tests of a DP slave against the rules of IEC 61158-6 DP /
 // IEC 61784-1 CP 3/1 as PI 2.032 and test labs group them (protocol-facts.md §C–§F). A device
 // under test (DUT) is given by its GSD and module list and is either a slave model (a fresh
 // devices::SlaveModel per test, optionally a mutant) or an outside slave behind a pty (one

@@ -1,5 +1,5 @@
 #pragma once
-// Mutation score of the battery (issue 10 item 3): run it against every mutant slave
+// Mutation score of the battery (docs/conformance.md): run it against every mutant slave
 // (devices/slave_mutant.hpp) of a DUT spec and count which broken rules it catches
 // (conformance/src/mutation.cpp).
 //

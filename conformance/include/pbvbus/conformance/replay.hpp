@@ -1,5 +1,5 @@
 #pragma once
-// `pbvbus replay` (issue 10 item 1; docs/replay.md): the capture's initiator frames are sent
+// `pbvbus replay` (docs/replay.md): the capture's initiator frames are sent
 // again to a target — the slaves of a scenario whose masters are left out, one station of it,
 // or an outside slave behind a pty — and every reply is compared octet by octet with the
 // recorded one. Sans-I/O: the Replayer is a bus::Device; the caller builds the line and runs the

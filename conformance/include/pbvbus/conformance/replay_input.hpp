@@ -1,5 +1,5 @@
 #pragma once
-// Replay input (issue 10 item 1): one line of a pcapng capture read as the frames a replayer
+// Replay input (docs/replay.md): one line of a pcapng capture read as the frames a replayer
 // sends and the replies it compares with. Sans-I/O: bytes in, a ReplayInput out; never throws,
 // never crashes on a broken file (tests/conformance/replay_parser_test.cpp, fuzz_pcapng).
 //

@@ -1,5 +1,5 @@
 #pragma once
-// `pbvbus replay CAPTURE --to PTY` (issue 10 item 1; docs/replay.md): plays a capture's frames
+// `pbvbus replay CAPTURE --to PTY` (docs/replay.md): plays a capture's frames
 // raw into a serial port for an analyzer program, with the original pacing scaled by a speed
 // ratio (wall time). This is the one part of replay that does I/O.
 //

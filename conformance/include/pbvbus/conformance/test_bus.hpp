@@ -1,5 +1,5 @@
 #pragma once
-// The tester's side of a conformance run (issue 10): one line with a tester station (an
+// The tester's side of a conformance run (docs/conformance.md): one line with a tester station (an
 // initiator that the battery drives step by step) and the device under test. Sans-I/O like the
 // rest: the tester is a bus::Device; TestBus turns "send this telegram and wait for the answer"
 // into a synchronous call by running the scheduler (fast) or the PacedRunner (an outside DUT

@@ -1,5 +1,5 @@
 #pragma once
-// CAN frames and the CAN segment the gateway and its doors share (issue 9; tools-and-formats.md
+// CAN frames and the CAN segment the gateway and its doors share (docs/gateway-canopen.md; tools-and-formats.md
 // §2). A CanHub is the virtual CAN bus: the CANopen gateway and every attached transport (a
 // SocketCAN interface, SLCAN over a pty or TCP, socketcand over TCP — each connected client is
 // one port) are ports on it. A frame sent by one port reaches every other port, as on a real

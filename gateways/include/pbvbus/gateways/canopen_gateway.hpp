@@ -1,5 +1,5 @@
 #pragma once
-// The CANopen-style CAN gateway (issue 9; CiA 301 predefined connection set,
+// The CANopen-style CAN gateway (docs/gateway-canopen.md; CiA 301 predefined connection set,
 // tools-and-formats.md §2.6; docs/gateway-canopen.md): every DP slave of one master system is a
 // CANopen node on a virtual CAN segment (a CanHub). Sans-I/O: the gateway is one hub port and
 // one scheduler target in virtual time; the transports (SLCAN, socketcand, SocketCAN) are other

@@ -1,5 +1,5 @@
 #pragma once
-// CiA 301 names and the object dictionary of one gateway node (issue 9; tools-and-formats.md
+// CiA 301 names and the object dictionary of one gateway node (docs/gateway-canopen.md; tools-and-formats.md
 // §2.6; docs/gateway-canopen.md). A node is one DP slave of the master system; its dictionary is
 // computed from what the ProcessSource says at the moment of the SDO request, so it never holds
 // a copy that could go stale.

@@ -1,5 +1,5 @@
 #pragma once
-// ProcessSource over one plain dp::Master (issue 9): what the Modbus and CAN gateways see of a
+// ProcessSource over one plain dp::Master (docs/gateway-modbus.md): what the Modbus and CAN gateways see of a
 // single master system. Public dp::Master API only; all calls on the bus thread.
 //
 // Decisions:

@@ -1,5 +1,5 @@
 #pragma once
-// Modbus framing for the doors (issue 9): the MBAP header of Modbus TCP and the RTU frame with
+// Modbus framing for the doors (docs/gateway-modbus.md): the MBAP header of Modbus TCP and the RTU frame with
 // its CRC. Pure functions and one small state machine, no I/O, fuzzed (fuzz_modbus_frame).
 //
 // MBAP (Modbus Messaging on TCP/IP Implementation Guide V1.0b §3.1.3): TID(2) PID(2) LEN(2)

@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus gateway core (issue 9): answers request PDUs for one ProcessSource following the
+// The Modbus gateway core (docs/gateway-modbus.md): answers request PDUs for one ProcessSource following the
 // register layout of modbus_map.hpp. The doors (TCP/RTU) frame; this class only sees PDUs.
 //
 // libmodbus is the PDU engine (tools-and-formats §1.2/§1.3 Pattern A): one never-connected

@@ -1,6 +1,6 @@
 #pragma once
 // The seam between the Modbus doors (TCP with MBAP framing, RTU with CRC framing) and the
-// Modbus gateway core (issue 9). The doors frame, the core answers PDUs: a door strips its
+// Modbus gateway core (docs/gateway-modbus.md). The doors frame, the core answers PDUs: a door strips its
 // framing, hands the unit id and the request PDU (function code + data) to handle(), and frames
 // whatever PDU comes back. Everything runs on the bus thread (process_source.hpp).
 

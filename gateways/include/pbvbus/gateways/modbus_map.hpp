@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus register layout of one master system (issue 9), built once from a ProcessSource
+// The Modbus register layout of one master system (docs/gateway-modbus.md), built once from a ProcessSource
 // and the gateway options; `pbvbus gateway map` prints it (to_text/to_json/to_csv).
 //
 // Decisions fixed by the integrator (docs/gateway-modbus.md has the tables):

@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus gateway's options (issue 9): plain structs the scenario loader fills. The register
+// The Modbus gateway's options (docs/gateway-modbus.md): plain structs the scenario loader fills. The register
 // layout (modbus_map.hpp) and the gateway (modbus_gateway.hpp) both read them.
 
 #include <cstddef>

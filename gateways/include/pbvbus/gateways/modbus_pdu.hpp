@@ -1,5 +1,5 @@
 #pragma once
-// A request-PDU decoder for the function codes the Modbus gateway serves (issue 9): 01, 02,
+// A request-PDU decoder for the function codes the Modbus gateway serves (docs/gateway-modbus.md): 01, 02,
 // 03, 04, 05, 06, 15, 16, 23 and 43/14. It does every length and quantity check of the Modbus
 // Application Protocol V1.1b3 (§6) so the gateway can pre-check a request against a slave's map
 // before libmodbus sees it; libmodbus then only ever gets well-formed requests.

@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus RTU door (issue 9): a serial line (a pty the door owns, or a real serial device)
+// The Modbus RTU door (docs/gateway-modbus.md): a serial line (a pty the door owns, or a real serial device)
 // on the paced run's io_context; requests are framed by the RtuFramer (modbus_frame.hpp) and
 // handed to a ModbusHandler (the gateway core); its response PDU goes back as unit + PDU + CRC.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The Modbus TCP door (issue 9): a listening socket on the paced run's Boost.Asio io_context
+// The Modbus TCP door (docs/gateway-modbus.md): a listening socket on the paced run's Boost.Asio io_context
 // (bus::PacedRunner::io_context()); every connection's requests are framed by their MBAP header
 // (modbus_frame.hpp) and handed to a ModbusHandler (the gateway core) as unit + PDU; the PDU it
 // returns goes back with the request's transaction id and unit.

@@ -1,5 +1,5 @@
 #pragma once
-// What a gateway sees of one DP master system (issue 9; design.md "Doors to the outside"): the
+// What a gateway sees of one DP master system (docs/gateway-modbus.md; design.md "Doors to the outside"): the
 // configured slaves with their module layout, each slave's state and process data, the master's
 // mode and counters, and — for a redundant system — the standby side and the H-system state.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Gateways in scenarios (issue 9; scenario/proto/scenario.proto message Gateway): the loader's
+// Gateways in scenarios (docs/gateway-modbus.md; scenario/proto/scenario.proto message Gateway): the loader's
 // checked form of each `gateway` entry, planned after the DP systems and the h_systems.
 // GatewayNode (gateway_node.hpp) builds the running gateways from it.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// A scenario's h_system entries (issue 8; docs/h-timing.md): the inputs of the T_P15 procedure
+// A scenario's h_system entries (docs/h-system.md; docs/h-timing.md): the inputs of the T_P15 procedure
 // and the configured H parameters, checked by the loader (FILE:LINE:COLUMN) and turned into a
 // devices::UpdatePlanInput by h_update_input() (the DP master systems that name a
 // redundant_master_system take T_TR, T_DP_UM and T_SLAVE_UM from redundancy::plan_switchover:

@@ -1,5 +1,5 @@
 #pragma once
-// The gateways of a running Simulation (issue 9; gateway_plan.hpp has the scenario rules).
+// The gateways of a running Simulation (docs/gateway-modbus.md; gateway_plan.hpp has the scenario rules).
 // One GatewayNode per `gateway` entry: the ProcessSource adapter over the served master system
 // (gateways::DpMasterSource or RedundantSource, with the h_system's model when one drives it),
 // the Modbus core (gateways::ModbusGateway, one register map for all its Modbus doors), the

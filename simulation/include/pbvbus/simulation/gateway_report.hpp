@@ -1,5 +1,5 @@
 #pragma once
-// The gateways' part of the run report (issue 9): per gateway its doors (clients, requests,
+// The gateways' part of the run report (docs/gateway-modbus.md): per gateway its doors (clients, requests,
 // exceptions, CAN frames) and its cores' counters. Plain data, so the report does not depend on
 // the gateway layer's types (gateway_node.cpp fills it).
 //

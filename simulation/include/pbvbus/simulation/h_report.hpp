@@ -1,5 +1,5 @@
 #pragma once
-// The H-system part of a run's report (issue 8, deliverable 5; docs/h-scenarios.md): per
+// The H-system part of a run's report (docs/h-system.md; docs/h-scenarios.md): per
 // simulated CPU pair the final state, role and LEDs of each CPU and its diagnostic buffer, a
 // timeline per CPU, the I/O events (OB 70/85/86... filled by the H-system runtime) and the
 // measured update windows beside the planned T_P15 / T_PH; as text for a commissioning

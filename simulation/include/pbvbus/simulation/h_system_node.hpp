@@ -1,5 +1,5 @@
 #pragma once
-// A scenario's simulated h_system at run time (issue 8; docs/h-scenarios.md): the CPU pair
+// A scenario's simulated h_system at run time (docs/h-system.md; docs/h-scenarios.md): the CPU pair
 // (devices::HSystemModel) driving the redundant master systems the entry names, its user
 // program, the power-on times, the H faults of the scenario, the report part and the capture's
 // CPU records.

@@ -1,5 +1,5 @@
 #pragma once
-// A scenario's redundant_master_system at run time (issue 7; docs/redundancy.md): the two
+// A scenario's redundant_master_system at run time (docs/redundancy.md): the two
 // dp_masters of the system as one devices::RedundantMasterSystemModel, its switched_stations as
 // devices::SwitchedStationModels (interface 0 on line A, 1 on line B), the program, the faults
 // that concern it, the events (report, JSON and the capture's event interface) and the

@@ -120,7 +120,7 @@
 //                      "t_p15_window_*","planned_t_p15_*", "t_p15_verdict": str,
 //                      "t_ph_window_*","planned_t_ph_*", "t_ph_verdict": str,
 //                      "last_io_before_*","first_io_after_*" } ] } ],   // *_ns, *_ms; null
-//     "gateways": [ ... ] }        // every gateway (issue 9): its doors' clients, requests,
+//     "gateways": [ ... ] }        // every gateway (docs/gateway-modbus.md): its doors' clients, requests,
 //                                  // exceptions and CAN frames; fields in gateway_report.hpp
 //
 // A DP slave's "requests" count each request that reached its DP layer once, from any master
@@ -235,9 +235,9 @@ struct Report {
   std::vector<LineReport> lines;
   std::vector<DpMasterReport> dp_masters;
   std::vector<DpSlaveView> dp_slaves;
-  std::vector<RedundancyReport> redundancy;  ///< redundant master systems (issue 7)
-  std::vector<HSystemReport> h_systems;      ///< simulated H-system CPU pairs (issue 8)
-  std::vector<GatewayReport> gateways;       ///< gateways (issue 9; gateway_report.hpp)
+  std::vector<RedundancyReport> redundancy;  ///< redundant master systems (docs/redundancy.md)
+  std::vector<HSystemReport> h_systems;      ///< simulated H-system CPU pairs (docs/h-system.md)
+  std::vector<GatewayReport> gateways;       ///< gateways (docs/gateway-modbus.md; gateway_report.hpp)
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

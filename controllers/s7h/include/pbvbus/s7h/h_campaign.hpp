@@ -1,5 +1,5 @@
 #pragma once
-// A seeded fault campaign over the whole H-system (issue 8 "Must show"; seeds-digest.md §1, §7
+// A seeded fault campaign over the whole H-system (docs/h-system.md; seeds-digest.md §1, §7
 // F1, F5, F6, F9, F10, F14, F16, F17, §11 R1-R5; docs/h-campaign.md): the HSystemModel (CPU
 // pair) driving one redundant DP master system on two lines (rack r <-> line r), two switched
 // stations (PBVB0A10 at 20, PBVB0A11 at 21, the slow one) and one one-sided slave per line

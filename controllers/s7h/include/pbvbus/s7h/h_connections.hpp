@@ -1,5 +1,5 @@
 #pragma once
-// Configured S7 connections of an H-system over its CPs (issue 8; seeds-digest.md §7 F4, §11 R8;
+// Configured S7 connections of an H-system over its CPs (docs/h-system.md; seeds-digest.md §7 F4, §11 R8;
 // 000 §7.1 "fault-tolerant S7 connections", §9.1.4 "failure and replacement of a communication
 // processor"; docs/h-system.md "Connections and CPs (F4, R8)").
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU pair of an S7-400H-style H-system (issue 8, deliverable 2 and the first parts of 4
+// The CPU pair of an S7-400H-style H-system (docs/h-system.md
 // and 5; seeds-digest.md §1, §4, §6, §7; docs/h-system.md has the states, the rules and every
 // decision): two CPUs, rack 0 and rack 1, joined by a sync link of two fibres (0 = upper,
 // 1 = lower). Per CPU: operating state, role (master/standby), mode switch, diagnostic buffer,

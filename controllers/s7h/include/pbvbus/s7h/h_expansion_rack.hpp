@@ -1,5 +1,5 @@
 #pragma once
-// Expansion racks of the H-system's central racks (F8, issue 8; seeds-digest.md §1/§2 "one-sided
+// Expansion racks of the H-system's central racks (F8, docs/h-system.md; seeds-digest.md §1/§2 "one-sided
 // I/O", §6 OB table, §7 F8 "IM 460/461: expansion rack off; OB 86 on both"): an expansion rack
 // hangs on one CPU's central rack through IM 460 (send, in the CPU rack) -> IM 461 (receive, in
 // the expansion rack). Its modules are one-sided central I/O of that CPU. HSystemModel owns the

@@ -1,5 +1,5 @@
 #pragma once
-// The process image of one H-CPU (issue 8, deliverable 1; seeds-digest.md §5): the
+// The process image of one H-CPU (docs/h-system.md; seeds-digest.md §5): the
 // process-image input table (PII, "IB n"), the process-image output table (PIQ, "QB n") and the
 // CPU's memory area that holds every piece of user-program state (counters, pulse phase,
 // discrepancy timers: devices/h_program_spec.hpp's decision). docs/h-programs.md has the

@@ -1,5 +1,5 @@
 #pragma once
-// The user program of an H-CPU (issue 8, deliverable 1; seeds-digest.md §1, §5, §6 error 7960):
+// The user program of an H-CPU (docs/h-system.md; seeds-digest.md §1, §5, §6 error 7960):
 // a cyclic OB 1 over the process image, built from a devices::ProgramSpec (the scenario
 // loader's contract, h_program_spec.hpp). docs/h-programs.md has the networks, the memory
 // layout and every decision; RedundantExecution (h_redundant_execution.hpp) runs one program on

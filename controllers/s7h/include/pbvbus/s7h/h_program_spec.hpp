@@ -1,5 +1,5 @@
 #pragma once
-// What a scenario says about the user program of an H-system (issue 8, deliverable 1): a cyclic
+// What a scenario says about the user program of an H-system (docs/h-system.md): a cyclic
 // OB 1 over the process image with a scan time, built from a few kinds of networks a scenario
 // can combine. The scenario loader fills this struct; devices/h_program.hpp builds and runs it.
 //

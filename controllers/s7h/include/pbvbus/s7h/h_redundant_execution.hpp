@@ -1,5 +1,5 @@
 #pragma once
-// Redundant execution of the user program on both CPUs of an H-system (issue 8, deliverable 1;
+// Redundant execution of the user program on both CPUs of an H-system (docs/h-system.md;
 // seeds-digest.md §1 sync points, §5 identical values and the RAM/output-image comparison,
 // §7 F16/F18, §11 C3). The pair's view: rack 0 and rack 1, each with its own ProcessImage,
 // running the same Program. docs/h-programs.md has the decisions.

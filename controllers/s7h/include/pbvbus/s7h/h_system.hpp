@@ -1,5 +1,5 @@
 #pragma once
-// The H-system model (issue 8; docs/h-system.md "The H-system model (CPU pair + DP master
+// The H-system model (docs/h-system.md "The H-system model (CPU pair + DP master
 // systems)"; seeds-digest.md §1, §2, §6, §7 F1, F5–F7, F9–F14, §11): an HCpuPair (owned) driving
 // N redundant DP master systems (RedundantMasterSystemModel, not owned; rack r <-> line r of
 // each) on a bus::Scheduler, with the user program (OB 1) on the process images.

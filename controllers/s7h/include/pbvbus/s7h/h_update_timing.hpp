@@ -1,5 +1,5 @@
 #pragma once
-// H-system update planner and H-parameter checks (issue 8, deliverables 3 and 6; seeds-digest.md
+// H-system update planner and H-parameter checks (docs/h-system.md; seeds-digest.md
 // §3.1, §10 item 6, §11 T1–T8). A pure library: no I/O, no clock, no exceptions for bad values.
 // docs/h-timing.md has every term, the procedure, the decisions and the worked example.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Mutant slaves (issue 10): a SlaveModel option that breaks exactly ONE rule of the standard, so
+// Mutant slaves (docs/mutants.md): a SlaveModel option that breaks exactly ONE rule of the standard, so
 // that the conformance battery (conformance/) and the replayer can be shown to catch it. They
 // exist for the suite's own tests and for a developer who wants to see what a failure looks
 // like; a scenario names one with `dp_slave { mutant: "ignore_fcb" }`.

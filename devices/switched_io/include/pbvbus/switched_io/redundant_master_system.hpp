@@ -1,8 +1,8 @@
 #pragma once
-// The redundant DP master system on two real lines (issue 7; docs/redundancy.md "The redundant
+// The redundant DP master system on two real lines (docs/redundancy.md "The redundant
 // DP master system"): two DP masters class 1 (each a dp::Master on its own fdl::ActiveStation,
 // line 0 = A, line 1 = B) joined by a redundancy::MasterSystem, as the two CPUs of an H-system
-// would own them (issue 8 puts CPU models on top; until then this model stands for the pair).
+// would own them (docs/h-system.md puts CPU models on top; until then this model stands for the pair).
 //
 // Decisions:
 // - The masters' events go to the MasterSystem first, then to the owner's handler.

@@ -1,5 +1,5 @@
 #pragma once
-// A switched station on two real lines (issue 7; protocol-facts.md §G, docs/redundancy.md):
+// A switched station on two real lines (docs/redundancy.md; protocol-facts.md §G, docs/redundancy.md):
 // one PROFIBUS address, two DP slave interfaces (interface 0 for line A, interface 1 for line B),
 // one backplane, built from a GSD that declares System Redundancy (PrmCmd_supp = 1,
 // Slave_Redundancy_supp bit 0) and a module list, like SlaveModel.

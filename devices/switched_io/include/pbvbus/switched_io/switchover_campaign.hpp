@@ -1,5 +1,5 @@
 #pragma once
-// A seeded random fault campaign for switched I/O (issue 7 "Must show"; seeds-digest.md §2, §7
+// A seeded random fault campaign for switched I/O (docs/redundancy.md; seeds-digest.md §2, §7
 // F9–F14, F24, §11 S1–S4, S8): a redundant DP master system (RedundantMasterSystemModel) on two
 // lines, N switched stations (SwitchedStationModel; PBVB0A10, the second one PBVB0A11, the slow
 // one) and one-sided slaves (PBVB0A01) on each line. A program writes one 16-bit counter

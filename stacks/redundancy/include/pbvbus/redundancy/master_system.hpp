@@ -1,6 +1,6 @@
 #pragma once
 // The redundant DP master system (seeds-digest.md §2, §7 F9–F14, F24; protocol-facts.md §G;
-// issue 7): two DP masters class 1, one per line (line 0 = A, line 1 = B), configured as ONE
+// docs/redundancy.md): two DP masters class 1, one per line (line 0 = A, line 1 = B), configured as ONE
 // logical master system with the same slave addresses. Together they parameterise every
 // switched station on both lines, choose its active channel with PrmCmd Primary_Request,
 // supervise both channels and switch over: per station when the active interface or its path

@@ -4,7 +4,7 @@
 # alternating; prints every run and the medians and ratios (new / base) of the counters.
 #   BASE=/path/to/old/pbvbus_bench NEW=build/bin/pbvbus_bench bench/sidebyside.py FILTER [ROUNDS] [MIN_TIME]
 import json, subprocess, statistics, sys, os
-base = os.environ.get('BASE', '/work/base/build/bin/pbvbus_bench')
+base = os.environ.get('BASE', 'base/build/bin/pbvbus_bench')
 new = os.environ.get('NEW', 'build/bin/pbvbus_bench')
 filt = sys.argv[1]
 rounds = int(sys.argv[2]) if len(sys.argv) > 2 else 5

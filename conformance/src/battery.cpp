@@ -7,13 +7,21 @@
 //   defaults) with max TSDR = the GSD's MaxTsdr there and TSL = max(default TSL, max TSDR + 15);
 //   the model's own delay is the line's min TSDR (a fast ASIC, SlaveModel's default).
 // - Outside DUT (a program behind a pty): ONE paced TestBus with a PtyStation (Station mode at
-//   the DUT's address, Interface timing, reply window = TSL) for the whole run; each open()
-//   resets the program with an unlocking Set_Prm (Lock_Req 0, Unlock_Req 1) from the tester and
-//   10 ms of virtual idle; only the main baud. The pty path given is a symlink to the pty.
+//   the DUT's address, Interface timing, reply window = the plan's TSL) for the whole run; only
+//   the main baud. The pty path given is a symlink to the pty. Before the first test the runner
+//   waits (DutSpec::open_wait) until a program has opened the pty.
+// - Every outside session starts from a VERIFIED state (establish_start): the program is found
+//   (at the DUT's address, else where an earlier test may have left it, and moved back with
+//   Set_Slave_Add), its owner is read from the Slave_Diag and that owner's unlocking Set_Prm is
+//   sent (waiting out a watchdog if the owner is gone), and the diagnosis must then show Wait_Prm
+//   with no master. When that cannot be established the session is not opened: the test's
+//   verdict is Error (its rule was not tested), with the telegrams that showed why.
 // - Main baud: DutSpec::baud, else the highest rate the GSD supports up to 1.5 Mbit/s (else its
 //   lowest rate).
-// - Evidence: every session a test opened contributes its exchanges from its opening on (copied
-//   when the session closes), unless the body filled result.evidence itself.
+// - Evidence: every session a test opened contributes its own exchanges (from its opening on,
+//   reset included), unless the body filled result.evidence itself.
+// - Every reply of every test is checked for its addressing (reply_addressing_fault, §B.2): a
+//   reply with wrong addresses or SAPs fails the test whatever its own rule.
 // - An exception out of a body is a Fail with its message; the run goes on.
 
 #include <algorithm>
@@ -25,8 +33,11 @@
 #include "pbvbus/conformance/battery.hpp"
 
 #include "pbvbus/bus/pty.hpp"
+#include "pbvbus/dp/diagnosis.hpp"
+#include "pbvbus/dp/prm.hpp"
 #include "pbvbus/dp/sap.hpp"
 #include "steps.hpp"
+#include "timing_plan.hpp"
 
 namespace pbvbus::conformance {
 
@@ -90,6 +101,7 @@ class ModelSession final : public Session {
   TestBus& bus() override { return *m_bus; }
   std::uint8_t dut_address() const override { return m_model->address(); }
   devices::SlaveModel* model() override { return m_model.get(); }
+  std::span<const Exchange> exchanges() const override { return m_bus->transcript(); }
 
  private:
   std::unique_ptr<devices::SlaveModel> m_model;
@@ -125,6 +137,8 @@ class ContextBase : public TestContext {
     m_in = lens.value->first;
     m_out = lens.value->second;
     m_baud = main_baud(spec);
+    if (const auto bp = params_at(*spec.gsd, m_baud))
+      m_timing = detail::plan_timing(spec, m_params, m_in, m_out, m_baud, bp->tsl, dx_interval());
     return true;
   }
   bus::Baud baud() const { return m_baud; }
@@ -171,6 +185,17 @@ class ModelContext final : public ContextBase {
 
 // --- outside DUT behind a pty ------------------------------------------------------------------
 
+std::string duration_text(std::chrono::milliseconds d) {
+  return d.count() % 1000 == 0 ? std::to_string(d.count() / 1000) + " s" : std::to_string(d.count()) + " ms";
+}
+
+// TEMPORARY until PtyStation::wait_program_open lands.
+template <class P>
+bool wait_open(P& p, std::chrono::milliseconds limit) {
+  if constexpr (requires { p.wait_program_open(limit); }) return p.wait_program_open(limit);
+  else return true;
+}
+
 class OutsideSession final : public Session {
  public:
   OutsideSession(TestBus& bus, std::uint8_t address, EvidenceSink* sink)
@@ -184,6 +209,7 @@ class OutsideSession final : public Session {
   TestBus& bus() override { return m_bus; }
   std::uint8_t dut_address() const override { return m_address; }
   devices::SlaveModel* model() override { return nullptr; }
+  std::span<const Exchange> exchanges() const override { return m_bus.since(m_mark); }
 
  private:
   TestBus& m_bus;
@@ -212,6 +238,7 @@ class OutsideContext final : public ContextBase {
     }
     TestBusOptions to;
     to.params = *params;
+    to.params.tsl = m_timing.tsl_bits;  // long enough for a program to answer (timing_plan.cpp)
     to.paced = m_spec->speed;
     to.dx_interval = dx_interval();
     try {
@@ -220,7 +247,7 @@ class OutsideContext final : public ContextBase {
       po.mode = bus::PtyStation::Mode::Station;
       po.address = m_spec->address;
       po.timing = bus::PtyStation::Timing::Interface;
-      po.reply_window_bits = params->tsl;
+      po.reply_window_bits = m_timing.tsl_bits;
       m_pty = std::make_unique<bus::PtyStation>(po);
     } catch (const std::exception& e) {
       error = std::string("cannot open a pty: ") + e.what();
@@ -236,6 +263,17 @@ class OutsideContext final : public ContextBase {
     m_link_made = true;
     m_bus->attach_dut(*m_pty, "pty DUT");
     m_pty->attach_io(*m_bus->runner());
+    // A program started after the battery must find the link and open it before the first test
+    // (its first telegram would otherwise be STA-01's "no reply").
+    if (progress)
+      progress("waiting up to " + duration_text(m_spec->open_wait) + " for a program to open " +
+               *m_spec->pty_path + " (" + m_pty->path() + ")");
+    if (!wait_open(*m_pty, m_spec->open_wait)) {
+      error = "no program opened " + *m_spec->pty_path + " (" + m_pty->path() + ") within " +
+              duration_text(m_spec->open_wait);
+      return false;
+    }
+    if (progress) progress("a program opened " + *m_spec->pty_path + "; testing");
     m_bus->start();
     return true;
   }
@@ -250,17 +288,107 @@ class OutsideContext final : public ContextBase {
       return nullptr;
     }
     auto s = std::make_unique<OutsideSession>(*m_bus, m_spec->address, m_sink);
-    // Reset: an unlocking Set_Prm (Lock_Req 0, Unlock_Req 1) releases the program from any
-    // earlier test's parameterisation; then 10 ms of virtual idle.
-    dp::SlaveParams p = m_params;
-    p.station_status = dp::kPrmUnlockReq;
-    const auto du = detail::prm_du(p);
-    set_prm(*s, du, "reset: Set_Prm Unlock_Req");
-    m_bus->idle(10 * bus::kTicksPerMs);
+    if (!establish_start(*s, error)) {
+      error = "the test's starting state could not be established: " + error;
+      return nullptr;  // the session's telegrams still go into the evidence
+    }
     return s;
   }
 
+  std::function<void(const std::string&)> progress;
+
  private:
+  /// Slave_Diag from the tester to `address`; the decoded standard diagnosis, if any.
+  std::optional<dp::StandardDiag> probe(Session& s, std::uint8_t address, const std::string& note,
+                                        std::string& got) {
+    const auto t = detail::srd(address, s.bus().options().tester_address, dp::kSapSlaveDiag,
+                               dp::kSapMs0, {});
+    const detail::Reply r = detail::reply_of(s.bus().request(t, note));
+    got = r.describe();
+    dp::StandardDiag d;
+    if (!r.ok_with_data() || !dp::StandardDiag::decode(r.data, d)) return std::nullopt;
+    return d;
+  }
+
+  /// The unlocking Set_Prm (Lock_Req 0, Unlock_Req 1) from `owner` to `address`.
+  void unlock_from(Session& s, std::uint8_t address, std::uint8_t owner) {
+    dp::SlaveParams p = m_params;
+    p.station_status = dp::kPrmUnlockReq;
+    const auto du = detail::prm_du(p);
+    const auto t = detail::srd(address, owner, dp::kSapSetPrm, dp::kSapMs0, du);
+    s.bus().request(t, "start state: Set_Prm Unlock_Req from master " + std::to_string(owner));
+  }
+
+  /// Brings the program to the state every test starts from — at the DUT's address, in
+  /// Wait_Prm, owned by no master — and checks it with a Slave_Diag (battery.cpp header).
+  bool establish_start(Session& s, std::string& error) {
+    const std::uint8_t home = m_spec->address;
+    std::string got;
+    auto d = probe(s, home, "start state: Slave_Diag", got);
+    if (!d) {
+      // Where an earlier test may have left it: the Set_Slave_Add group's addresses and 126.
+      std::uint8_t found = 0;
+      for (const std::uint8_t a : {std::uint8_t{100}, std::uint8_t{101}, std::uint8_t{126}}) {
+        if (a == home) continue;
+        std::string g;
+        if (auto da = probe(s, a, "start state: is the DUT at " + std::to_string(a) + "?", g)) {
+          found = a;
+          d = da;
+          break;
+        }
+      }
+      if (!d) {
+        error = "the DUT answers no Slave_Diag at its address " + std::to_string(home) + " (" + got +
+                "), nor at 100, 101 or 126";
+        return false;
+      }
+      if (!m_spec->gsd->slave_features().set_slave_add_supp) {
+        error = "the DUT answers at " + std::to_string(found) + ", not at its address " +
+                std::to_string(home) + ", and its GSD has no Set_Slave_Add to move it back";
+        return false;
+      }
+      if (d->master_add != dp::kNoMaster) unlock_from(s, found, d->master_add);
+      const std::uint16_t ident = m_spec->gsd->ident_number();
+      const std::uint8_t du[4] = {home, static_cast<std::uint8_t>(ident >> 8),
+                                  static_cast<std::uint8_t>(ident & 0xFF), 0};
+      const auto t = detail::srd(found, s.bus().options().tester_address, dp::kSapSetSlaveAdd,
+                                 dp::kSapMs0, du);
+      s.bus().request(t, "start state: Set_Slave_Add back to " + std::to_string(home));
+      d = probe(s, home, "start state: Slave_Diag at " + std::to_string(home), got);
+      if (!d) {
+        error = "the DUT was at " + std::to_string(found) + " and does not answer at " +
+                std::to_string(home) + " after Set_Slave_Add (" + got + ")";
+        return false;
+      }
+    }
+    // Release whoever owns it (the tester, the class-2 master of an earlier test, ...).
+    const std::uint8_t owner =
+        d->master_add == dp::kNoMaster ? s.bus().options().tester_address : d->master_add;
+    unlock_from(s, home, owner);
+    d = probe(s, home, "start state: Slave_Diag after the unlock", got);
+    if (d && d->master_add != dp::kNoMaster && (d->status_2 & dp::kDiagWdOn) != 0) {
+      // The owner's unlock did not take; a watchdog still runs: wait it out (the battery's own
+      // watchdogs are at most max(TWD, 1 s)).
+      s.bus().idle(std::max<bus::Ticks>(m_timing.twd, bus::kTicksPerSecond) * 3 / 2);
+      d = probe(s, home, "start state: Slave_Diag after waiting out the watchdog", got);
+    }
+    if (!d) {
+      error = "Slave_Diag after the unlock answered " + got;
+      return false;
+    }
+    const bool wait_prm = (d->status_1 & dp::kDiagStationNotReady) != 0;
+    if (d->master_add != dp::kNoMaster || !wait_prm) {
+      const auto b = d->encode();
+      error = "after an unlocking Set_Prm from master " + std::to_string(owner) +
+              " the diagnosis is " + detail::hex(b) + ": expected Station_Not_Ready (octet 1 bit 1) " +
+              "and Master_Add FF (no owner), got " +
+              (wait_prm ? std::string("Station_Not_Ready") : std::string("Station_Not_Ready clear")) +
+              " and Master_Add " + std::to_string(d->master_add);
+      return false;
+    }
+    return true;
+  }
+
   std::unique_ptr<TestBus> m_bus;
   std::unique_ptr<bus::PtyStation> m_pty;
   bool m_link_made = false;
@@ -309,7 +437,13 @@ BatteryReport run_battery(const DutSpec& spec, const BatteryOptions& options) {
   std::string error;
   if (spec.pty_path) {
     auto oc = std::make_unique<OutsideContext>();
-    if (!oc->init(report.spec, error) || !oc->connect(error)) {
+    oc->progress = options.progress;
+    if (!oc->init(report.spec, error)) {
+      report.dut_error = error;
+      return report;
+    }
+    report.timing = oc->timing();
+    if (!oc->connect(error)) {
       report.dut_error = error;
       return report;
     }
@@ -325,6 +459,7 @@ BatteryReport run_battery(const DutSpec& spec, const BatteryOptions& options) {
       report.dut_error = error;
       return report;
     }
+    report.timing = mc->timing();
     ctx = std::move(mc);
   }
 
@@ -348,6 +483,16 @@ BatteryReport run_battery(const DutSpec& spec, const BatteryOptions& options) {
       r.message = "unknown exception";
     }
     ctx->set_sink(nullptr);
+    // Every reply of the test, whatever its rule, must mirror its request's addresses and SAPs.
+    if (r.verdict != Verdict::Fail) {
+      for (const Exchange& e : sink.exchanges) {
+        if (auto why = detail::reply_addressing_fault(e); !why.empty()) {
+          r.verdict = Verdict::Fail;
+          r.message = why + (r.message.empty() ? std::string() : " [the test itself: " + r.message + "]");
+          break;
+        }
+      }
+    }
     if (r.evidence.empty()) r.evidence = std::move(sink.exchanges);
     report.results.push_back(std::move(r));
   }

@@ -11,6 +11,10 @@
 //   configuration.
 // - Chk_Cfg in Wait_Prm: refused means the slave does not reach Data_Exch — RS, or SC without
 //   effect (the diagnosis still shows Not_Ready, Data_Exchange gets RS); either passes.
+// - Data_Exchange in Wait_Cfg (after a good Set_Prm, before any Chk_Cfg; §D.8 "Wait_Cfg accepts
+//   Chk_Cfg"): refused with RS, and the diagnosis after it still shows Station_Not_Ready. What
+//   the slave does next is not this test's rule (the standard does not say whether the refused
+//   telegram sends it back to Wait_Prm), so a good Chk_Cfg afterwards is not judged.
 
 #include "groups.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
@@ -90,6 +94,24 @@ void chk_cfg_in_wait_prm(TestContext& ctx, TestResult& r) {
   check(r, "Data_Exchange", expect_rs(data_exchange(*s, out)));
 }
 
+void data_exchange_in_wait_cfg(TestContext& ctx, TestResult& r) {
+  auto s = open_session(ctx, r);
+  if (!s) return;
+  const auto prm = prm_du(ctx.params());
+  if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm)))) return;
+  const auto out = output_pattern(ctx.output_len(), 0x5A);
+  const Reply x = data_exchange(*s, out, "Data_Exchange in Wait_Cfg (no Chk_Cfg yet)");
+  if (!x.rs()) {
+    fail(r, "Data_Exchange after Set_Prm, before Chk_Cfg (Wait_Cfg): expected RS (refused), got " +
+                x.describe());
+    return;
+  }
+  DiagExpect e;
+  e.s1_mask = dp::kDiagStationNotReady;
+  e.s1 = dp::kDiagStationNotReady;
+  check(r, "Slave_Diag after the refused Data_Exchange (still not ready)", check_diag(slave_diag(*s), e));
+}
+
 }  // namespace
 
 void add_chk_cfg_tests(std::vector<TestCase>& out) {
@@ -109,6 +131,11 @@ void add_chk_cfg_tests(std::vector<TestCase>& out) {
                  "Before a Set_Prm, Chk_Cfg does not bring the slave to data exchange (Wait_Prm accepts "
                  "only Set_Prm, Slave_Diag, Get_Cfg, Set_Slave_Add; §D.8)",
                  chk_cfg_in_wait_prm, {}});
+  out.push_back({"CFG-05", kChkCfgGroup, "Data_Exchange in Wait_Cfg refused",
+                 "After a good Set_Prm and before a good Chk_Cfg (Wait_Cfg) the slave accepts only "
+                 "Chk_Cfg (or Set_Prm again): a Data_Exchange gets RS and does not bring it to "
+                 "data exchange (§D.8)",
+                 data_exchange_in_wait_cfg, {SlaveMutant::DataExchangeInWaitCfg}});
 }
 
 }  // namespace pbvbus::conformance::detail

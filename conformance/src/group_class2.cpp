@@ -9,7 +9,7 @@
 //   (Master_Add) and data exchange with the tester stay, and a Data_Exchange from the class-2
 //   master is refused.
 // - "Takes control": after the tester's Set_Prm with Unlock_Req (§D.2: Lock 0, Unlock 1), or
-//   after the tester's watchdog (C2-04: 100 ms, 10 ms for an outside slave) has expired, the
+//   after the tester's watchdog (C2-04: the run's TWD, TimingPlan) has expired, the
 //   class-2 master's own start-up succeeds and Master_Add = 2.
 
 #include <algorithm>
@@ -38,7 +38,7 @@ void reads_while_locked(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   const auto out = run.outputs(0x3C);
   const Reply dx = reply_of(run.data_exchange(out, "tester: Data_Exchange outputs 3C"));
   if (!data_answer(ctx, dx)) return run.fail("tester's Data_Exchange answered " + dx.describe());
@@ -73,7 +73,7 @@ void foreign_set_prm(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   const auto p2 = class2_params(ctx);
   run.set_prm(p2.set_prm_du(), "class 2: Set_Prm (Lock_Req) to the locked slave", kClass2Master);
   run.chk_cfg(p2.chk_cfg_du(), "class 2: Chk_Cfg", kClass2Master);
@@ -124,7 +124,7 @@ void takes_control_after_unlock(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   dp::SlaveParams unlock = ctx.params();
   unlock.station_status = dp::kPrmUnlockReq;
   run.set_prm(unlock.set_prm_du(), "tester: Set_Prm with Unlock_Req");
@@ -134,15 +134,12 @@ void takes_control_after_unlock(TestContext& ctx, TestResult& res) {
 void takes_control_after_watchdog(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
-  dp::SlaveParams p = ctx.params();
+  // The run's watchdog (TimingPlan), as in the Interruption group.
+  dp::SlaveParams p = with_plan_watchdog(ctx, ctx.params());
   p.station_status |= dp::kPrmWdOn;
-  const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
-  // 100 ms (10 ms for a paced outside slave, as in the Interruption group).
-  p.wd_fact_1 = static_cast<std::uint8_t>((base_1ms ? 10 : 1) * (ctx.outside() ? 1 : 10));
-  p.wd_fact_2 = 1;
-  const bus::Ticks twd = dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
+  const bus::Ticks twd = watchdog_time(p);
   std::string why;
-  if (!run.start_up(why, &p)) return run.fail(why);
+  if (!run.start_up(why, &p)) return run.not_ready(why);
   run.bus().idle(twd + twd / 2);
   class2_takes_over(run, "the tester's watchdog expired");
 }
@@ -156,7 +153,7 @@ void add_class2_tests(std::vector<TestCase>& out) {
       "While another master owns the slave, a class-2 master gets Slave_Diag (Master_Add = the "
       "owner), Get_Cfg, Rd_Inp and Rd_Outp answered (IEC 61158-6 DP; protocol-facts.md §D.8 "
       "Locking, §D.4, §D.7)",
-      {SlaveMutant::WrongGetCfg}, reads_while_locked));
+      {SlaveMutant::WrongGetCfg, SlaveMutant::GetCfgSapsNotSwapped}, reads_while_locked));
   out.push_back(make_case(
       "C2-02", kClass2Group, "Class-2 Set_Prm has no effect while locked",
       "A Set_Prm or Chk_Cfg from a master other than the owner has no effect on a locked slave; "

@@ -31,7 +31,7 @@ bool setup(TestContext& ctx, TestResult& r, std::unique_ptr<Session>& s) {
   }
   s = open_session(ctx, r);
   if (!s) return false;
-  return !check(r, "start-up", start_up(*s, ctx));
+  return !precondition(r, start_up(*s, ctx));
 }
 
 /// Rd_Outp by master 2 must show `want`.

@@ -50,7 +50,7 @@ void diag_ident(TestContext& ctx, TestResult& res) {
                     " in Wait_Prm, the GSD "
                     "says Ident_Number " +
                     hex(ident_octets(want)));
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   d = run.diag(why, "Slave_Diag in Data_Exch");
   if (!d) return run.fail(why);
   if (d->ident != want)
@@ -66,7 +66,7 @@ void get_cfg_is_gsd_cfg(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   const auto want = ctx.params().chk_cfg_du();
   const Reply r = reply_of(run.get_cfg());
   if (!r.ok_with_data() || r.data != want)
@@ -81,7 +81,7 @@ void io_lengths(TestContext& ctx, TestResult& res) {
   const auto len = devices::gsd_cfg_lengths(ctx.params().chk_cfg_du(), &err);
   if (!len) return run.fail("the GSD module identifiers cannot be read: " + err);
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   const std::vector<std::uint8_t> out(len->output_len, 0);
   const Reply r = reply_of(run.data_exchange(
       out, "Data_Exchange with " + std::to_string(len->output_len) + " output octets"));
@@ -169,7 +169,7 @@ void max_diag_len(TestContext& ctx, TestResult& res) {
   run.chk_cfg(cfg, "Chk_Cfg with one module too many");
   if (!check("Slave_Diag after a wrong Chk_Cfg")) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   if (!check("Slave_Diag in Data_Exch")) return;
   if (run.model() && ctx.spec().gsd->dpv1().dpv1_slave && p.dpv1()) {
     if (run.model()->apply(devices::SlaveFault::process_alarm(0, {0x01})).empty() &&
@@ -260,7 +260,7 @@ void add_gsd_tests(std::vector<TestCase>& out) {
       "GSD-02", kGsdGroup, "Get_Cfg = the modules' identifiers",
       "Get_Cfg returns the real configuration: the identifiers of the configured GSD modules "
       "(PI 2.122 Module; protocol-facts.md §D.3, §I.1)",
-      {SlaveMutant::WrongGetCfg}, get_cfg_is_gsd_cfg));
+      {SlaveMutant::WrongGetCfg, SlaveMutant::GetCfgSapsNotSwapped}, get_cfg_is_gsd_cfg));
   out.push_back(
       make_case("GSD-03", kGsdGroup, "Data_Exchange lengths",
                 "Data_Exchange takes as many output octets and returns as many input octets as the "

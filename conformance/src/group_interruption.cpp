@@ -4,10 +4,10 @@
 // §D.2 WD_Fact_1/2).
 //
 // Decisions:
-// - These tests parameterise the watchdog at 100 ms (WD_Fact_1 = 10, WD_Fact_2 = 1, base 10 ms;
-//   with WD_Base_1ms in the GSD-assembled DPV1_Status_1: 100 x 1 x 1 ms), long against a message
-//   cycle. An outside slave gets 10 ms (WD_Fact 1 x 1, as cbat's watchdog tests): paced at 1/1000
-//   the 150 ms wait would take 150 s of wall time, the 10 ms one 15 s.
+// - These tests parameterise the run's watchdog (TimingPlan, timing_plan.cpp): at least 100 ms
+//   and 4 × the longest exchange at the run's baud and pace (WD_Fact_1 × WD_Fact_2 × 10 ms, or
+//   × 1 ms with WD_Base_1ms in the GSD-assembled DPV1_Status_1), so that at 9.6 kbit/s, where
+//   one Chk_Cfg lasts 20 ms, no normal exchange looks like a silence.
 // - "Longer than the watchdog" = 1.5 × TWD of silence, "shorter" = 0.5 × TWD.
 // - After a watchdog expiry or a power cycle the slave must be in Wait_Prm: Slave_Diag octet 1
 //   has Station_Not_Ready, octet 4 (Master_Add) is FF, and Data_Exchange is not answered with
@@ -29,14 +29,12 @@ namespace {
 
 constexpr const char* kInterruptionGroup = "Interruption";
 
-/// The context's parameters with a 100 ms watchdog (10 ms for an outside slave).
+/// The context's parameters with the run's watchdog (TimingPlan: at least 100 ms and four times
+/// the longest exchange at the run's baud and pace).
 dp::SlaveParams with_short_watchdog(const TestContext& ctx, bus::Ticks& twd) {
-  dp::SlaveParams p = ctx.params();
+  dp::SlaveParams p = with_plan_watchdog(ctx, ctx.params());
   p.station_status |= dp::kPrmWdOn;
-  const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
-  p.wd_fact_1 = static_cast<std::uint8_t>((base_1ms ? 10 : 1) * (ctx.outside() ? 1 : 10));
-  p.wd_fact_2 = 1;
-  twd = dp::watchdog_ticks(p.wd_fact_1, p.wd_fact_2, base_1ms);
+  twd = watchdog_time(p);
   return p;
 }
 
@@ -85,7 +83,7 @@ bool outputs_safe(Run& run, const std::string& when) {
 bool operate(Run& run, const dp::SlaveParams& p, std::uint8_t fill) {
   std::string why;
   if (!run.start_up(why, &p)) {
-    run.fail(why);
+    run.not_ready(why);
     return false;
   }
   const Reply r = reply_of(run.data_exchange(run.outputs(fill), "Data_Exchange"));

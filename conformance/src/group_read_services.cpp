@@ -42,7 +42,7 @@ void get_cfg_matches_gsd(TestContext& ctx, TestResult& r) {
   if (!s) return;
   const auto cfg = cfg_du(ctx.params());
   if (check(r, "Get_Cfg in Wait_Prm", expect_data(get_cfg(*s, "Get_Cfg in Wait_Prm"), cfg))) return;
-  if (check(r, "start-up", start_up(*s, ctx))) return;
+  if (precondition(r, start_up(*s, ctx))) return;
   if (check(r, "Get_Cfg in Data_Exch", expect_data(get_cfg(*s, "Get_Cfg in Data_Exch"), cfg))) return;
   check(r, "Get_Cfg from master 2", expect_data(get_cfg(*s, "Get_Cfg from master 2", kOtherMaster), cfg));
 }
@@ -54,7 +54,7 @@ void rd_inp_test(TestContext& ctx, TestResult& r, std::optional<std::uint8_t> re
   }
   auto s = open_session(ctx, r);
   if (!s) return;
-  if (check(r, "start-up", start_up(*s, ctx))) return;
+  if (precondition(r, start_up(*s, ctx))) return;
   set_model_inputs(*s, 0x31);
   const auto out = output_pattern(ctx.output_len(), 0x42);
   const Reply dx = data_exchange(*s, out);
@@ -73,7 +73,7 @@ void rd_outp_test(TestContext& ctx, TestResult& r, std::optional<std::uint8_t> r
   }
   auto s = open_session(ctx, r);
   if (!s) return;
-  if (check(r, "start-up", start_up(*s, ctx))) return;
+  if (precondition(r, start_up(*s, ctx))) return;
   const auto out = output_pattern(ctx.output_len(), 0x53);
   const Reply dx = data_exchange(*s, out);
   if (ctx.input_len() == 0 ? dx.kind != Reply::Kind::Sc : !dx.ok_with_data()) {
@@ -104,7 +104,7 @@ void add_read_service_tests(std::vector<TestCase>& out) {
   out.push_back({"RD-01", kReadServicesGroup, "Get_Cfg = the GSD configuration",
                  "Get_Cfg answers the real configuration: the configured GSD modules' identifier "
                  "octets in module order, in any state and to any master (§D.3, §D.8)",
-                 get_cfg_matches_gsd, {SlaveMutant::WrongGetCfg}});
+                 get_cfg_matches_gsd, {SlaveMutant::WrongGetCfg, SlaveMutant::GetCfgSapsNotSwapped}});
   out.push_back({"RD-02", kReadServicesGroup, "Rd_Inp",
                  "Rd_Inp (SAP 56) answers the slave's inputs: those of the last Data_Exchange reply, "
                  "with the configured input length (§D.7)",

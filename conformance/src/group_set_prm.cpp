@@ -7,17 +7,18 @@
 // - Wrong content: the first Ext_User_Prm_Data_Ref parameter (global area, then the modules'
 //   areas) whose field can hold a value its ExtUserPrmData does not allow gets that value. A GSD
 //   whose every parameter allows every value of its field has no wrong content: n/a.
-// - Watchdog: TWD from the battery's Set_Prm (10 × 10 × 10 ms = 1 s unless the GSD's defaults
-//   say otherwise). The slave is checked 1 % of TWD (at least 1 ms) before and after the expiry,
-//   counted from the end of the owner's last request (the frame that restarted the watchdog):
-//   each check on a fresh session, because the checking Slave_Diag from the owner would itself
-//   restart the watchdog. An outside slave gets WD_Fact 1 × 1 (10 ms): paced at 1/1000 one
-//   virtual second would take over 16 minutes of wall time.
+// - Watchdog: TWD and the margin of the checks from the run's TimingPlan (timing_plan.cpp: at
+//   least 100 ms and 4 × the longest exchange, so no normal exchange looks like a silence at any
+//   baud). The slave is checked the plan's margin (a model: 1 % of TWD, at least 1 ms) before
+//   and after the expiry, counted from the end of the owner's last request (the frame that
+//   restarted the watchdog): each check on a fresh session, because the checking Slave_Diag
+//   from the owner would itself restart the watchdog.
 // - Min TSDR: Set_Prm with min TSDR 60 (or the line's max TSDR − 1 if that is lower); every reply
 //   after it (Chk_Cfg, Slave_Diag, Data_Exchange) must start at least that many bit times after
 //   its request.
 
 #include <algorithm>
+#include <cstdio>
 
 #include "groups.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
@@ -173,7 +174,7 @@ void wrong_content(TestContext& ctx, TestResult& r) {
 void lock_against_other_master(TestContext& ctx, TestResult& r) {
   auto s = open_session(ctx, r);
   if (!s) return;
-  if (check(r, "start-up", start_up(*s, ctx))) return;
+  if (precondition(r, start_up(*s, ctx))) return;
   const std::uint8_t me = tester_address(*s);
   dp::SlaveParams other = ctx.params();
   const auto du = prm_du(other);
@@ -191,7 +192,7 @@ void lock_against_other_master(TestContext& ctx, TestResult& r) {
 void unlock(TestContext& ctx, TestResult& r) {
   auto s = open_session(ctx, r);
   if (!s) return;
-  if (check(r, "start-up", start_up(*s, ctx))) return;
+  if (precondition(r, start_up(*s, ctx))) return;
   dp::SlaveParams p = ctx.params();
   p.station_status = dp::kPrmUnlockReq;
   const auto du = prm_du(p);
@@ -205,7 +206,7 @@ void unlock(TestContext& ctx, TestResult& r) {
 /// (the watchdog's last restart), then Slave_Diag.
 Reply after_silence(TestContext& ctx, TestResult& r, Session& s, const dp::SlaveParams& p, bus::Ticks offset,
                     const std::string& note) {
-  if (check(r, "start-up", start_up(s, ctx, p))) return {};
+  if (precondition(r, start_up(s, ctx, p))) return {};
   const auto out = output_pattern(ctx.output_len(), 0x77);
   data_exchange(s, out, "Data_Exchange (last frame from the owner)");
   const Exchange& last = s.bus().transcript().back();
@@ -214,15 +215,14 @@ Reply after_silence(TestContext& ctx, TestResult& r, Session& s, const dp::Slave
   return reply_of(s.bus().request(diag, note, at));
 }
 
-bus::Ticks margin(bus::Ticks twd) { return std::max<bus::Ticks>(bus::kTicksPerMs, twd / 100); }
-
-/// The Set_Prm of the watchdog tests: the battery's, or for an outside slave (paced, where one
-/// virtual second is many wall seconds) the shortest watchdog, WD_Fact 1 × 1 (10 ms).
-dp::SlaveParams watchdog_params(TestContext& ctx) {
-  dp::SlaveParams p = ctx.params();
-  if (ctx.outside()) p.wd_fact_1 = p.wd_fact_2 = 1;
-  return p;
+std::string ms(bus::Ticks t) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f ms", static_cast<double>(t) / static_cast<double>(bus::kTicksPerMs));
+  return b;
 }
+
+/// The Set_Prm of the watchdog tests: the battery's with the run's watchdog (TimingPlan).
+dp::SlaveParams watchdog_params(TestContext& ctx) { return with_plan_watchdog(ctx, ctx.params()); }
 
 void watchdog_expiry(TestContext& ctx, TestResult& r) {
   r.timing_not_meaningful = ctx.outside();
@@ -232,15 +232,17 @@ void watchdog_expiry(TestContext& ctx, TestResult& r) {
   {
     auto s = open_session(ctx, r);
     if (!s) return;
-    const Reply before = after_silence(ctx, r, *s, p, twd - margin(twd), "Slave_Diag 1 % before TWD");
-    if (r.verdict == Verdict::Fail) return;
+    const bus::Ticks margin = ctx.timing().wd_margin;
+    const Reply before = after_silence(ctx, r, *s, p, twd - margin, "Slave_Diag " + ms(margin) + " before TWD");
+    if (r.verdict != Verdict::Pass) return;
     if (check(r, "just before the watchdog expires", check_diag(before, data_exch(ctx, tester_address(*s)))))
       return;
   }
   auto s = open_session(ctx, r);
   if (!s) return;
-  const Reply after = after_silence(ctx, r, *s, p, twd + margin(twd), "Slave_Diag 1 % after TWD");
-  if (r.verdict == Verdict::Fail) return;
+  const bus::Ticks margin = ctx.timing().wd_margin;
+  const Reply after = after_silence(ctx, r, *s, p, twd + margin, "Slave_Diag " + ms(margin) + " after TWD");
+  if (r.verdict != Verdict::Pass) return;
   check(r, "just after the watchdog expired (back to Wait_Prm)", check_diag(after, wait_prm(ctx)));
 }
 
@@ -251,8 +253,9 @@ void watchdog_off(TestContext& ctx, TestResult& r) {
   p.station_status = static_cast<std::uint8_t>((p.station_status | dp::kPrmLockReq) & ~dp::kPrmWdOn);
   auto s = open_session(ctx, r);
   if (!s) return;
-  const Reply d = after_silence(ctx, r, *s, p, twd + margin(twd), "Slave_Diag after TWD of silence, WD off");
-  if (r.verdict == Verdict::Fail) return;
+  const Reply d = after_silence(ctx, r, *s, p, twd + ctx.timing().wd_margin,
+                                "Slave_Diag after TWD of silence, WD off");
+  if (r.verdict != Verdict::Pass) return;
   DiagExpect e = data_exch(ctx, tester_address(*s));
   e.s2_mask |= dp::kDiagWdOn;  // WD_On must be clear
   check(r, "watchdog off: still Data_Exch", check_diag(d, e));
@@ -260,6 +263,10 @@ void watchdog_off(TestContext& ctx, TestResult& r) {
 
 void min_tsdr_honoured(TestContext& ctx, TestResult& r) {
   r.timing_not_meaningful = ctx.outside();
+  if (ctx.outside())
+    return not_applicable(r, "behind a pty the interface puts the program's reply on the line as "
+                             "soon as it is written and the line is free: the reply's start is the "
+                             "pty's and the operating system's, not the device's min TSDR");
   auto s = open_session(ctx, r);
   if (!s) return;
   dp::SlaveParams p = ctx.params();

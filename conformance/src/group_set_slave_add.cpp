@@ -138,7 +138,7 @@ void in_data_exchange(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   std::string why;
-  if (!run.start_up(why)) return run.fail(why);
+  if (!run.start_up(why)) return run.not_ready(why);
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
   const Reply r = reply_of(
       run.set_slave_add(old_a, new_a, ctx.params().ident, false, "Set_Slave_Add in Data_Exch"));

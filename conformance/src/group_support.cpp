@@ -60,8 +60,8 @@ Run::Run(TestContext& ctx, TestResult& result, std::optional<bus::Baud> baud)
   std::string error;
   m_session = ctx.open(baud, error);
   if (!m_session) {
-    m_result.verdict = Verdict::Fail;
-    m_result.message = "the device under test could not be started: " + error;
+    m_result.verdict = Verdict::Error;
+    m_result.message = "no session with the device under test: " + error;
     return;
   }
   m_tester = m_session->bus().options().tester_address;
@@ -85,7 +85,7 @@ Run::~Run() {
 
 void Run::collect() {
   if (!m_session) return;
-  const auto& t = m_session->bus().transcript();
+  const auto t = m_session->exchanges();
   m_evidence.insert(m_evidence.end(), t.begin(), t.end());
 }
 
@@ -245,6 +245,16 @@ void Run::pass(std::string message) {
 void Run::fail(std::string message) {
   m_result.verdict = Verdict::Fail;
   m_result.message = std::move(message);
+}
+
+void Run::error(std::string message) {
+  m_result.verdict = Verdict::Error;
+  m_result.message = std::move(message);
+}
+
+void Run::not_ready(const std::string& why) {
+  error("precondition not established: the device did not reach Data_Exch with the GSD's "
+        "parameters (" + why + "); the Start-up group's tests say why");
 }
 
 void Run::na(std::string message) {

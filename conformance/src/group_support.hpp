@@ -22,7 +22,8 @@
 //   succeeds when Set_Prm and Chk_Cfg are acknowledged (SC, or a response without data) and the
 //   last diagnosis says "ready for data exchange" (octet 1 & 0x47 = 0, octet 2 Prm_Req = 0), as
 //   a master judges it.
-// - Evidence: the whole transcript of every session the test opened, but at most 64 exchanges
+// - Evidence: the exchanges of every session the test opened (its own, from the session's opening
+//   on: an outside slave's start-state check included, earlier tests' excluded), but at most 64 exchanges
 //   (the first 24 and the last 40; the message says how many were left out) — a test that loops
 //   stops at the first telegram that decides against the DUT, so that one is among the last.
 
@@ -70,8 +71,9 @@ TestCase make_case(std::string id, std::string group, std::string name, std::str
 
 class Run {
  public:
-  /// Opens a session at `baud` (the spec's main baud if unset). If that fails the result is a
-  /// Fail with the reason and the Run is false.
+  /// Opens a session at `baud` (the spec's main baud if unset). If that fails the result is an
+  /// Error with the reason (the test's starting state could not be established) and the Run is
+  /// false.
   Run(TestContext& ctx, TestResult& result, std::optional<bus::Baud> baud = std::nullopt);
   ~Run();
   Run(const Run&) = delete;
@@ -131,6 +133,10 @@ class Run {
   void pass(std::string message);
   void fail(std::string message);
   void na(std::string message);
+  /// The test's precondition could not be established: its rule was not tested.
+  void error(std::string message);
+  /// error() for a failed start-up with the GSD's parameters (the test's precondition).
+  void not_ready(const std::string& why);
 
  private:
   void collect();

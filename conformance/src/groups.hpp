@@ -63,4 +63,8 @@ struct Reply {
 };
 Reply reply_of(const Exchange& e);
 
+/// "" when the reply of `e` (if any) mirrors its request's addresses and SAPs (§B.2), else what
+/// is wrong with it, in words with the octets (conformance/src/reply_addressing.cpp).
+std::string reply_addressing_fault(const Exchange& e);
+
 }  // namespace pbvbus::conformance::detail

@@ -37,7 +37,8 @@ MutationReport mutation_score(const DutSpec& in) {
   const BatteryReport base = run_battery(rep.spec);
   if (!base.dut_error.empty()) rep.unbroken_failures.push_back("DUT: " + base.dut_error);
   for (const auto& r : base.results)
-    if (r.verdict == Verdict::Fail) rep.unbroken_failures.push_back(r.id);
+    if (r.verdict == Verdict::Fail || r.verdict == Verdict::Error)
+      rep.unbroken_failures.push_back(r.id + (r.verdict == Verdict::Error ? " (error)" : ""));
   rep.unbroken_passed = base.passed();
 
   for (const auto& info : devices::slave_mutants()) {
@@ -76,8 +77,10 @@ MutationReport mutation_score(const DutSpec& in) {
     } else if (na == r.results.size()) {
       m.status = MutantStatus::NotApplicable;
     } else {
+      // An error (the test could not establish its precondition) did not test the rule: the
+      // mutant is not killed by it.
       m.status = MutantStatus::Survived;
-      m.note = "every test aimed at it passed";
+      m.note = "every test aimed at it passed (or could not run: error)";
     }
     rep.mutants.push_back(std::move(m));
   }

@@ -63,7 +63,7 @@ std::string to_json(const BatteryReport& report) {
   o << "},\"dut_error\":" << json_str(report.dut_error);
   o << ",\"passed\":" << (report.passed() ? "true" : "false");
   o << ",\"totals\":{\"tests\":" << report.results.size() << ",\"pass\":" << report.count(Verdict::Pass)
-    << ",\"fail\":" << report.count(Verdict::Fail) << ",\"na\":" << report.count(Verdict::NotApplicable) << "}";
+    << ",\"fail\":" << report.count(Verdict::Fail) << ",\"error\":" << report.count(Verdict::Error) << ",\"na\":" << report.count(Verdict::NotApplicable) << "}";
   o << ",\"timing_not_meaningful\":[";
   bool first = true;
   for (const auto& r : report.results)

@@ -27,20 +27,21 @@ std::string to_junit(const BatteryReport& report) {
     return o.str();
   }
   o << "<testsuites name=\"pbvbus conformance\" tests=\"" << report.results.size() << "\" failures=\""
-    << report.count(Verdict::Fail) << "\" errors=\"0\" skipped=\"" << report.count(Verdict::NotApplicable)
+    << report.count(Verdict::Fail) << "\" errors=\"" << report.count(Verdict::Error) << "\" skipped=\"" << report.count(Verdict::NotApplicable)
     << "\" time=\"0\">\n";
   std::size_t i = 0;
   while (i < report.results.size()) {
     const std::string& group = report.results[i].group;
     std::size_t j = i;
-    std::size_t fails = 0, skips = 0;
+    std::size_t fails = 0, skips = 0, errors = 0;
     while (j < report.results.size() && report.results[j].group == group) {
       fails += report.results[j].verdict == Verdict::Fail;
       skips += report.results[j].verdict == Verdict::NotApplicable;
+      errors += report.results[j].verdict == Verdict::Error;
       ++j;
     }
     o << "  <testsuite name=\"" << xml_escape(group) << "\" tests=\"" << (j - i) << "\" failures=\"" << fails
-      << "\" errors=\"0\" skipped=\"" << skips << "\" time=\"0\">\n";
+      << "\" errors=\"" << errors << "\" skipped=\"" << skips << "\" time=\"0\">\n";
     for (std::size_t k = i; k < j; ++k) {
       const TestResult& r = report.results[k];
       o << "    <testcase classname=\"" << xml_escape(group) << "\" name=\"" << xml_escape(r.id + " " + r.name)
@@ -51,6 +52,13 @@ std::string to_junit(const BatteryReport& report) {
                         "\nevidence (> tester to DUT, < DUT to tester, times in bit times):\n" +
                         evidence_text(r.evidence, "  "))
           << "</failure>\n";
+      } else if (r.verdict == Verdict::Error) {
+        o << "      <error message=\"" << xml_escape(r.message) << "\" type=\"precondition\">"
+          << xml_escape(r.message + "\nrequirement (not tested): " + r.requirement +
+                        "\nDUT: " + describe_dut(report.spec) +
+                        "\nevidence (> tester to DUT, < DUT to tester, times in bit times):\n" +
+                        evidence_text(r.evidence, "  "))
+          << "</error>\n";
       } else if (r.verdict == Verdict::NotApplicable) {
         o << "      <skipped message=\"" << xml_escape(r.message) << "\"/>\n";
       }

@@ -106,10 +106,14 @@ std::string to_text(const BatteryReport& report) {
       o << evidence_text(r.evidence, "      ");
     } else if (r.verdict == Verdict::NotApplicable) {
       o << "      n/a: " << r.message << "\n";
+    } else if (r.verdict == Verdict::Error) {
+      o << "      error (not tested): " << r.message << "\n";
+      o << evidence_text(r.evidence, "      ");
     }
   }
   o << "\n" << report.results.size() << " tests: " << report.count(Verdict::Pass) << " passed, "
-    << report.count(Verdict::Fail) << " failed, " << report.count(Verdict::NotApplicable) << " n/a\n";
+    << report.count(Verdict::Fail) << " failed, " << report.count(Verdict::Error) << " errors, "
+    << report.count(Verdict::NotApplicable) << " n/a\n";
   o << (report.passed() ? "PASSED\n" : "FAILED\n");
   return o.str();
 }

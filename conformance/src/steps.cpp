@@ -135,18 +135,55 @@ std::string expect_rs(const Reply& r) {
   return r.rs() ? std::string{} : "expected RS, got " + r.describe();
 }
 
+namespace {
+
+constexpr const char* kStatus1Bits[8] = {"Station_Non_Existent", "Station_Not_Ready", "Cfg_Fault",
+                                         "Ext_Diag", "Not_Supported", "Invalid_Slave_Response",
+                                         "Prm_Fault", "Master_Lock"};
+constexpr const char* kStatus2Bits[8] = {"Prm_Req", "Stat_Diag", "bit 2 (always 1)", "WD_On",
+                                         "Freeze_Mode", "Sync_Mode", "bit 6 (reserved)",
+                                         "Deactivated"};
+
+/// "Station_Not_Ready=1 Cfg_Fault=0" for the bits under `mask` of `value`.
+std::string bits_text(const char* const (&names)[8], std::uint8_t mask, std::uint8_t value) {
+  std::string s;
+  for (int b = 0; b < 8; ++b) {
+    if ((mask & (1u << b)) == 0) continue;
+    if (!s.empty()) s += " ";
+    s += std::string(names[b]) + "=" + ((value >> b) & 1u ? "1" : "0");
+  }
+  return s;
+}
+
+std::string ident_text(std::uint16_t v) {
+  char b[8];
+  std::snprintf(b, sizeof b, "%04X", v);
+  return b;
+}
+
+}  // namespace
+
 std::string check_diag(const Reply& r, const DiagExpect& e) {
   if (!r.ok_with_data() || r.data.size() < 6)
     return "expected Slave_Diag data (6+ octets), got " + r.describe();
   const auto& d = r.data;
   std::string why;
-  if ((d[0] & e.s1_mask) != e.s1) why += "Station_Status_1 bits " + hex(std::span(d).first(1));
-  if ((d[1] & e.s2_mask) != e.s2) why += (why.empty() ? "" : ", ") + std::string("Station_Status_2");
-  if (e.master && d[3] != *e.master) why += (why.empty() ? "" : ", ") + std::string("Master_Add");
-  if (e.ident && (d[4] != (*e.ident >> 8) || d[5] != (*e.ident & 0xFF)))
-    why += (why.empty() ? "" : ", ") + std::string("Ident_Number");
+  auto add = [&](const std::string& t) { why += (why.empty() ? "" : "; ") + t; };
+  if ((d[0] & e.s1_mask) != e.s1)
+    add("Station_Status_1 (octet 1) expected " + bits_text(kStatus1Bits, e.s1_mask, e.s1) +
+        ", received " + bits_text(kStatus1Bits, e.s1_mask, d[0]));
+  if ((d[1] & e.s2_mask) != e.s2)
+    add("Station_Status_2 (octet 2) expected " + bits_text(kStatus2Bits, e.s2_mask, e.s2) +
+        ", received " + bits_text(kStatus2Bits, e.s2_mask, d[1]));
+  if (e.master && d[3] != *e.master)
+    add("Master_Add (octet 4) expected " + std::to_string(*e.master) +
+        (*e.master == 0xFF ? " (none)" : "") + ", received " + std::to_string(d[3]) +
+        (d[3] == 0xFF ? " (none)" : ""));
+  const std::uint16_t ident = static_cast<std::uint16_t>(d[4] << 8 | d[5]);
+  if (e.ident && ident != *e.ident)
+    add("Ident_Number (octets 5..6) expected " + ident_text(*e.ident) + ", received " + ident_text(ident));
   if (why.empty()) return {};
-  return "diag " + hex(d) + ": wrong " + why;
+  return "diag " + hex(d) + ": " + why;
 }
 
 std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expected) {
@@ -160,15 +197,43 @@ std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expect
     got[2] &= 0x7F;
     want[2] &= 0x7F;
   }
-  if (got != want) return "expected diag " + hex(expected) + ", got " + hex(r.data);
+  if (got != want) {
+    std::string diff;
+    auto add = [&](const std::string& t) { diff += (diff.empty() ? "" : "; ") + t; };
+    if (const std::uint8_t x = got[0] ^ want[0])
+      add("octet 1 expected " + bits_text(kStatus1Bits, x, want[0]) + ", received " +
+          bits_text(kStatus1Bits, x, got[0]));
+    if (const std::uint8_t x = got[1] ^ want[1])
+      add("octet 2 expected " + bits_text(kStatus2Bits, x, want[1]) + ", received " +
+          bits_text(kStatus2Bits, x, got[1]));
+    if (got[2] != want[2]) add("octet 3 (Ext_Diag_Overflow) differs");
+    if (got[3] != want[3])
+      add("Master_Add expected " + std::to_string(want[3]) + ", received " + std::to_string(got[3]));
+    if (got[4] != want[4] || got[5] != want[5])
+      add("Ident_Number expected " + ident_text(static_cast<std::uint16_t>(want[4] << 8 | want[5])) +
+          ", received " + ident_text(static_cast<std::uint16_t>(got[4] << 8 | got[5])));
+    return "expected diag " + hex(expected) + ", got " + hex(r.data) + " (" + diff + ")";
+  }
   return {};
 }
 
 std::unique_ptr<Session> open_session(TestContext& ctx, TestResult& r, std::optional<bus::Baud> baud) {
   std::string err;
   auto s = ctx.open(baud, err);
-  if (!s) fail(r, "cannot open a session: " + err);
+  if (!s) error(r, "no session with the device under test: " + err);
   return s;
+}
+
+dp::SlaveParams with_plan_watchdog(const TestContext& ctx, dp::SlaveParams p) {
+  const bool base_1ms = p.dpv1() && (p.user_prm[0] & dp::kDpv1WdBase1ms) != 0;
+  const bus::Ticks unit = base_1ms ? bus::kTicksPerMs : 10 * bus::kTicksPerMs;
+  const bus::Ticks want = std::max(ctx.timing().twd, 100 * bus::kTicksPerMs);
+  const std::int64_t n = std::min<std::int64_t>((want + unit - 1) / unit, 255 * 255);
+  const std::int64_t f2 = (n + 254) / 255;
+  const std::int64_t f1 = (n + f2 - 1) / f2;
+  p.wd_fact_1 = static_cast<std::uint8_t>(f1);
+  p.wd_fact_2 = static_cast<std::uint8_t>(f2);
+  return p;
 }
 
 bus::Ticks watchdog_time(const dp::SlaveParams& p) {
@@ -188,6 +253,20 @@ void not_applicable(TestResult& r, const std::string& why) {
     r.verdict = Verdict::NotApplicable;
     r.message = why;
   }
+}
+
+void error(TestResult& r, const std::string& why) {
+  if (r.verdict != Verdict::Fail && r.verdict != Verdict::Error) {
+    r.verdict = Verdict::Error;
+    r.message = why;
+  }
+}
+
+bool precondition(TestResult& r, const std::string& start_up_why) {
+  if (start_up_why.empty()) return false;
+  error(r, "precondition not established: the device did not reach Data_Exch with the GSD's "
+           "parameters (" + start_up_why + "); the Start-up group's tests say why");
+  return true;
 }
 
 bool check(TestResult& r, const std::string& what, const std::string& why) {

@@ -102,16 +102,25 @@ std::string check_diag(const Reply& r, const DiagExpect& e);
 /// bit 7) are not compared, the other 46 bits are.
 std::string expect_std_diag(const Reply& r, std::span<const std::uint8_t> expected);
 
-/// Opens a session (main baud unless given); on failure fails `r` and returns nullptr.
+/// Opens a session (main baud unless given); on failure `r` is an Error (its starting state could
+/// not be established) and nullptr is returned.
 std::unique_ptr<Session> open_session(TestContext& ctx, TestResult& r,
                                       std::optional<bus::Baud> baud = std::nullopt);
 /// The watchdog time of `p` (TWD = WD_Fact_1 × WD_Fact_2 × 10 ms, or × 1 ms with WD_Base_1ms in
 /// DPV1_Status_1 of a DP-V1 Set_Prm), in ticks.
 bus::Ticks watchdog_time(const dp::SlaveParams& p);
+/// `p` with the WD factors of the run's watchdog tests (TimingPlan::twd, rounded up to what
+/// WD_Fact_1 × WD_Fact_2 × base can say); watchdog_time() of the result is the exact TWD.
+dp::SlaveParams with_plan_watchdog(const TestContext& ctx, dp::SlaveParams p);
 
 /// Result helpers: set verdict + message (keep the first failure's message).
 void fail(TestResult& r, const std::string& why);
 void not_applicable(TestResult& r, const std::string& why);
+/// Error: the test's precondition could not be established (keeps an earlier Fail or Error).
+void error(TestResult& r, const std::string& why);
+/// For start_up()'s result as a test's precondition: an Error when `start_up_why` is not empty;
+/// returns whether it was.
+bool precondition(TestResult& r, const std::string& start_up_why);
 /// Fails `r` with `what: why` when `why` is not empty; returns whether it failed.
 bool check(TestResult& r, const std::string& what, const std::string& why);
 

@@ -9,6 +9,7 @@ const char* verdict_name(Verdict v) {
     case Verdict::Pass: return "pass";
     case Verdict::Fail: return "fail";
     case Verdict::NotApplicable: return "n/a";
+    case Verdict::Error: return "error";
   }
   return "?";
 }

@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -173,7 +177,28 @@ namespace {
 // An outside DUT whose program never answers: every request times out within TSL of virtual
 // time (paced at 1/1 here), the tests fail with "no reply" — no hang, no abort — and the pty
 // link exists during the run and is removed afterwards.
-TEST(Battery, SilentPtyDutFailsWithoutHanging) {
+TEST(Battery, APtyNoProgramOpensIsADutErrorAfterTheWait) {
+  DutSpec s = spec_0a01();
+  const std::string link = std::string(PBVBUS_BINARY_DIR) + "/battery_test_pty_unopened";
+  std::filesystem::remove(link);
+  s.pty_path = link;
+  s.speed = {1, 1};
+  s.open_wait = std::chrono::milliseconds(300);
+  std::vector<std::string> said;
+  BatteryOptions o;
+  o.only = {"STA-01"};
+  o.progress = [&](const std::string& m) { said.push_back(m); };
+  const BatteryReport rep = run_battery(s, o);
+  EXPECT_NE(rep.dut_error.find("no program opened " + link), std::string::npos) << rep.dut_error;
+  EXPECT_TRUE(rep.results.empty());
+  ASSERT_FALSE(said.empty());
+  EXPECT_NE(said.front().find("waiting up to 300 ms for a program to open " + link), std::string::npos)
+      << said.front();
+  EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(link)));
+}
+
+TEST(Battery, ASilentProgramIsAnErrorNotAFailAndNeverHangs) {
+  // A program that opens the pty and never answers: no test can establish its starting state.
   DutSpec s = spec_0a01();
   const std::string link = std::string(PBVBUS_BINARY_DIR) + "/battery_test_pty";
   std::filesystem::remove(link);
@@ -181,16 +206,27 @@ TEST(Battery, SilentPtyDutFailsWithoutHanging) {
   s.speed = {1, 1};
   BatteryOptions o;
   o.only = {"STA-01", "PRM-08"};
+  int fd = -1;
+  o.progress = [&](const std::string& m) {
+    if (fd < 0 && m.find("waiting") != std::string::npos) fd = ::open(link.c_str(), O_RDWR | O_NOCTTY);
+  };
   const BatteryReport rep = run_battery(s, o);
+  if (fd >= 0) ::close(fd);
   ASSERT_TRUE(rep.dut_error.empty()) << rep.dut_error;
   ASSERT_EQ(rep.results.size(), 2u);
-  EXPECT_EQ(rep.results[0].verdict, Verdict::Fail);
-  EXPECT_NE(rep.results[0].message.find("no reply"), std::string::npos) << rep.results[0].message;
-  // The reset (unlocking Set_Prm) is part of the evidence: 2 exchanges.
-  ASSERT_EQ(rep.results[0].evidence.size(), 2u);
-  EXPECT_EQ(rep.results[0].evidence[0].note, "reset: Set_Prm Unlock_Req");
+  EXPECT_EQ(rep.results[0].verdict, Verdict::Error);
+  EXPECT_NE(rep.results[0].message.find("answers no Slave_Diag at its address 3 (no reply), nor at 100, 101 or 126"),
+            std::string::npos)
+      << rep.results[0].message;
+  // The evidence: the four probes of the start state, this test's only.
+  ASSERT_EQ(rep.results[0].evidence.size(), 4u);
+  EXPECT_EQ(rep.results[0].evidence[0].note, "start state: Slave_Diag");
+  EXPECT_EQ(rep.results[0].evidence[1].note, "start state: is the DUT at 100?");
   EXPECT_FALSE(rep.results[0].timing_not_meaningful);
+  // PRM-08 is n/a behind a pty before it needs a session.
+  EXPECT_EQ(rep.results[1].verdict, Verdict::NotApplicable);
   EXPECT_TRUE(rep.results[1].timing_not_meaningful);
+  EXPECT_FALSE(rep.passed());
   EXPECT_FALSE(std::filesystem::exists(std::filesystem::symlink_status(link)));
 }
 

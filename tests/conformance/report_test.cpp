@@ -83,7 +83,7 @@ TEST(ConformanceReport, TextHasHeaderLinesEvidenceAndTotals) {
   EXPECT_TRUE(contains(t, "      < 110 bt  10 01 03 00 04 16  (TSDR 11 bit times)\n")) << t;
   EXPECT_TRUE(contains(t, "      > 209 bt  10 03 01 49 4D 16  (Slave_Diag, SA 1)\n      < no reply within TSL\n")) << t;
   EXPECT_TRUE(contains(t, "\nSet_Prm\n  PRM-03   n/a   Wrong content\n      n/a: no range\n")) << t;
-  EXPECT_TRUE(contains(t, "3 tests: 1 passed, 1 failed, 1 n/a\nFAILED\n")) << t;
+  EXPECT_TRUE(contains(t, "3 tests: 1 passed, 1 failed, 0 errors, 1 n/a\nFAILED\n")) << t;
 }
 
 TEST(ConformanceReport, TextOfAPtyDutNamesTheTimingMeaninglessTests) {
@@ -186,7 +186,7 @@ TEST(ConformanceReport, JsonIsWellFormedWithTheDocumentedFields) {
   EXPECT_TRUE(contains(j, "\"ident\":\"0x0A01\""));
   EXPECT_TRUE(contains(j, "\"baud\":\"1.5M\""));
   EXPECT_TRUE(contains(j, "\"passed\":false"));
-  EXPECT_TRUE(contains(j, "\"totals\":{\"tests\":3,\"pass\":1,\"fail\":1,\"na\":1}"));
+  EXPECT_TRUE(contains(j, "\"totals\":{\"tests\":3,\"pass\":1,\"fail\":1,\"error\":0,\"na\":1}"));
   EXPECT_TRUE(contains(j, "\"verdict\":\"n/a\""));
   // The control character of the message is escaped, the quotes too.
   EXPECT_TRUE(contains(j, "got <no reply> & \\u0001 more")) << j;

@@ -12,7 +12,8 @@
 //   GSD's Model_Name or the GSD file name.
 // - Exit status: 0 every test passed (n/a counts as passed), 1 a test failed, 2 bad usage or bad
 //   input (unreadable or broken GSD, unknown module or mutant, a baud the GSD lacks: the DUT
-//   cannot be built). --mutation-score: 0 only if every score is 100 % and every unbroken model
+//   cannot be built), 3 nothing failed but some test could not establish its precondition
+//   (verdict error: its rule was not tested, so the run proves less than it claims). --mutation-score: 0 only if every score is 100 % and every unbroken model
 //   passes, else 1.
 // - --mutation-score without --gsd scores the shipped GSDs PBVB0A01..04 with the module lists
 //   of examples/gateway.textproto (the dp-basic slaves 3..5 plus the gateway test station 6);
@@ -69,7 +70,8 @@ constexpr const char* kConformanceUsage =
     "  -h, --help          this text\n"
     "\n"
     "Exit status: 0 nothing failed, 1 a test failed (with --mutation-score: a score below\n"
-    "100 % or a failing unbroken model), 2 bad usage or bad input.\n";
+    "100 % or a failing unbroken model), 2 bad usage or bad input, 3 no failure but a test\n"
+    "whose precondition could not be established (verdict error).\n";
 
 std::optional<bus::Speed> parse_ratio(const std::string& v) {
   auto num = [](std::string_view t) -> std::optional<std::uint32_t> {
@@ -369,7 +371,8 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
     err << "pbvbus conformance: the DUT cannot be built: " << report.dut_error << "\n";
     return 2;
   }
-  return report.passed() ? 0 : 1;
+  if (report.count(conformance::Verdict::Fail) > 0) return 1;
+  return report.count(conformance::Verdict::Error) > 0 ? 3 : 0;
 }
 
 }  // namespace pbvbus::tools

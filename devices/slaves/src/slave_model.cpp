@@ -72,6 +72,8 @@ dp::EngineMutation engine_mutation(std::optional<SlaveMutant> m) {
     case SlaveMutant::Dpv1BadIndexAccepted: return E::Dpv1BadIndexAccepted;
     case SlaveMutant::RejectFailSafe: return E::RejectFailSafe;
     case SlaveMutant::WrongDiagIdent: return E::WrongDiagIdent;
+    case SlaveMutant::GetCfgSapsNotSwapped: return E::GetCfgSapsNotSwapped;
+    case SlaveMutant::DataExchangeInWaitCfg: return E::DataExchangeInWaitCfg;
   }
   return E::None;
 }

@@ -11,7 +11,7 @@ namespace {
 
 using M = SlaveMutant;
 
-constexpr std::array<MutantInfo, 18> kMutants{{
+constexpr std::array<MutantInfo, 20> kMutants{{
     {M::TsdrTooLate, "tsdr_too_late",
      "a responder answers no later than max TSDR (the GSD's MaxTsdr at the line's baud) after "
      "the request's last stop bit (IEC 61158-4-3 station delay; protocol-facts.md §C.2)"},
@@ -64,6 +64,12 @@ constexpr std::array<MutantInfo, 18> kMutants{{
      "outputs safe (protocol-facts.md §D.8 Fail_Safe, §D.2)"},
     {M::WrongDiagIdent, "wrong_diag_ident",
      "Slave_Diag octets 5..6 carry the slave's Ident_Number (protocol-facts.md §D.4)"},
+    {M::GetCfgSapsNotSwapped, "get_cfg_saps_not_swapped",
+     "a response mirrors its request: DSAP = the request's SSAP, SSAP = the request's DSAP "
+     "(Get_Cfg: DSAP 62, SSAP 59) (protocol-facts.md §B.2)"},
+    {M::DataExchangeInWaitCfg, "dx_in_wait_cfg",
+     "after Set_Prm the slave waits for a good Chk_Cfg (Wait_Cfg) and refuses Data_Exchange "
+     "until then (protocol-facts.md §D.8)"},
 }};
 
 constexpr bool table_in_enum_order() {
@@ -72,7 +78,7 @@ constexpr bool table_in_enum_order() {
   return true;
 }
 static_assert(table_in_enum_order(), "slave_mutants(): one row per enum value, in enum order");
-static_assert(static_cast<std::size_t>(M::WrongDiagIdent) + 1 == kMutants.size(),
+static_assert(static_cast<std::size_t>(M::DataExchangeInWaitCfg) + 1 == kMutants.size(),
               "a new SlaveMutant needs its row");
 
 }  // namespace

@@ -185,6 +185,7 @@ void SlaveEngine::on_request(const Indication& ind, Reply& reply) {
         } else {
           reply.respond(ResponseStatus::DL, m_layout.cfg);
         }
+        if (mutated(EngineMutation::GetCfgSapsNotSwapped)) [[unlikely]] reply.saps_not_mirrored = true;
         break;
       case kSapGlobalControl: handle_global_control(ind, reply); break;
       case kSapSetSlaveAdd: handle_set_slave_add(ind, reply); break;
@@ -434,7 +435,9 @@ void SlaveEngine::handle_slave_diag(const Indication& ind, Reply& reply) {
 // --- Data_Exchange (§D.7) -------------------------------------------------------------------------
 
 void SlaveEngine::handle_data_exchange(const Indication& ind, Reply& reply) {
-  if (m_state != SlaveState::DataExch || ind.sa != m_master) return;  // RS
+  const bool early = m_state == SlaveState::WaitCfg && ind.sa == m_master &&
+                     mutated(EngineMutation::DataExchangeInWaitCfg);  // mutant: no Chk_Cfg needed
+  if ((m_state != SlaveState::DataExch && !early) || ind.sa != m_master) return;  // RS
   const std::size_t n_out = m_layout.outputs;
   if (ind.data.size() == n_out) {
     std::copy(ind.data.begin(), ind.data.end(), m_rx_outputs.begin());

@@ -74,6 +74,10 @@ const Frame& Responder::finish(const Telegram& req, std::uint8_t own, StationTyp
       // Mirror the request's extensions: its source SAP/segment becomes our destination's.
       spec.dsap = req.ssap;
       spec.ssap = req.dsap;
+      if (reply.saps_not_mirrored) [[unlikely]] {  // mutant slave only
+        spec.dsap = req.dsap;
+        spec.ssap = req.ssap;
+      }
       if (req.ssap) spec.da_segment = req.sa_segment;
       if (req.dsap) spec.sa_segment = req.da_segment;
       spec.data = reply.data;

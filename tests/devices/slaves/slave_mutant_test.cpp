@@ -15,7 +15,7 @@
 namespace pbvbus::devices {
 namespace {
 
-constexpr std::size_t kMutantCount = 18;  // the enum's values, counted by hand
+constexpr std::size_t kMutantCount = 20;  // the enum's values, counted by hand
 
 TEST(SlaveMutant, EveryEnumValueHasItsRowInOrder) {
   const auto all = slave_mutants();
@@ -87,6 +87,8 @@ TEST(SlaveMutant, EveryMutantBuildsOnPbvb0a03WithExactlyOneHook) {
       {M::Dpv1BadIndexAccepted, E::Dpv1BadIndexAccepted, false, false, false},
       {M::RejectFailSafe, E::RejectFailSafe, false, false, false},
       {M::WrongDiagIdent, E::WrongDiagIdent, false, false, false},
+      {M::GetCfgSapsNotSwapped, E::GetCfgSapsNotSwapped, false, false, false},
+      {M::DataExchangeInWaitCfg, E::DataExchangeInWaitCfg, false, false, false},
   };
   ASSERT_EQ(std::size(expected), kMutantCount);
   const GsdFile gsd = load("PBVB0A03.gsd");

@@ -11,10 +11,12 @@
 // Pass, Fail, NotApplicable (the GSD says the feature is absent, or the DUT kind cannot show it —
 // e.g. outputs applied to the process are visible only in a model), with the reason.
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -42,10 +44,46 @@ struct DutSpec {
   /// The baud of the main session (the TSDR test visits every baud the GSD supports; an outside
   /// slave only this one). Default: the highest the GSD supports up to 1.5 Mbit/s.
   std::optional<bus::Baud> baud;
+  /// Outside slave: the wall time a program gets to answer a request (the slot time is made at
+  /// least this long in virtual time at `speed`, within TSL <= 16 383 bit times).
+  std::chrono::milliseconds reply_wall{50};
+  /// Outside slave: how long the battery waits for the program to open the pty before the
+  /// first test (then every test is an error: nothing could be tested).
+  std::chrono::milliseconds open_wait{30000};
 };
 
-enum class Verdict : std::uint8_t { Pass, Fail, NotApplicable };
-const char* verdict_name(Verdict v);  ///< "pass", "fail", "n/a"
+/// The battery's times, chosen once per run from the main baud, the longest telegrams the
+/// battery sends and expects, and (outside slave) the pace (docs/conformance.md "Timing").
+struct TimingPlan {
+  std::uint32_t tsl_bits = 0;      ///< slot time of the main sessions
+  bus::Ticks longest_request = 0;  ///< the longest telegram the battery sends, on the wire
+  bus::Ticks longest_reply = 0;    ///< the longest reply it expects, on the wire
+  /// The longest gap between two of the owner's requests in a test's normal flow: TSYN +
+  /// longest request + TSL + longest reply + the Data_Exchange spacing.
+  bus::Ticks exchange_span = 0;
+  /// Outside slave: a program's wall-clock jitter (30 ms) in virtual time at the pace; 0 else.
+  bus::Ticks pace_jitter = 0;
+  /// The watchdog tests' TWD (PRM-06/07, INT-01..04, C2-04): a multiple of 10 ms, at least
+  /// 100 ms, at least 4 × exchange_span and at least 4 × wd_margin.
+  bus::Ticks twd = 0;
+  /// Distance of the checks before and after the expiry from TWD: 1 % of TWD (at least 1 ms)
+  /// for a model (exact); for a program also where it may start its watchdog (the start or the
+  /// end of the last request, or its own reply) and twice the pace jitter.
+  bus::Ticks wd_margin = 0;
+  /// Outside slave: the wall time the slot time gives a program to answer.
+  std::chrono::milliseconds reply_wall{0};
+  /// One line for the report header.
+  std::string summary() const;
+};
+
+/// The fastest pace (virtual/wall) at which a slot time within 16 383 bit times still gives a
+/// program `reply_wall` of wall time to answer at `baud`: 1/1, 1/2, 1/5, 1/10, 1/20, 1/50, ...
+bus::Speed auto_speed(bus::Baud baud, std::chrono::milliseconds reply_wall);
+
+/// Error: the test's precondition (the state it starts from: owner, state, address; or a session
+/// at all) could not be established, so its rule was not tested — neither pass nor fail.
+enum class Verdict : std::uint8_t { Pass, Fail, NotApplicable, Error };
+const char* verdict_name(Verdict v);  ///< "pass", "fail", "n/a", "error"
 
 struct TestResult {
   std::string id;           ///< stable, e.g. "PRM-03"
@@ -69,6 +107,8 @@ class Session {
   virtual std::uint8_t dut_address() const = 0;
   /// White box: the slave model, or nullptr for an outside slave.
   virtual devices::SlaveModel* model() = 0;
+  /// The exchanges of this session since it was opened (its own, not earlier tests').
+  virtual std::span<const Exchange> exchanges() const = 0;
 };
 
 class TestContext {
@@ -83,6 +123,8 @@ class TestContext {
   std::size_t input_len() const { return m_in; }
   std::size_t output_len() const { return m_out; }
   bool outside() const { return m_spec->pty_path.has_value(); }
+  /// The run's times (slot time, watchdog, margins).
+  const TimingPlan& timing() const { return m_timing; }
   /// Opens a session at `baud` (the spec's main baud if unset). nullptr + `error` when the DUT
   /// cannot run there (an outside slave at another baud, a baud the GSD lacks).
   virtual std::unique_ptr<Session> open(std::optional<bus::Baud> baud, std::string& error) = 0;
@@ -92,6 +134,7 @@ class TestContext {
   dp::SlaveParams m_params;
   std::size_t m_in = 0;
   std::size_t m_out = 0;
+  TimingPlan m_timing;
 };
 
 /// A test: its identity and its body. The body fills verdict, message and evidence of `result`
@@ -113,14 +156,20 @@ const std::vector<TestCase>& all_tests();
 struct BatteryOptions {
   /// Only tests whose id or group matches one of these (exact id, or group name); empty = all.
   std::vector<std::string> only;
+  /// Told what the runner waits for (an outside slave: the program opening the pty).
+  std::function<void(const std::string&)> progress;
 };
 
 struct BatteryReport {
   DutSpec spec;
+  TimingPlan timing;  ///< the times the run used
   std::vector<TestResult> results;
   std::string dut_error;  ///< the DUT could not be built at all (then no results)
   std::size_t count(Verdict v) const;
-  bool passed() const { return dut_error.empty() && count(Verdict::Fail) == 0; }
+  /// Nothing failed and nothing was left untested by an error (n/a is neither).
+  bool passed() const {
+    return dut_error.empty() && count(Verdict::Fail) == 0 && count(Verdict::Error) == 0;
+  }
 };
 
 /// Runs the battery. Never throws on a bad DUT: a DUT that cannot be built is dut_error.

@@ -23,14 +23,14 @@
 //       "pty": str | null,           // the pty path, outside slave only
 //       "speed": str | null },       // "1/1000" for a pty (virtual/wall), else null
 //     "dut_error": str,              // "" unless the DUT could not be built (then no tests)
-//     "passed": bool,                // no dut_error and no failed test
-//     "totals": { "tests": int, "pass": int, "fail": int, "na": int },
+//     "passed": bool,                // no dut_error, no failed test and no error
+//     "totals": { "tests": int, "pass": int, "fail": int, "error": int, "na": int },
 //     "timing_not_meaningful": [ str ],   // ids (pty DUT only; else [])
 //     "timing_note": str,            // why, for a pty DUT; else ""
 //     "tests": [ {
 //       "id": str, "group": str, "name": str, "requirement": str,
-//       "verdict": "pass" | "fail" | "n/a",
-//       "message": str,              // why (fail, n/a); "" on pass
+//       "verdict": "pass" | "fail" | "n/a" | "error",  (error: precondition not established)
+//       "message": str,              // why (fail, n/a, error); on pass what was seen
 //       "timing_not_meaningful": bool,
 //       "evidence": [ {              // the telegrams that decided it, in order
 //         "note": str,

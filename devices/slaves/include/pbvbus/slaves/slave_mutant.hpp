@@ -35,6 +35,8 @@ enum class SlaveMutant : std::uint8_t {
   Dpv1BadIndexAccepted,  ///< MSAC_C1 Read of an unknown index answers data instead of an error
   RejectFailSafe,        ///< a zero-length Data_Exchange in Clear is refused despite Fail_Safe=1
   WrongDiagIdent,        ///< Slave_Diag octets 5..6 carry the ident + 1
+  GetCfgSapsNotSwapped,  ///< the Get_Cfg reply carries DSAP 59, SSAP 62 (not mirrored)
+  DataExchangeInWaitCfg, ///< Data_Exchange answered after Set_Prm, before a good Chk_Cfg
 };
 
 struct MutantInfo {

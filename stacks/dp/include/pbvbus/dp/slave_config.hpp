@@ -90,6 +90,8 @@ enum class EngineMutation : std::uint8_t {
   Dpv1BadIndexAccepted,   ///< MSAC_C1 Read of an unknown index answers zero data, not 80 B0 00
   RejectFailSafe,         ///< zero-length Data_Exchange refused (RS) although Fail_Safe
   WrongDiagIdent,         ///< Slave_Diag octets 5..6 = Ident_Number + 1
+  GetCfgSapsNotSwapped,   ///< Get_Cfg reply with DSAP 59, SSAP 62 (the request's, not mirrored)
+  DataExchangeInWaitCfg,  ///< Data_Exchange from the owner answered in Wait_Cfg (before Chk_Cfg)
 };
 
 struct SlaveConfig {

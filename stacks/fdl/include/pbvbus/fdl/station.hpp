@@ -42,6 +42,9 @@ struct Reply {
   /// Applied after the reply has gone out (Set_Slave_Add, Set_Prm's min TSDR).
   std::optional<std::uint8_t> new_address;
   std::optional<std::uint32_t> new_min_tsdr;
+  /// Test-only (mutant slaves, docs/mutants.md): the reply carries the request's DSAP and SSAP
+  /// as they came instead of mirrored (breaks §B.2 on purpose).
+  bool saps_not_mirrored = false;
 
   void short_ack() { kind = Kind::ShortAck; }
   void respond(ResponseStatus s, std::span<const std::uint8_t> d) {

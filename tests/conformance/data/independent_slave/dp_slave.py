@@ -107,7 +107,15 @@ class SlaveProgram:
         self.stop = False
         self.rx_frames = self.tx_frames = 0
 
-    def handle_telegrams(self, telegrams, now):
+    def reply_not_before(self, rx_wall):
+        """min TSDR (§C.1/§D.2): a reply starts no earlier than min TSDR bit times after the
+        request's end. Through a pty this is only approximate: the request's end is taken as
+        the moment its octets were read, and the bit time is that of --baud in virtual time."""
+        if self.args.no_tsdr_delay:
+            return rx_wall
+        return rx_wall + self.clock.wall(self.dp.min_tsdr / float(self.args.baud))
+
+    def handle_telegrams(self, telegrams, now, rx_wall):
         for tel in telegrams:
             self.rx_frames += 1
             try:
@@ -118,6 +126,9 @@ class SlaveProgram:
             if self.args.trace:
                 self.log("rx %s" % hexs(tel.raw))
             if reply:
+                delay = self.reply_not_before(rx_wall) - time.monotonic()
+                if delay > 0:
+                    time.sleep(delay)
                 self.ser.write(reply)
                 self.tx_frames += 1
                 if self.args.trace:
@@ -151,9 +162,9 @@ class SlaveProgram:
                     self.log("port closed; exiting")
                     return 0
                 self.last_rx = time.monotonic()
-                self.handle_telegrams(self.deframer.feed(data), now)
+                self.handle_telegrams(self.deframer.feed(data), now, self.last_rx)
             elif self.deframer.pending() and time.monotonic() - self.last_rx >= self.resync_gap:
-                self.handle_telegrams(self.deframer.flush_stale(), now)
+                self.handle_telegrams(self.deframer.flush_stale(), now, time.monotonic())
         return 0
 
     def summary(self):
@@ -177,6 +188,8 @@ def main(argv=None):
     ap.add_argument("--log", help="append a log to FILE")
     ap.add_argument("--trace", action="store_true", help="log every telegram in and out")
     ap.add_argument("-v", "--verbose", action="store_true", help="log to stderr too")
+    ap.add_argument("--no-tsdr-delay", action="store_true",
+                    help="answer at once instead of waiting min TSDR (virtual bit times)")
     ap.add_argument("--resync-ms", type=float, default=50.0,
                     help="wall ms of silence after which an incomplete telegram is dropped")
     ap.add_argument("--lplus-missing-after", type=int, default=None, metavar="N",

@@ -72,6 +72,13 @@ std::string to_json(const BatteryReport& report) {
       first = false;
     }
   o << "],\"timing_note\":" << json_str(s.pty_path ? kPtyTimingNote : "");
+  {
+    const TimingPlan& t = report.timing;
+    const auto us = [](bus::Ticks x) { return std::to_string(bus::ticks_to_us(x)); };
+    o << ",\"timing\":{\"tsl_bits\":" << t.tsl_bits << ",\"reply_wall_ms\":" << t.reply_wall.count()
+      << ",\"exchange_span_us\":" << us(t.exchange_span) << ",\"twd_us\":" << us(t.twd)
+      << ",\"wd_margin_us\":" << us(t.wd_margin) << "}";
+  }
   o << ",\"tests\":[";
   for (std::size_t i = 0; i < report.results.size(); ++i) {
     const TestResult& r = report.results[i];

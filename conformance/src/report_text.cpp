@@ -79,6 +79,7 @@ std::string to_text(const BatteryReport& report) {
   o << "  modules:  " << modules_text(s) << "\n";
   o << "  address:  " << int(s.address) << "\n";
   o << "  baud:     " << bus::baud_name(dut_main_baud(s)) << "\n";
+  if (report.timing.twd > 0) o << "  timing:   " << report.timing.summary() << "\n";
   if (s.mutant) o << "  mutant:   " << devices::slave_mutant_name(*s.mutant) << "\n";
   if (s.pty_path) {
     o << "  pty:      " << *s.pty_path << ", speed " << s.speed.num << "/" << s.speed.den << "\n";

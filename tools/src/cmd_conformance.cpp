@@ -59,7 +59,10 @@ constexpr const char* kConformanceUsage =
     "  --mutant NAME       a slave model that breaks one rule (docs/mutants.md)\n"
     "  --pty PATH          the DUT is an outside program: the battery creates a pty and links\n"
     "                      PATH to it; the program opens PATH as its serial port\n"
-    "  --speed N/M         virtual/wall time ratio with --pty (default 1/1000)\n"
+    "  --speed N/M         virtual/wall time ratio with --pty (default: the fastest of 1/1, 1/2,\n"
+    "                      1/5, 1/10, ... that gives the program 100 ms of wall time per reply\n"
+    "                      within a slot time of 16 383 bit times: 1/1 up to 93.75k, 1/2 at\n"
+    "                      187.5k, 1/10 at 1.5M)\n"
     "  --only ID|GROUP     run only these tests (exact id or group name; repeat)\n"
     "  --scenario FILE     take GSD, modules, address and baud from a scenario's dp_slave ...\n"
     "  --station ADDR|NAME ... at this address (or GSD Model_Name / file name)\n"
@@ -338,7 +341,9 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
   spec.mutant = o.mutant;
   if (o.pty) {
     spec.pty_path = *o.pty;
-    spec.speed = o.speed.value_or(bus::Speed{1, 1000});
+    // Default pace: the fastest at which a slot time within the standard's 16 383 bit times
+    // still gives the program spec.reply_wall (100 ms) of wall time to answer (battery.hpp).
+    spec.speed = o.speed.value_or(conformance::auto_speed(conformance::dut_main_baud(spec), spec.reply_wall));
   }
   if (spec.gsd && spec.gsd->is_master()) {
     err << "pbvbus conformance: " << spec.gsd_path << " describes a DP master, not a slave\n";
@@ -347,6 +352,7 @@ int cmd_conformance(const Args& args, std::ostream& out, std::ostream& err) {
 
   conformance::BatteryOptions bo;
   bo.only = o.only;
+  bo.progress = [&err](const std::string& m) { err << "pbvbus conformance: " << m << std::endl; };
   if (!bo.only.empty()) {
     for (const auto& sel : bo.only) {
       bool known = false;

@@ -46,7 +46,7 @@ struct DutSpec {
   std::optional<bus::Baud> baud;
   /// Outside slave: the wall time a program gets to answer a request (the slot time is made at
   /// least this long in virtual time at `speed`, within TSL <= 16 383 bit times).
-  std::chrono::milliseconds reply_wall{50};
+  std::chrono::milliseconds reply_wall{100};
   /// Outside slave: how long the battery waits for the program to open the pty before the
   /// first test (then every test is an error: nothing could be tested).
   std::chrono::milliseconds open_wait{30000};

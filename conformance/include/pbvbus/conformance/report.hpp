@@ -27,6 +27,10 @@
 //     "totals": { "tests": int, "pass": int, "fail": int, "error": int, "na": int },
 //     "timing_not_meaningful": [ str ],   // ids (pty DUT only; else [])
 //     "timing_note": str,            // why, for a pty DUT; else ""
+//     "timing": { "tsl_bits": int,   // the run's TimingPlan (battery.hpp): slot time,
+//       "reply_wall_ms": int,        //   wall time a pty program gets per reply (0: a model),
+//       "exchange_span_us": int,     //   the longest exchange,
+//       "twd_us": int, "wd_margin_us": int },  // the watchdog tests' TWD and check margin
 //     "tests": [ {
 //       "id": str, "group": str, "name": str, "requirement": str,
 //       "verdict": "pass" | "fail" | "n/a" | "error",  (error: precondition not established)

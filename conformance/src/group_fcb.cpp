@@ -11,8 +11,13 @@
 //   frame (FCV 0, FCB 1); the slave must execute it and store its FCB, so the next frame with
 //   FCB 0 is new (even though the last frame before Set_Prm also had FCB 0) and a repeat of that
 //   one is again a repeat.
+// - "Per master" (FCB-04): between two frames of the tester, master 2 sends its own FCB sequence
+//   (a first frame FCV 0 FCB 1, then FCV 1 FCB 0 — Slave_Diag, which changes nothing). The
+//   tester's next frame has FCB 0 too; it is new for the tester (its last was FCB 1) and must be
+//   executed — a slave that keeps one FCB for all masters takes it for a repeat of master 2's.
 
 #include "groups.hpp"
+#include "pbvbus/dp/sap.hpp"
 #include "steps.hpp"
 
 namespace pbvbus::conformance::detail {
@@ -109,6 +114,23 @@ void restart_after_set_prm(TestContext& ctx, TestResult& r) {
   outputs_are(r, *s, c, "the repeat is not executed (outputs still C)");
 }
 
+void fcb_per_master(TestContext& ctx, TestResult& r) {
+  std::unique_ptr<Session> s;
+  if (!setup(ctx, r, s)) return;
+  const auto a = output_pattern(ctx.output_len(), 0x04);
+  const auto b = output_pattern(ctx.output_len(), 0xB0);
+  if (!first_frame(r, *s, a)) return;
+  const auto diag = [&](bool fcv, bool fcb, const std::string& note) {
+    return service(*s, dp::kSapSlaveDiag, {}, note, kReader, fcv, fcb);
+  };
+  if (check(r, "master 2's first frame", expect_data(diag(false, true, "master 2: Slave_Diag FCV=0 FCB=1 (first frame)"), {}, false)))
+    return;
+  if (check(r, "master 2's second frame", expect_data(diag(true, false, "master 2: Slave_Diag FCV=1 FCB=0"), {}, false)))
+    return;
+  data_exchange(*s, b, "tester: Data_Exchange FCV=1 FCB=0 (new for the tester), outputs B", std::nullopt, true, false);
+  outputs_are(r, *s, b, "the tester's FCB 0 after master 2's FCB 0 is executed (outputs B)");
+}
+
 }  // namespace
 
 void add_fcb_tests(std::vector<TestCase>& out) {
@@ -125,6 +147,11 @@ void add_fcb_tests(std::vector<TestCase>& out) {
                  "After re-parameterisation the first frame (FCV=0, FCB=1) is executed and starts the "
                  "FCB sequence again: the next toggled frame is new, its repeat is not (§C.6)",
                  restart_after_set_prm, {SlaveMutant::IgnoreFcb}});
+  out.push_back({"FCB-04", kFcbGroup, "FCB kept per master",
+                 "The responder keeps the frame count bit per requesting station: another master's "
+                 "FCB sequence in between does not make the tester's next toggled frame a repeat "
+                 "(§C.6: the FCB is stored per source address)",
+                 fcb_per_master, {}});
 }
 
 }  // namespace pbvbus::conformance::detail

@@ -193,9 +193,39 @@ void freeze_unfreeze(TestContext& ctx, TestResult& res) {
            ") over four Data_Exchanges; Unfreeze made them live again");
 }
 
+/// GC-04 for an outside slave (no view of its applied outputs): Group_Select seen through the
+/// Sync_Mode bit of the diagnosis (§D.4 octet 2 bit 5) after Sync to another group (ignored)
+/// and to its own (obeyed).
+void group_select_black_box(Run& run) {
+  if (!run.ctx().spec().gsd->slave_features().sync_mode_supp)
+    return run.na("an outside slave's Group_Select is seen through Sync_Mode, and the GSD says "
+                  "Sync_Mode_supp = 0");
+  dp::SlaveParams p = run.ctx().params();
+  p.group_ident = 0x01;  // group 1
+  p.station_status |= dp::kPrmSyncReq;
+  std::string why;
+  if (!run.start_up(why, &p)) return run.fail("Set_Prm with Group_Ident 01 and Sync_Req: " + why);
+  if (!exchange_ok(run, run.outputs(0x5A), "outputs 5A")) return;
+  run.global_control(kSync, 0x02, "Global_Control Sync to group 2 (20 02)");
+  auto d = run.diag(why, "Slave_Diag after Sync to group 2");
+  if (!d) return run.fail(why);
+  if ((d->status_2 & dp::kDiagSyncMode) != 0)
+    return run.fail("after Sync to group 2 only (the slave is in group 1: must be ignored) the "
+                    "diagnosis " + hex(d->encode()) + " has Sync_Mode=1 (expected Sync_Mode=0)");
+  run.global_control(kSync, 0x01, "Global_Control Sync to group 1 (20 01)");
+  d = run.diag(why, "Slave_Diag after Sync to group 1");
+  if (!d) return run.fail(why);
+  if ((d->status_2 & dp::kDiagSyncMode) == 0)
+    return run.fail("after Sync to its own group 1 the diagnosis " + hex(d->encode()) +
+                    " has Sync_Mode=0 (expected Sync_Mode=1)");
+  run.pass("Sync to another group was ignored (Sync_Mode=0), to its own group obeyed (Sync_Mode=1)");
+}
+
 void group_select(TestContext& ctx, TestResult& res) {
   Run run(ctx, res);
-  if (!run || !need_model_outputs(run)) return;
+  if (!run) return;
+  if (!run.model()) return group_select_black_box(run);
+  if (!need_model_outputs(run)) return;
   dp::SlaveParams p = ctx.params();
   p.group_ident = 0x01;  // group 1
   std::string why;

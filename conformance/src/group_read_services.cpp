@@ -4,10 +4,14 @@
 // Decisions:
 // - Get_Cfg must answer exactly the configuration a configuration tool derives from the GSD:
 //   the chosen modules' identifier octets in module order (the Chk_Cfg DU).
-// - Rd_Inp is compared with the inputs of the last Data_Exchange reply, Rd_Outp with the
-//   outputs of the last Data_Exchange. For a slave model the inputs are first set to a known
-//   non-zero pattern through the model's application (white box), so that the comparison is
-//   not between zeros; an outside slave answers with whatever its program has.
+// - Rd_Inp answers the slave's CURRENT input image (§D.7), which a device's process may change at
+//   any time. So Rd_Inp is read between two Data_Exchanges: when both replies carry the same
+//   inputs the image did not move and Rd_Inp must equal them octet for octet; when they differ
+//   (live inputs, e.g. a counter) only Rd_Inp's length is judged, and the message says so.
+//   Rd_Outp is compared with the outputs of the last Data_Exchange. For a slave model the
+//   inputs are first set to a known non-zero pattern through the model's application (white
+//   box), so that the comparison is not between zeros; an outside slave answers with whatever
+//   its program has.
 // - Rd_Inp/Rd_Outp are read in Data_Exch (the slave's image exists there, §D.7), from the owner
 //   and from another master (address 2): both must be answered.
 // - A slave without inputs (outputs) answers Rd_Inp (Rd_Outp) with SC like Data_Exchange
@@ -63,7 +67,27 @@ void rd_inp_test(TestContext& ctx, TestResult& r, std::optional<std::uint8_t> re
     return;
   }
   const std::string who = reader ? "Rd_Inp from master 2" : "Rd_Inp from the owner";
-  check(r, who + " (= the inputs of the last Data_Exchange reply)", expect_data(rd_inp(*s, who, reader), dx.data));
+  const Reply rd = rd_inp(*s, who, reader);
+  const Reply dx2 = data_exchange(*s, out, "Data_Exchange after Rd_Inp");
+  if (!dx2.ok_with_data() || dx2.data.size() != ctx.input_len()) {
+    fail(r, "Data_Exchange after Rd_Inp: expected " + std::to_string(ctx.input_len()) +
+                " input octets, got " + dx2.describe());
+    return;
+  }
+  if (dx2.data == dx.data) {
+    if (check(r, who + " (inputs unchanged between the Data_Exchanges before and after it)",
+              expect_data(rd, dx.data)))
+      return;
+    r.message = who + " = " + hex(rd.data) + ", the inputs of both Data_Exchanges around it";
+    return;
+  }
+  if (!rd.ok_with_data() || rd.data.size() != ctx.input_len()) {
+    fail(r, who + ": expected " + std::to_string(ctx.input_len()) + " input octets, got " + rd.describe());
+    return;
+  }
+  r.message = "the inputs moved between the Data_Exchanges around " + who + " (" + hex(dx.data) +
+              " → " + hex(dx2.data) + ": a live process image); " + who + " = " + hex(rd.data) +
+              ", judged on its length only";
 }
 
 void rd_outp_test(TestContext& ctx, TestResult& r, std::optional<std::uint8_t> reader) {

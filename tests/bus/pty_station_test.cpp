@@ -236,7 +236,9 @@ TEST_F(PtyTest, ProgramMayCloseAndReopenThePath) {
   sched.run_until(B(1000));
   EXPECT_EQ(pty->poll_input(20ms), 0u) << "no EIO/hangup on the master side";
   Program again(pty->path());
-  EXPECT_EQ(again.read_hex(1), "E5") << "queued while closed, like a serial port";
+  EXPECT_FALSE(again.readable()) << "a program never reads frames from before it opened";
+  EXPECT_EQ(pty->stats().frames_no_program, 1u);
+  EXPECT_EQ(pty->stats().program_closes, 1u);
   again.write_hex("DC 05 01");
   ASSERT_EQ(poll_until(*pty, 3), 3u);
   master.send(B(2000), "10 05 01 49 4F 16");
@@ -244,6 +246,7 @@ TEST_F(PtyTest, ProgramMayCloseAndReopenThePath) {
   EXPECT_EQ(again.read_hex(6), "10 05 01 49 4F 16");
   ASSERT_EQ(slave.rx.size(), 4u);  // pty SD1, master SC, pty token, master SD1
   EXPECT_EQ(slave.rx[2].hex(), "DC 05 01");
+  EXPECT_EQ(pty->stats().program_opens, 2u);
 }
 
 TEST_F(PtyTest, ProgramThatDoesNotReadNeverStallsTheBus) {

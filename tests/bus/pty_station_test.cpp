@@ -9,6 +9,11 @@
 
 #include <gtest/gtest.h>
 
+#include <termios.h>
+
+#include <atomic>
+#include <cstring>
+#include <random>
 #include <thread>
 
 #include "frame_recorder.hpp"
@@ -236,7 +241,9 @@ TEST_F(PtyTest, ProgramMayCloseAndReopenThePath) {
   sched.run_until(B(1000));
   EXPECT_EQ(pty->poll_input(20ms), 0u) << "no EIO/hangup on the master side";
   Program again(pty->path());
-  EXPECT_EQ(again.read_hex(1), "E5") << "queued while closed, like a serial port";
+  EXPECT_FALSE(again.readable()) << "a program never reads frames from before it opened";
+  EXPECT_EQ(pty->stats().frames_no_program, 1u);
+  EXPECT_EQ(pty->stats().program_closes, 1u);
   again.write_hex("DC 05 01");
   ASSERT_EQ(poll_until(*pty, 3), 3u);
   master.send(B(2000), "10 05 01 49 4F 16");
@@ -244,6 +251,7 @@ TEST_F(PtyTest, ProgramMayCloseAndReopenThePath) {
   EXPECT_EQ(again.read_hex(6), "10 05 01 49 4F 16");
   ASSERT_EQ(slave.rx.size(), 4u);  // pty SD1, master SC, pty token, master SD1
   EXPECT_EQ(slave.rx[2].hex(), "DC 05 01");
+  EXPECT_EQ(pty->stats().program_opens, 2u);
 }
 
 TEST_F(PtyTest, ProgramThatDoesNotReadNeverStallsTheBus) {
@@ -460,6 +468,265 @@ TEST_F(PtyTiming, RawSendsAtOnceWhateverIsOnTheLine) {
   EXPECT_EQ(rec.frame(2).sender, 0);  // taps see frames in the order they end
   EXPECT_EQ(rec.frame(2).start, B(2100));
   EXPECT_NE(rec.frame(2).flags & kRxCollision, 0);
+}
+
+// --- Bounds: the queue, the age, memory ---------------------------------------------------
+
+TEST_F(PtyTiming, TheQueueIsBoundedAndFullDropsAreCounted) {
+  PtyStation::Options o = station();
+  o.max_queue = 8;
+  make(o);
+  std::string many;
+  for (int i = 0; i < 100; ++i) many += std::string(kPtyTo4) + " ";
+  feed_at(B(1000), many);
+  sched.run_until(B(1001));
+  EXPECT_EQ(pty->stats().dropped_full, 92u);
+  EXPECT_EQ(pty->stats().queue_max, 8u);
+  EXPECT_EQ(pty->queued(), 7u);  // the first is on the line
+  sched.run_until(B(10000));     // each after the slot time of the one before: all within the age
+  EXPECT_EQ(rec.size(), 8u);
+  EXPECT_EQ(pty->stats().dropped_stale, 0u);
+}
+
+TEST_F(PtyTiming, TelegramsOlderThanTheAgeAreDroppedWhenTheirTurnComes) {
+  PtyStation::Options o = station();
+  o.max_age_bits = 200;
+  make(o);  // nobody answers: each request waits the slot time, 300 bit times
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5 + " " + kPtyTo4);
+  sched.run_until(B(5000));
+  ASSERT_EQ(rec.size(), 1u);
+  EXPECT_EQ(rec.frame(0).start, B(1000));
+  EXPECT_EQ(pty->stats().dropped_stale, 2u);  // at B(1366) both had waited 366 bit times
+  EXPECT_EQ(pty->queued(), 0u);
+  // The default: two of the longest request cycles.
+  EXPECT_EQ(default_max_age_bits(300), 2 * (2805 + 33 + 300 + 2805 + 33));
+}
+
+TEST_F(PtyTiming, DefaultAgeIsTwoLongestRequestCycles) {
+  make(station());
+  EXPECT_EQ(pty->max_age_bits(), 2 * (2805 + 33 + 300 + 2805 + 33));
+  // A request that waits one slot time behind our previous one is well within it.
+  feed_at(B(1000), std::string(kPtyTo4) + " " + kPtyTo5);
+  sched.run_until(B(3000));
+  EXPECT_EQ(rec.size(), 2u);
+  EXPECT_EQ(pty->stats().dropped_stale, 0u);
+}
+
+TEST_F(PtyTiming, RawTimingIsBoundedToo) {
+  PtyStation::Options o = station(PtyStation::Timing::Raw);
+  o.max_queue = 4;
+  make(o);
+  std::string many;
+  for (int i = 0; i < 10; ++i) many += std::string(kPtyTo4) + " ";
+  feed_at(B(1000), many);  // one at once, four handed to the line for later, five dropped
+  sched.run_until(B(5000));
+  EXPECT_EQ(rec.size(), 5u);
+  EXPECT_EQ(pty->stats().dropped_full, 5u);
+  EXPECT_EQ(rec.gap_bits(1), 33);
+}
+
+TEST_F(PtyTest, AGarbageFloodKeepsTheStationBounded) {
+  PtyStation::Options o{PtyStation::Mode::Station, 1};
+  make(o);
+  Program prog(pty->path());
+  constexpr std::size_t kFlood = 1 << 20;
+  std::vector<std::uint8_t> junk(kFlood);
+  std::mt19937 rng(7);
+  for (auto& b : junk) b = static_cast<std::uint8_t>(rng());
+  // The program writes the flood through its own descriptor (blocking writes in a thread).
+  int wfd = ::open(pty->path().c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  ASSERT_GE(wfd, 0);
+  std::thread flood([&] {
+    std::size_t done = 0;
+    while (done < junk.size()) {
+      const ssize_t n = ::write(wfd, junk.data() + done, junk.size() - done);
+      if (n > 0) done += static_cast<std::size_t>(n);
+      else if (n < 0 && errno != EINTR) break;
+    }
+  });
+  std::size_t got = 0, max_queued = 0;
+  const auto until = std::chrono::steady_clock::now() + 20s;
+  while (got < kFlood && std::chrono::steady_clock::now() < until) {
+    got += pty->poll_input(20ms);
+    max_queued = std::max(max_queued, pty->queued());
+    sched.run_until(sched.now() + B(2000));  // the line carries what it can meanwhile
+  }
+  flood.join();
+  ::close(wfd);
+  EXPECT_EQ(got, kFlood);
+  EXPECT_LE(max_queued, o.max_queue);
+  const auto s = pty->stats();
+  EXPECT_EQ(s.bytes_in, kFlood);
+  EXPECT_GT(s.dropped_full, 0u);
+  EXPECT_LE(s.queue_max, o.max_queue);
+  // After the flood the queue is empty within the age bound (plus one telegram and its slot time).
+  sched.run_until(sched.now() + B(pty->max_age_bits() + 2805 + 33 + 300));
+  EXPECT_EQ(pty->queued(), 0u);
+}
+
+// --- The program's open and close ------------------------------------------------------------
+
+TEST_F(PtyTest, SeesTheProgramOpenAndClose) {
+  make({});
+  EXPECT_FALSE(pty->program_open());
+  EXPECT_EQ(pty->program_opens(), 0u);
+  EXPECT_FALSE(pty->wait_program_open(30ms));
+  {
+    Program prog(pty->path());
+    EXPECT_TRUE(pty->program_open());
+    EXPECT_EQ(pty->program_opens(), 1u);
+    EXPECT_TRUE(pty->wait_program_open(0ms));
+  }
+  EXPECT_FALSE(pty->program_open());
+  std::thread later([&] {
+    std::this_thread::sleep_for(30ms);
+    Program prog(pty->path());
+    std::this_thread::sleep_for(200ms);
+  });
+  EXPECT_TRUE(pty->wait_program_open(5000ms));
+  later.join();
+  EXPECT_EQ(pty->program_opens(), 2u);
+  EXPECT_FALSE(pty->program_open());
+  EXPECT_EQ(pty->poll_input(), 0u);
+  EXPECT_EQ(pty->stats().program_closes, 1u) << "both closes seen in one go: the last one counts";
+}
+
+TEST_F(PtyTest, WaitProgramOpenWorksWithThePacedRunner) {
+  make({});
+  PacedRunner runner(sched);
+  pty->attach_io(runner);
+  std::atomic<bool> opened{false};
+  std::thread waiter([&] { opened = pty->wait_program_open(5000ms); });
+  std::thread program([&] {
+    while (!runner.running()) std::this_thread::sleep_for(1ms);
+    std::this_thread::sleep_for(20ms);
+    Program prog(pty->path());
+    std::this_thread::sleep_for(50ms);
+  });
+  runner.run_for(150 * kTicksPerMs);
+  program.join();
+  waiter.join();
+  EXPECT_TRUE(opened);
+  EXPECT_EQ(pty->stats().program_opens, 1u);
+  EXPECT_EQ(pty->stats().program_closes, 1u);
+  pty->detach_io();
+}
+
+TEST_F(PtyTest, ClosingDropsWhatWaitsAndRestoresTheTermios) {
+  make({PtyStation::Mode::Station, 3});
+  termios pristine{};
+  {
+    Program probe(pty->path());
+  }
+  pty->poll_input();
+  const int fd0 = ::open(pty->path().c_str(), O_RDWR | O_NOCTTY);
+  ASSERT_GE(fd0, 0);
+  ASSERT_EQ(::tcgetattr(fd0, &pristine), 0);
+  // The program sets its own baud rate, writes two requests (nobody answers: the second waits
+  // the slot time) and half a telegram, and closes.
+  termios t = pristine;
+  ::cfsetispeed(&t, B19200);
+  ::cfsetospeed(&t, B19200);
+  t.c_cflag |= PARENB;
+  ASSERT_EQ(::tcsetattr(fd0, TCSANOW, &t), 0);
+  sched.run_until(B(1000));
+  const auto req = bytes_from_hex(std::string(kPtyTo4) + " " + kPtyTo4 + " 10 04");
+  ASSERT_EQ(::write(fd0, req.data(), req.size()), static_cast<ssize_t>(req.size()));
+  ::close(fd0);
+  pty->poll_input();  // sees the close: takes in what it wrote, then drops what still waits
+  master.send(B(2000), "10 03 01 49 4D 16");  // for the program, but it is gone
+  sched.run_until(B(3000));
+  const auto s = pty->stats();
+  EXPECT_EQ(s.frames_in, 1u) << "the first went out when read (the line was idle)";
+  EXPECT_EQ(s.dropped_closed, 1u);
+  EXPECT_EQ(s.abandoned, 1u);
+  EXPECT_EQ(pty->queued(), 0u);
+  EXPECT_EQ(s.frames_no_program, 1u);
+  Program next(pty->path());
+  EXPECT_FALSE(next.readable());
+  const int fd1 = ::open(pty->path().c_str(), O_RDWR | O_NOCTTY);
+  termios now{};
+  ASSERT_EQ(::tcgetattr(fd1, &now), 0);
+  ::close(fd1);
+  EXPECT_EQ(::cfgetospeed(&now), ::cfgetospeed(&pristine));
+  EXPECT_EQ(now.c_cflag, pristine.c_cflag);
+  // So a program asking for the same baud and parity as the last one can set them.
+  const int fd2 = ::open(pty->path().c_str(), O_RDWR | O_NOCTTY);
+  EXPECT_EQ(::tcsetattr(fd2, TCSANOW, &t), 0) << std::strerror(errno);
+  ::close(fd2);
+}
+
+// --- Which frames the program sees; Set_Slave_Add --------------------------------------------
+
+/// "68 LE LE 68 <body> FCS 16" for a body given in hex.
+std::string sd2(const std::string& body_hex) {
+  const auto body = bytes_from_hex(body_hex);
+  unsigned sum = 0;
+  for (auto b : body) sum += b;
+  char head[32], tail[16];
+  std::snprintf(head, sizeof head, "68 %02X %02X 68 ", unsigned(body.size()), unsigned(body.size()));
+  std::snprintf(tail, sizeof tail, " %02X 16", sum & 0xFF);
+  return head + body_hex + tail;
+}
+
+TEST_F(PtyTiming, FollowsAnAcknowledgedSetSlaveAdd) {
+  make(station());
+  Program prog(pty->path());
+  EXPECT_EQ(pty->current_address(), 3);
+  // Master 1 -> 3: Set_Slave_Add to 9 (DSAP 55, SSAP 62, ident 0x0A01, No_Add_Chg 0).
+  const std::string ssa = sd2("83 81 6D 37 3E 09 0A 01 00");
+  master.send(B(100), ssa);
+  const Ticks end = B(100 + 15 * 11);
+  feed_at(end + B(20), "E5");  // the program acknowledges within the slot time
+  sched.run_until(B(1000));
+  EXPECT_EQ(pty->current_address(), 9);
+  EXPECT_EQ(pty->options().address, 3);
+  EXPECT_EQ(pty->stats().address_changes, 1u);
+  EXPECT_EQ(prog.read_hex(15), ssa);
+  master.send(B(1000), "10 09 01 49 53 16");  // to 9: out
+  master.send(B(1100), kFdlStatusTo3);         // to 3: no longer
+  sched.run_until(B(2000));
+  EXPECT_EQ(prog.read_hex(6), "10 09 01 49 53 16");
+  EXPECT_FALSE(prog.readable());
+  // A late acknowledgement (after the slot time) changes nothing.
+  master.send(B(2000), sd2("89 81 6D 37 3E 0A 0A 01 00"));
+  feed_at(B(2000 + 165 + 301), "E5");
+  sched.run_until(B(3000));
+  EXPECT_EQ(pty->current_address(), 9);
+  // When the program closes, the station goes back to the configured address.
+  prog.close();
+  pty->poll_input();
+  EXPECT_EQ(pty->current_address(), 3);
+}
+
+TEST_F(PtyTiming, IgnoresSetSlaveAddThatIsRefusedOrBroken) {
+  make(station());
+  // Refused: the program answers with an SD1 response "RS" (0x03).
+  master.send(B(100), sd2("83 81 6D 37 3E 09 0A 01 00"));
+  feed_at(B(100 + 165 + 11), "10 01 03 03 07 16");
+  sched.run_until(B(1000));
+  EXPECT_EQ(pty->current_address(), 3);
+  // Bad FCS: not a request at all.
+  master.send(B(1000), "68 09 09 68 83 81 6D 37 3E 09 0A 01 00 00 16");
+  feed_at(B(1000 + 165 + 11), "E5");
+  sched.run_until(B(2000));
+  EXPECT_EQ(pty->current_address(), 3);
+  // An SD1 acknowledgement with status OK counts.
+  master.send(B(2000), sd2("83 81 6D 37 3E 0B 0A 01 00"));
+  feed_at(B(2000 + 165 + 11), "10 01 03 00 04 16");
+  sched.run_until(B(3000));
+  EXPECT_EQ(pty->current_address(), 11);
+}
+
+TEST_F(PtyTest, ForwardAllGivesTheProgramEveryFrame) {
+  PtyStation::Options o{PtyStation::Mode::Station, 3};
+  o.forward_all = true;
+  make(o);
+  Program prog(pty->path());
+  master.send(B(10), "10 04 01 49 4E 16");  // to 4
+  slave.send(B(100), "E5");                  // someone else's SC
+  sched.run_until(B(1000));
+  EXPECT_EQ(prog.read_hex(7), "10 04 01 49 4E 16 E5");
 }
 
 TEST_F(PtyTest, PacedRunnerReadsThePtyAndWritesToIt) {

@@ -36,23 +36,75 @@
 // hold_total, hold_max, in virtual time); in Raw mode only the gap between own telegrams holds.
 // Telegrams still waiting when the station loses power are dropped (Stats::discarded).
 //
-// Line -> program, by mode:
+// Bounds (an interface chip has a job queue of fixed size and the PC program's requests have a
+// lifetime; whatever a program writes, the station's memory stays bounded):
+//  - At most `max_queue` (default 32) telegrams wait for the line. A telegram completed while
+//    that many wait is dropped (Stats::dropped_full). A program that awaits each reply has one
+//    telegram waiting; one that writes a cycle's requests at once, a handful. In Raw timing the
+//    telegrams handed to the line but not yet started count instead.
+//  - A telegram that has waited longer than `max_age_bits` (virtual time) when its turn comes is
+//    dropped (Stats::dropped_stale); in Raw timing, one that would start that late. The default
+//    is two of the longest request cycles, 2 x (2805 + 33 + TSL + 2805 + 33) bit times: the
+//    longest telegram (255 octets = 2805 bit times) on the line, TSYN, our own request's slot
+//    time TSL, the longest reply, TSYN. A program that awaits each reply never waits longer than
+//    one such cycle; a telegram older than two sits behind a backlog (garbage, a program that
+//    wrote far ahead), its program has given up on it (a PC master's reply timeout is longer
+//    than a cycle), and sent late its reply would be taken for the reply to the retry. At the
+//    DP default TSL: 11 552 bit times at 45.45 kbit/s (254 ms), 13 352 at 12 Mbit/s (1.1 ms).
+//  - The program's bytes are read and split in chunks of `kReadChunk` (4096) octets; with
+//    attach_io() the next chunk is read only after the previous one was fed, so a program that
+//    writes faster than the station splits is slowed down by the pty, like a UART's full FIFO.
+//    The splitter holds at most one incomplete telegram (255 octets); the backlog towards the
+//    program at most `max_backlog` octets.
+//
+// Line -> program, by mode (exactly these frames, as they were on the line):
 //  - Monitor: every frame seen on the line comes out raw, damaged ones included (a UART on a
 //    real bus would deliver those bytes too).
-//  - Station(address): frames whose DA is the address or 127 (requests, tokens and replies to
-//    it), plus the first frame that starts within `reply_window` bit times after the end of a
-//    telegram the pty sent: that is the reply to the program's request, whatever its form (SC
-//    E5 has no DA). The default window is the DP default slot time TSL for the line's baud
-//    (protocol-facts.md §C.1: 100..1000 bit times), which is max TSDR + margin: a reply that
-//    starts later would have timed out at a real master too. Scenarios set it to the line's
-//    TSL. The same window is the slot time of the Interface timing.
+//  - Station(address): frames whose DA is current_address() or 127 (requests, tokens and
+//    replies to it; damaged ones included, a UART cannot tell), plus the first frame that starts
+//    within `reply_window` bit times after the end of a telegram the pty sent: that is the
+//    reply to the program's request, whatever its form (SC E5 has no DA). The default window is
+//    the DP default slot time TSL for the line's baud (protocol-facts.md §C.1: 100..1000 bit
+//    times), which is max TSDR + margin: a reply that starts later would have timed out at a
+//    real master too. Scenarios set it to the line's TSL. The same window is the slot time of
+//    the Interface timing. Other stations' traffic (requests to other slaves and their replies,
+//    tokens between others, SC answering someone else) does not come out.
+//  - Station with `forward_all`: every frame, like Monitor (a plain UART on the bus); the
+//    address still decides the reply window and the Set_Slave_Add tracking below.
+// Set_Slave_Add (protocol-facts.md §D.7): a request from the line to current_address() with DSAP
+// 55 (SD2 or SD3, FCS and ED correct, SRD), data octet 0 = the new address 0..126, that the
+// program acknowledges positively (SC E5, or an SD1 response with status OK to the requester)
+// as the first telegram after it, starting within the reply window, changes the program's
+// address: from then on the frames for the new address are forwarded (Stats::address_changes).
+// options().address stays what was configured; current_address() goes back to it when the
+// program closes the pty (a new program starts with the configured address).
 // Output is written as frames are delivered, without blocking: when the program does not read
 // and the pty buffer is full, up to `max_backlog` octets wait; beyond that whole frames are
 // dropped and counted, and the bus never stalls.
 //
-// The station keeps its own handle on the slave side open, so the program may close and reopen
-// the path without the master side seeing EIO or a hangup. (A program opening the pty late may
-// first read frames queued earlier; like with any serial port, it should flush on open.)
+// The program's open and close. The station keeps its own handle on the slave side open, so
+// the program may close and reopen the path without the master side seeing EIO or a hangup
+// (which also means the master side never learns of a close). It watches the slave side's
+// device node with inotify (IN_OPEN, IN_CLOSE_WRITE, IN_CLOSE_NOWRITE: works on devpts; the
+// station's own handle is opened before the watch and counts for nothing): every open file
+// description of the node made by anyone else counts until its last close. program_open(),
+// program_opens() and wait_program_open() report what has been observed.
+//  - While no program has the pty open, frames for it are not written (Stats::frames_no_program).
+//  - When a program opens it, whatever was written towards the program before is discarded
+//    (the slave side's input is flushed, the backlog cleared): a program never reads frames from
+//    before it opened.
+//  - When the last program closes it: the bytes it wrote that are still unread are read and
+//    split (they were written while it was open), then the telegrams still waiting for the line
+//    are dropped (Stats::dropped_closed), the incomplete telegram of the splitter too (counted
+//    as abandoned), the backlog and the slave side's input are cleared, and the slave side's
+//    termios is set back to the raw settings of open_pty(). Otherwise the settings of the last
+//    program would persist (the station's handle keeps the tty alive), and a pty ignores parity:
+//    glibc's tcsetattr reads the settings back and fails with EINVAL when the parity asked for
+//    did not take and the baud rate is unchanged, so a second pyserial program asking the same
+//    baud and even parity as the first could not open the port (Stats::program_closes).
+//    A program that writes a telegram and closes at once loses it if the line was busy: the
+//    telegram needs the pty open until it is on the line.
+// If inotify is not available, the station behaves as if a program always had the pty open.
 //
 // Timing: in paced mode a program's bytes enter at the virtual time that matches the wall clock
 // when they were read. At real-time speed a program answering a request through the pty takes
@@ -62,8 +114,10 @@
 //
 // I/O: attach_io(runner) reads the pty when the runner's io_context says it is readable and
 // injects the bytes through runner.post(); poll_input() does the same synchronously, for tests
-// and the fast driver. All Device callbacks run on the runner's thread.
+// and the fast driver. All Device callbacks run on the runner's thread. program_open(),
+// program_opens(), current_address() and wait_program_open() may be called from any thread.
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
@@ -81,6 +135,9 @@ class PacedRunner;
 
 /// The DP default slot time TSL in bit times for a baud rate (protocol-facts.md §C.1).
 std::int64_t default_slot_time_bits(Baud baud);
+/// The default age bound of a waiting telegram for a slot time (see the header comment):
+/// 2 x (2805 + 33 + slot + 2805 + 33) bit times.
+std::int64_t default_max_age_bits(std::int64_t slot_bits);
 
 class PtyStation final : public Device {
  public:
@@ -100,6 +157,15 @@ class PtyStation final : public Device {
     Ticks resync_after = 100 * kTicksPerMs;
     /// Octets that may wait for the program to read before frames are dropped.
     std::size_t max_backlog = 64 * 1024;
+    /// Telegrams from the program that may wait for the line at once; more are dropped
+    /// (Stats::dropped_full).
+    std::size_t max_queue = 32;
+    /// Bit times a telegram may have waited when its turn comes; older ones are dropped
+    /// (Stats::dropped_stale). 0 = default_max_age_bits(the reply window).
+    std::int64_t max_age_bits = 0;
+    /// Station mode: forward every frame on the line to the program, like Monitor mode (a plain
+    /// UART), instead of only its own traffic and its replies.
+    bool forward_all = false;
   };
 
   struct Stats {
@@ -116,7 +182,17 @@ class PtyStation final : public Device {
     Ticks hold_max = 0;                ///< the longest of them
     std::uint64_t queue_max = 0;       ///< most telegrams waiting at once
     std::uint64_t discarded = 0;       ///< telegrams dropped unsent (power loss)
+    std::uint64_t dropped_full = 0;    ///< telegrams dropped: max_queue were waiting
+    std::uint64_t dropped_stale = 0;   ///< telegrams dropped: older than max_age_bits
+    std::uint64_t dropped_closed = 0;  ///< telegrams dropped unsent: their program closed the pty
+    std::uint64_t frames_no_program = 0;  ///< frames for the program while none had it open
+    std::uint64_t program_opens = 0;   ///< opens of the slave side by programs (observed)
+    std::uint64_t program_closes = 0;  ///< times the last program closed it (observed, handled)
+    std::uint64_t address_changes = 0;  ///< Set_Slave_Add the program acknowledged
   };
+
+  /// Octets read from the program and split at a time (see the header comment).
+  static constexpr std::size_t kReadChunk = 4096;
 
   /// Opens a new pty in raw mode. Throws std::system_error if that fails, std::invalid_argument
   /// for a Station without a valid address.
@@ -147,6 +223,21 @@ class PtyStation final : public Device {
   /// Tries to write the backlog again (called on every output and input anyway).
   void flush_output();
 
+  /// Whether some process other than this station has the slave side open now, as far as the
+  /// station has observed (see the header comment). Any thread.
+  bool program_open() const;
+  /// How many opens of the slave side by programs have been observed so far. Any thread.
+  std::uint64_t program_opens() const;
+  /// Blocks the calling thread up to `limit` until a program has the slave side open; returns
+  /// whether one has. Works with attach_io() running on a PacedRunner's thread and without it;
+  /// must not run concurrently with detach_io() or the destructor.
+  bool wait_program_open(std::chrono::milliseconds limit);
+  /// The program's FDL address in Station mode: options().address until the program
+  /// acknowledges a Set_Slave_Add (see the header comment); -1 in Monitor mode. Any thread.
+  int current_address() const { return m_address.load(std::memory_order_relaxed); }
+  /// The age bound in bit times actually used (max_age_bits or its default).
+  std::int64_t max_age_bits() const;
+
   // --- Device ---------------------------------------------------------------------------------
   void on_power_on(Ticks now) override;
   void on_power_off(Ticks now) override;
@@ -159,6 +250,7 @@ class PtyStation final : public Device {
 
  private:
   struct Io;
+  struct Watch;
   struct Held {
     std::vector<std::uint8_t> bytes;
     Ticks arrived = 0;
@@ -171,7 +263,16 @@ class PtyStation final : public Device {
   void pump(Ticks now);
   void send(Ticks start, const Held& t);
   std::int64_t window_bits() const;
-  std::size_t read_available(std::vector<std::uint8_t>& into);
+  /// Reads up to `max` octets from the master side (non-blocking).
+  std::size_t read_some(std::uint8_t* into, std::size_t max);
+  /// Reads and feeds up to `limit` octets in chunks; returns how many.
+  std::size_t read_and_feed(std::size_t limit);
+  /// Station thread: takes in the observed opens and closes and acts on them.
+  void sync_program();
+  void on_program_closed();
+  void on_program_opened();
+  /// Whether a telegram from the program answers a pending Set_Slave_Add positively.
+  void check_slave_add_ack(Ticks start, std::span<const std::uint8_t> t);
 
   Options m_opt;
   int m_master = -1;
@@ -190,7 +291,19 @@ class PtyStation final : public Device {
   Ticks m_await_until = 0;        // ... and at or before this (slot time)
   bool m_powered = false;
   std::vector<std::uint8_t> m_out;  // backlog towards the program
+  std::deque<Ticks> m_raw_starts;   // Raw timing: starts of telegrams handed to the line
+  // The program's address and a Set_Slave_Add waiting for the program's acknowledgement.
+  std::atomic<int> m_address{-1};
+  int m_ssa_new = -1;       // the new address asked for, -1 = none pending
+  int m_ssa_master = -1;    // who asked
+  Ticks m_ssa_from = 0;     // the acknowledgement must start at or after this (request end)
+  Ticks m_ssa_until = 0;    // ... and at or before this (the reply window)
+  // The program's opens and closes as applied on the station's thread.
+  bool m_present = false;
+  std::uint64_t m_applied_opens = 0;
+  std::uint64_t m_applied_zeros = 0;
   Stats m_stats;
+  std::unique_ptr<Watch> m_watch;  // inotify on the slave side (shared with other threads)
   std::unique_ptr<Io> m_io;
 };
 

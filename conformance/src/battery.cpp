@@ -189,13 +189,6 @@ std::string duration_text(std::chrono::milliseconds d) {
   return d.count() % 1000 == 0 ? std::to_string(d.count() / 1000) + " s" : std::to_string(d.count()) + " ms";
 }
 
-// TEMPORARY until PtyStation::wait_program_open lands.
-template <class P>
-bool wait_open(P& p, std::chrono::milliseconds limit) {
-  if constexpr (requires { p.wait_program_open(limit); }) return p.wait_program_open(limit);
-  else return true;
-}
-
 class OutsideSession final : public Session {
  public:
   OutsideSession(TestBus& bus, std::uint8_t address, EvidenceSink* sink)
@@ -268,7 +261,7 @@ class OutsideContext final : public ContextBase {
     if (progress)
       progress("waiting up to " + duration_text(m_spec->open_wait) + " for a program to open " +
                *m_spec->pty_path + " (" + m_pty->path() + ")");
-    if (!wait_open(*m_pty, m_spec->open_wait)) {
+    if (!m_pty->wait_program_open(m_spec->open_wait)) {
       error = "no program opened " + *m_spec->pty_path + " (" + m_pty->path() + ") within " +
               duration_text(m_spec->open_wait);
       return false;

@@ -80,8 +80,11 @@ void wrong_output_length(TestContext& ctx, TestResult& res) {
   const auto d = run.diag(why, "Slave_Diag after the wrong length");
   if (!d) return run.fail(why);
   if (!wait_prm_diag(*d))
-    return run.fail("after the wrong output length the diagnosis " + hex(d->encode()) +
-                    " is not that of a slave in Wait_Prm (Station_Not_Ready, Master_Add FF)");
+    // What a slave does after refusing the telegram is not in the standard as protocol-facts.md
+    // §D.7 gives it (pbvbus's own model goes to Wait_Prm, docs/dp-slave.md): not judged.
+    return run.pass("the wrong output length was refused (" + r.describe() +
+                    "); the slave then stayed in data exchange (diagnosis " + hex(d->encode()) +
+                    "), which the standard leaves open");
   if (run.model()) {
     const auto got = applied_outputs(*run.model());
     const std::vector<std::uint8_t> zero(got.size(), 0);
@@ -104,9 +107,9 @@ void add_fail_safe_tests(std::vector<TestCase>& out) {
                 {SlaveMutant::RejectFailSafe}, zero_length_outputs));
   out.push_back(make_case(
       "FS-02", kFailSafeGroup, "Wrong output length",
-      "A Data_Exchange whose output length differs from the configuration is refused and the slave "
-      "returns to Wait_Prm with its outputs safe (IEC 61158-6 DP; protocol-facts.md §D.7, "
-      "docs/dp-slave.md)",
+      "A Data_Exchange whose output length differs from the configuration is refused (not "
+      "answered with inputs); a slave that then returns to Wait_Prm has its outputs safe "
+      "(IEC 61158-6 DP; protocol-facts.md §D.7, docs/dp-slave.md)",
       {}, wrong_output_length));
 }
 

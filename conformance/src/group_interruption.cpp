@@ -139,6 +139,9 @@ void short_interruption(TestContext& ctx, TestResult& res) {
 }
 
 void dut_power_cycle(TestContext& ctx, TestResult& res) {
+  if (ctx.outside())
+    return not_applicable(res, "the battery cannot power a program behind a pty off and on (it can "
+                               "only switch the pty's own station, which the program does not see)");
   Run run(ctx, res);
   if (!run) return;
   bus::Ticks twd = 0;

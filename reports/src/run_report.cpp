@@ -42,11 +42,16 @@ void write_text(const Report& r, std::ostream& os) {
        << st.octets_sent << " octets) put on the line, " << st.garbage_bytes
        << " octets discarded (" << st.abandoned << " incomplete telegrams)";
     if (st.discarded) os << ", " << st.discarded << " telegrams lost unsent";
+    os << "\n  dropped unsent: " << st.dropped_full << " (queue full), " << st.dropped_stale
+       << " (too old), " << st.dropped_closed << " (program closed); program opens "
+       << st.program_opens << ", closes " << st.program_closes << ", address changes "
+       << st.address_changes;
     os << "\n  held " << st.held << " telegrams, total " << format_us(st.hold_total) << " us = "
        << st.hold_total / bit << " bit times, max " << format_us(st.hold_max) << " us = "
        << st.hold_max / bit << " bit times, at most " << st.queue_max << " waiting\n";
     os << "  to the program: " << st.frames_out << " frames (" << st.bytes_out << " octets), "
-       << st.frames_dropped << " dropped (not read)\n";
+       << st.frames_dropped << " dropped (not read), " << st.frames_no_program
+       << " while no program had it open\n";
     os << "  requests dropped by the line's receivers for too short an idle time (TSYN): "
        << s.receivers_tsyn_drops << "\n";
   }
@@ -139,6 +144,11 @@ void write_json(const Report& r, std::ostream& os) {
        << ",\"hold_max_ns\":" << bus::ticks_to_ns(st.hold_max)
        << ",\"hold_total_bits\":" << st.hold_total / bit << ",\"hold_max_bits\":" << st.hold_max / bit
        << ",\"queue_max\":" << st.queue_max << ",\"discarded\":" << st.discarded
+       << ",\"dropped_full\":" << st.dropped_full << ",\"dropped_stale\":" << st.dropped_stale
+       << ",\"dropped_closed\":" << st.dropped_closed
+       << ",\"frames_no_program\":" << st.frames_no_program
+       << ",\"program_opens\":" << st.program_opens << ",\"program_closes\":" << st.program_closes
+       << ",\"address_changes\":" << st.address_changes
        << ",\"receivers_tsyn_drops\":" << s.receivers_tsyn_drops << "}";
   }
   os << "],\n\"faults_not_reached\":[";

@@ -325,3 +325,126 @@ TEST(OutsideMaster, RawTimingShowsTheReceiversTsynDrops) {
 
 }  // namespace
 }  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+namespace {
+
+/// VmRSS of a process in kB, or 0.
+long rss_kb(pid_t pid) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(f, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::atol(line.c_str() + 6);
+  return 0;
+}
+
+/// Writes `n` random octets into `path` (blocking, as a careless program would) and closes it.
+bool write_garbage(const std::string& path, std::size_t n, unsigned seed) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_NOCTTY | O_CLOEXEC);
+  if (fd < 0) return false;
+  std::vector<std::uint8_t> junk(64 * 1024);
+  std::uint32_t x = seed | 1;
+  std::size_t done = 0;
+  while (done < n) {
+    for (auto& b : junk) {
+      x ^= x << 13;
+      x ^= x >> 17;
+      x ^= x << 5;
+      b = static_cast<std::uint8_t>(x);
+    }
+    std::size_t off = 0;
+    const std::size_t want = std::min(junk.size(), n - done);
+    while (off < want) {
+      const ssize_t w = ::write(fd, junk.data() + off, want - off);
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) {
+        ::close(fd);
+        return false;
+      }
+      off += static_cast<std::size_t>(w);
+    }
+    done += want;
+  }
+  ::close(fd);
+  return true;
+}
+
+// The outside-master example after a garbage flood: 1 MiB of random octets into the station's
+// pty, then the README's master (fewer cycles); 8 MiB more, then the README's master again (a
+// second master process, the same command a second time). Each master reaches data exchange
+// with every slave and completes; pbvbus's memory does not grow with the flood.
+TEST(OutsideMaster, GarbageFloodThenTheReadmeMasterTwice) {
+  if (const auto why = missing_python(); !why.empty()) GTEST_SKIP() << why;
+  const std::string base = std::string(PBVBUS_BINARY_DIR) + "/outside_master_flood";
+  const std::string link = base + ".pty", scenario_file = base + ".textproto";
+  const std::string report_file = base + ".report.json", err_file = base + ".err";
+  // examples/outside-master.textproto with a link of its own.
+  std::string text = read_file(PBVBUS_SOURCE_DIR "/examples/outside-master.textproto");
+  const auto at = text.find("link: \"/tmp/pbvbus-dp\"");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at + 7, 14, link);
+  const auto gsd = text.find("gsd: \"gsd/");
+  ASSERT_NE(gsd, std::string::npos);
+  for (auto p = text.find("\"gsd/"); p != std::string::npos; p = text.find("\"gsd/", p + 1))
+    text.replace(p + 1, 4, PBVBUS_SOURCE_DIR "/examples/gsd/");
+  std::ofstream(scenario_file) << text;
+  std::cout.flush();
+  std::fflush(nullptr);
+  ::unlink(link.c_str());
+  const pid_t child = ::fork();
+  if (child == 0) {
+    const int out = ::open(report_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, STDOUT_FILENO);
+    ::dup2(err, STDERR_FILENO);
+    const int rc = cmd_run({scenario_file, "--json"}, std::cout, std::cerr);
+    std::cout.flush();
+    std::fflush(nullptr);
+    ::_exit(rc);
+  }
+  ASSERT_GT(child, 0);
+  struct stat st;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (::lstat(link.c_str(), &st) != 0 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(10ms);
+  // The README's command (tests/integration/outside_master.py, the example's slaves), 20 cycles.
+  const std::string master = std::string(kPython) + " " + kScript + " --port " + link +
+                             " --slave 3:0x0A01:12:1121:2:2 --slave 4:0x0A02:0101000202:102061:1:5"
+                             " --cycles 20 --max-time 10";
+  auto run_master = [&](const std::string& tag) {
+    const auto [rc, out] = shell(master);
+    std::ofstream(base + "." + tag + ".json") << out;
+    EXPECT_EQ(rc, 0) << tag << ": " << out;
+    const Flat m = flatten(base + "." + tag + ".json");
+    EXPECT_EQ(str(m, "completed"), "true") << tag;
+    for (int i = 0; i < 2; ++i)
+      EXPECT_GE(num(m, "slaves." + std::to_string(i) + ".data_exchange"), 20u) << tag;
+    std::cout << tag << ": " << out;
+    return m;
+  };
+  EXPECT_TRUE(write_garbage(link, 1 << 20, 1));
+  run_master("after_1MiB");
+  const long rss1 = rss_kb(child);
+  EXPECT_TRUE(write_garbage(link, 8 << 20, 2));
+  run_master("after_8MiB");
+  const long rss8 = rss_kb(child);
+  std::cout << "VmRSS after 1 MiB: " << rss1 << " kB, after 8 MiB more: " << rss8 << " kB\n";
+  ::kill(child, SIGINT);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_file(err_file);
+  ASSERT_GT(rss1, 0);
+  // No growth with the flood (it used to be ~1.2 MB per MiB): bounded by the queue, the chunk
+  // and the backlog, whatever was written.
+  EXPECT_LT(rss8 - rss1, 1024) << "kB";
+  const Flat rep = flatten(report_file);
+  EXPECT_GE(num(rep, "serial.0.octets_in"), 9u << 20);  // and the masters' requests
+  EXPECT_EQ(num(rep, "serial.0.program_opens"), 4u);  // garbage, master, garbage, master
+  EXPECT_EQ(num(rep, "serial.0.program_closes"), 4u);
+  EXPECT_GT(num(rep, "serial.0.dropped_full"), 0u);
+  EXPECT_LE(num(rep, "serial.0.queue_max"), 32u);
+  EXPECT_EQ(str(rep, "dp_slaves.0.state"), "Data_Exch");
+  EXPECT_EQ(str(rep, "dp_slaves.1.state"), "Data_Exch");
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

@@ -27,6 +27,11 @@
 //                   "hold_total_ns","hold_max_ns": int,   // written, and by how much
 //                   "hold_total_bits","hold_max_bits": int,
 //                   "queue_max": int, "discarded": int,   // most waiting at once; lost unsent
+//                   "dropped_full","dropped_stale","dropped_closed": int,  // dropped unsent:
+//                                                     // queue full, too old, program closed
+//                   "frames_no_program": int,         // for the program while none had it open
+//                   "program_opens","program_closes": int, // the program's opens, last closes
+//                   "address_changes": int,           // Set_Slave_Add the program acknowledged
 //                   "receivers_tsyn_drops": int       // = the line's "tsyn_drops"
 //                 } ],
 //     "faults_not_reached": [ str ], // scheduled after the end of the run

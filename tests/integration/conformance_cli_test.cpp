@@ -122,7 +122,7 @@ TEST(ConformanceCli, OnlyAndJson) {
   const auto [rc, out] = run("conformance --gsd " + kGsd + "PBVB0A01.gsd --only STA-01 --json");
   EXPECT_EQ(rc, 0) << out;
   EXPECT_EQ(out.rfind("{\"schema\":\"pbvbus.conformance/1\"", 0), 0u) << out;
-  EXPECT_NE(out.find("\"totals\":{\"tests\":1,\"pass\":1,\"fail\":0,\"na\":0}"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"totals\":{\"tests\":1,\"pass\":1,\"fail\":0,\"error\":0,\"na\":0}"), std::string::npos) << out;
 }
 
 TEST(ConformanceCli, ScenarioStation) {

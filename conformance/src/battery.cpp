@@ -369,14 +369,40 @@ class OutsideContext final : public ContextBase {
       error = "Slave_Diag after the unlock answered " + got;
       return false;
     }
-    const bool wait_prm = (d->status_1 & dp::kDiagStationNotReady) != 0;
-    if (d->master_add != dp::kNoMaster || !wait_prm) {
-      const auto b = d->encode();
+    // Wait_Prm with no owner, and nothing left of an earlier test's parameterisation. An unlock
+    // only releases the slave (protocol-facts.md §D.2 Lock/Unlock: parameters are not taken), so
+    // a Prm_Fault, Cfg_Fault, Not_Supported or Sync/Freeze mode of an earlier test may remain:
+    // then a good locking Set_Prm (the GSD's parameters, which replaces them) and an unlock.
+    const auto leftover = [](const dp::StandardDiag& x) {
+      return (x.status_1 & (dp::kDiagCfgFault | dp::kDiagPrmFault | dp::kDiagNotSupported)) != 0 ||
+             (x.status_2 & (dp::kDiagSyncMode | dp::kDiagFreezeMode)) != 0;
+    };
+    if (d && d->master_add == dp::kNoMaster && leftover(*d)) {
+      const std::uint8_t tester = s.bus().options().tester_address;
+      const auto good = detail::prm_du(m_params);
+      s.bus().request(detail::srd(home, tester, dp::kSapSetPrm, dp::kSapMs0, good),
+                      "start state: Set_Prm with the GSD's parameters (clears an earlier fault)");
+      unlock_from(s, home, tester);
+      d = probe(s, home, "start state: Slave_Diag after the fresh Set_Prm and unlock", got);
+      if (!d) {
+        error = "Slave_Diag after the fresh Set_Prm and unlock answered " + got;
+        return false;
+      }
+    }
+    detail::DiagExpect e;
+    e.s1_mask = dp::kDiagStationNotReady | dp::kDiagCfgFault | dp::kDiagPrmFault | dp::kDiagNotSupported;
+    e.s1 = dp::kDiagStationNotReady;
+    e.s2_mask = dp::kDiagSyncMode | dp::kDiagFreezeMode;
+    e.s2 = 0;
+    e.master = dp::kNoMaster;
+    detail::Reply r;
+    r.kind = detail::Reply::Kind::Telegram;
+    r.status = fdl::ResponseStatus::DL;
+    const auto b = d->encode();
+    r.data.assign(b.begin(), b.end());
+    if (const auto why = detail::check_diag(r, e); !why.empty()) {
       error = "after an unlocking Set_Prm from master " + std::to_string(owner) +
-              " the diagnosis is " + detail::hex(b) + ": expected Station_Not_Ready (octet 1 bit 1) " +
-              "and Master_Add FF (no owner), got " +
-              (wait_prm ? std::string("Station_Not_Ready") : std::string("Station_Not_Ready clear")) +
-              " and Master_Add " + std::to_string(d->master_add);
+              " the slave is not in a fresh Wait_Prm: " + why;
       return false;
     }
     return true;
@@ -424,6 +450,14 @@ BatteryReport run_battery(const DutSpec& spec, const BatteryOptions& options) {
   report.spec = spec;
   if (!spec.gsd) {
     report.dut_error = "no GSD";
+    return report;
+  }
+  // The battery plays the class-1 master at 1 and a second master at 2 (TestBusOptions,
+  // kOtherMaster): a DUT there would answer its own tester's frames.
+  if (spec.address == 1 || spec.address == detail::kOtherMaster || spec.address > 126) {
+    report.dut_error = "the DUT's address " + std::to_string(spec.address) +
+                       (spec.address > 126 ? " is not a slave address 0..126"
+                                           : " is the battery's own (1: the tester, 2: the second master)");
     return report;
   }
   std::unique_ptr<ContextBase> ctx;

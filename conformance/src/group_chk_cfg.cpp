@@ -44,11 +44,29 @@ void right_config(TestContext& ctx, TestResult& r) {
   check(r, "Slave_Diag (Data_Exch)", check_diag(slave_diag(*s), e));
 }
 
+/// The precondition of the tests that send something in Wait_Cfg: the GSD's Set_Prm was taken
+/// (no Prm_Fault, the tester owns the slave). An Error otherwise: a refused Set_Prm leaves the
+/// slave in Wait_Prm, where RS and Not_Ready would pass these tests for the wrong reason.
+bool set_prm_taken(TestResult& r, Session& s) {
+  const Reply d = slave_diag(s, "Slave_Diag after Set_Prm (Wait_Cfg expected)");
+  DiagExpect e;
+  e.s1_mask = dp::kDiagPrmFault;
+  e.s1 = 0;
+  e.master = tester_address(s);
+  if (const auto why = check_diag(d, e); !why.empty()) {
+    error(r, "precondition not established: the Set_Prm with the GSD's parameters was not taken (" +
+                 why + "); the Set_Prm group's tests say why");
+    return false;
+  }
+  return true;
+}
+
 void expect_cfg_fault(TestContext& ctx, TestResult& r, const std::vector<std::uint8_t>& cfg, const std::string& what) {
   auto s = open_session(ctx, r);
   if (!s) return;
   const auto prm = prm_du(ctx.params());
   if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm)))) return;
+  if (!set_prm_taken(r, *s)) return;
   if (check(r, "Chk_Cfg, " + what, expect_sc(chk_cfg(*s, cfg, "Chk_Cfg, " + what)))) return;
   DiagExpect e;
   e.s1_mask = dp::kDiagStationNotReady | dp::kDiagCfgFault;
@@ -99,6 +117,7 @@ void data_exchange_in_wait_cfg(TestContext& ctx, TestResult& r) {
   if (!s) return;
   const auto prm = prm_du(ctx.params());
   if (check(r, "Set_Prm", expect_sc(set_prm(*s, prm)))) return;
+  if (!set_prm_taken(r, *s)) return;
   const auto out = output_pattern(ctx.output_len(), 0x5A);
   const Reply x = data_exchange(*s, out, "Data_Exchange in Wait_Cfg (no Chk_Cfg yet)");
   if (!x.rs()) {

@@ -139,7 +139,7 @@ void takes_control_after_watchdog(TestContext& ctx, TestResult& res) {
   p.station_status |= dp::kPrmWdOn;
   const bus::Ticks twd = watchdog_time(p);
   std::string why;
-  if (!run.start_up(why, &p)) return run.not_ready(why);
+  if (!run.start_up(why, &p)) return run.not_ready(why, "the GSD's parameters and the run's watchdog (WD_On)");
   run.bus().idle(twd + twd / 2);
   class2_takes_over(run, "the tester's watchdog expired");
 }

@@ -184,7 +184,7 @@ void alarm_ack(TestContext& ctx, TestResult& res) {
   p.user_prm[1] |= dp::kEnableProcessAlarm;
   if (!start_dpv1(run, p)) return;
   const std::string err = run.model()->apply(devices::SlaveFault::process_alarm(0, {0x01}));
-  if (!err.empty()) return run.fail("the model could not raise a process alarm: " + err);
+  if (!err.empty()) return run.error("the test could not make the model raise a process alarm: " + err);
   const Reply dx = reply_of(run.data_exchange(run.outputs(0x00), "Data_Exchange after the alarm"));
   if (dx.kind != Reply::Kind::Telegram || dx.status != fdl::ResponseStatus::DH)
     return run.fail("after a process alarm the owner's Data_Exchange answered " + dx.describe() +

@@ -36,7 +36,19 @@ bool setup(TestContext& ctx, TestResult& r, std::unique_ptr<Session>& s) {
   }
   s = open_session(ctx, r);
   if (!s) return false;
-  return !precondition(r, start_up(*s, ctx));
+  if (precondition(r, start_up(*s, ctx))) return false;
+  // The tests see "executed or not" through Rd_Outp by master 2: that view must work first. A
+  // Data_Exchange with FCV = 0 is executed whatever the FCB state (§C.6).
+  const auto probe = output_pattern(ctx.output_len(), 0x6C);
+  data_exchange(*s, probe, "Data_Exchange FCV=0 (is Rd_Outp a view of the outputs?)");
+  const Reply rd = rd_outp(*s, "Rd_Outp from master 2", kReader);
+  if (const auto why = expect_data(rd, probe); !why.empty()) {
+    error(r, "precondition not established: Rd_Outp from master 2 does not show the outputs of a "
+             "Data_Exchange with FCV = 0 (" + why + "), so these tests cannot see whether a frame "
+             "was executed; RD-03/RD-04 say why");
+    return false;
+  }
+  return true;
 }
 
 /// Rd_Outp by master 2 must show `want`.

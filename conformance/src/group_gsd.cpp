@@ -129,6 +129,9 @@ void user_prm_len(TestContext& ctx, TestResult& res) {
     msg += ", " + std::to_string(n + 1) + " refused";
   }
   if (n > 0) {
+    // A fresh starting state, so that the Prm_Fault of the probe above cannot be read again.
+    if (std::string err; !longer_ok && !run.reopen(std::nullopt, err))
+      return run.error("no session for the shorter probe: " + err);
     dp::SlaveParams p = ctx.params();
     p.user_prm.pop_back();
     const auto f =
@@ -211,7 +214,13 @@ void sync_freeze(TestContext& ctx, TestResult& res) {
     const char* name;
   } cases[] = {{dp::kPrmSyncReq, f.sync_mode_supp, "Sync_Req"},
                {dp::kPrmFreezeReq, f.freeze_mode_supp, "Freeze_Req"}};
+  bool first = true;
   for (const auto& c : cases) {
+    // Each probe from a fresh starting state: a Not_Supported or Prm_Fault of the one before
+    // must not be read again.
+    if (std::string err; !first && !run.reopen(std::nullopt, err))
+      return run.error(std::string("no session for the ") + c.name + " probe: " + err);
+    first = false;
     dp::SlaveParams p = ctx.params();
     p.station_status |= c.bit;
     run.set_prm(p.set_prm_du(), std::string("Set_Prm with ") + c.name);

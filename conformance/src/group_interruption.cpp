@@ -83,7 +83,7 @@ bool outputs_safe(Run& run, const std::string& when) {
 bool operate(Run& run, const dp::SlaveParams& p, std::uint8_t fill) {
   std::string why;
   if (!run.start_up(why, &p)) {
-    run.not_ready(why);
+    run.not_ready(why, "the GSD's parameters and the run's watchdog (WD_On)");
     return false;
   }
   const Reply r = reply_of(run.data_exchange(run.outputs(fill), "Data_Exchange"));

@@ -206,9 +206,15 @@ void unlock(TestContext& ctx, TestResult& r) {
 /// (the watchdog's last restart), then Slave_Diag.
 Reply after_silence(TestContext& ctx, TestResult& r, Session& s, const dp::SlaveParams& p, bus::Ticks offset,
                     const std::string& note) {
-  if (precondition(r, start_up(s, ctx, p))) return {};
+  if (precondition(r, start_up(s, ctx, p), "the GSD's parameters and the run's watchdog settings"))
+    return {};
   const auto out = output_pattern(ctx.output_len(), 0x77);
-  data_exchange(s, out, "Data_Exchange (last frame from the owner)");
+  const Reply dx = data_exchange(s, out, "Data_Exchange (last frame from the owner)");
+  if (!dx.ok_with_data() && !(dx.kind == Reply::Kind::Sc && ctx.input_len() == 0)) {
+    error(r, "precondition not established: the Data_Exchange that starts the silence was answered " +
+                 dx.describe() + ", not with the inputs (the slave is not in Data_Exch)");
+    return {};
+  }
   const Exchange& last = s.bus().transcript().back();
   const bus::Ticks at = last.request_end + offset;
   const auto diag = srd(s.dut_address(), tester_address(s), dp::kSapSlaveDiag, dp::kSapMs0, {});

@@ -252,9 +252,9 @@ void Run::error(std::string message) {
   m_result.message = std::move(message);
 }
 
-void Run::not_ready(const std::string& why) {
-  error("precondition not established: the device did not reach Data_Exch with the GSD's "
-        "parameters (" + why + "); the Start-up group's tests say why");
+void Run::not_ready(const std::string& why, const std::string& with) {
+  error("precondition not established: the device did not reach Data_Exch with " + with + " (" +
+        why + "); the Start-up group's tests say why");
 }
 
 void Run::na(std::string message) {

@@ -135,8 +135,9 @@ class Run {
   void na(std::string message);
   /// The test's precondition could not be established: its rule was not tested.
   void error(std::string message);
-  /// error() for a failed start-up with the GSD's parameters (the test's precondition).
-  void not_ready(const std::string& why);
+  /// error() for a failed start-up with `with` (the GSD's parameters unless said: the test's
+  /// precondition).
+  void not_ready(const std::string& why, const std::string& with = "the GSD's parameters");
 
  private:
   void collect();

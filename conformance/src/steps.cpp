@@ -82,16 +82,27 @@ void global_control(Session& s, std::uint8_t control, std::uint8_t group_select,
 std::vector<std::uint8_t> prm_du(const dp::SlaveParams& p) { return p.set_prm_du(); }
 std::vector<std::uint8_t> cfg_du(const dp::SlaveParams& p) { return p.chk_cfg_du(); }
 
+namespace {
+/// A service without response data acknowledged as a master judges it: SC, or a response
+/// without data with status OK or DL (the same rule as Run::start_up in group_support.cpp).
+bool acknowledged_without_data(const Reply& r) {
+  if (r.kind == Reply::Kind::Sc) return true;
+  return r.kind == Reply::Kind::Telegram && r.data.empty() &&
+         (r.status == fdl::ResponseStatus::OK || r.status == fdl::ResponseStatus::DL);
+}
+}  // namespace
+
 std::string start_up(Session& s, TestContext& ctx, const std::optional<dp::SlaveParams>& params) {
   const dp::SlaveParams& p = params ? *params : ctx.params();
   const Reply d0 = slave_diag(s, "start-up: Slave_Diag");
-  if (!d0.ok_with_data()) return "Slave_Diag before Set_Prm: " + d0.describe();
+  if (!d0.ok_with_data() || d0.data.size() < 6)
+    return "Slave_Diag before Set_Prm: " + d0.describe() + ", not a diagnosis of six or more octets";
   const auto prm = prm_du(p);
   const Reply r1 = set_prm(s, prm, "start-up: Set_Prm");
-  if (r1.kind != Reply::Kind::Sc) return "Set_Prm: expected SC, got " + r1.describe();
+  if (!acknowledged_without_data(r1)) return "Set_Prm: expected SC, got " + r1.describe();
   const auto cfg = cfg_du(p);
   const Reply r2 = chk_cfg(s, cfg, "start-up: Chk_Cfg");
-  if (r2.kind != Reply::Kind::Sc) return "Chk_Cfg: expected SC, got " + r2.describe();
+  if (!acknowledged_without_data(r2)) return "Chk_Cfg: expected SC, got " + r2.describe();
   const Reply d1 = slave_diag(s, "start-up: Slave_Diag after Chk_Cfg");
   if (!d1.ok_with_data() || d1.data.size() < 6) return "Slave_Diag after Chk_Cfg: " + d1.describe();
   // Ready for data exchange (§D.4, S1): no Non_Existent/Not_Ready/Cfg_Fault/Prm_Fault, no Prm_Req.
@@ -262,10 +273,10 @@ void error(TestResult& r, const std::string& why) {
   }
 }
 
-bool precondition(TestResult& r, const std::string& start_up_why) {
+bool precondition(TestResult& r, const std::string& start_up_why, const std::string& with) {
   if (start_up_why.empty()) return false;
-  error(r, "precondition not established: the device did not reach Data_Exch with the GSD's "
-           "parameters (" + start_up_why + "); the Start-up group's tests say why");
+  error(r, "precondition not established: the device did not reach Data_Exch with " + with + " (" +
+               start_up_why + "); the Start-up group's tests say why");
   return true;
 }
 

@@ -120,7 +120,8 @@ void not_applicable(TestResult& r, const std::string& why);
 void error(TestResult& r, const std::string& why);
 /// For start_up()'s result as a test's precondition: an Error when `start_up_why` is not empty;
 /// returns whether it was.
-bool precondition(TestResult& r, const std::string& start_up_why);
+bool precondition(TestResult& r, const std::string& start_up_why,
+                  const std::string& with = "the GSD's parameters");
 /// Fails `r` with `what: why` when `why` is not empty; returns whether it failed.
 bool check(TestResult& r, const std::string& what, const std::string& why);
 

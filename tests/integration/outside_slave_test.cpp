@@ -314,18 +314,19 @@ TEST(OutsideSlave, PythonSlaveAcceptingAWrongIdentIsCaughtByPrm01) {
 TEST(OutsideSlave, PythonSlaveExecutingRepeatsIsCaughtByFcb01) {
   if (const auto why = missing_python(); !why.empty()) GTEST_SKIP() << why;
   if (const auto why = missing_binary(); !why.empty()) GTEST_SKIP() << why;
-  // Only FCB-01, in a fresh program: its first frame (FCV=0, FCB=1) is the program's first
-  // Data_Exchange (inputs, a counter of the Data_Exchanges executed, 00 01); the next one
-  // (FCV=1, FCB=0) counts to 00 02:
-  //   68 05 05 68 01 05 08 00 02 10 16   (SD2, DA 1, SA 5, FC 08 = DL; FCS 01+05+08+00+02 = 0x10)
-  // and its repeat, executed although it must not be, counts on to 00 03:
-  //   68 05 05 68 01 05 08 00 03 11 16   (FCS 01+05+08+00+03 = 0x11)
+  // Only FCB-01, in a fresh program: the group's check that Rd_Outp shows the outputs is the
+  // program's first Data_Exchange (FCV=0; inputs, a counter of the Data_Exchanges executed,
+  // 00 01), the first frame (FCV=0, FCB=1) its second (00 02); the next one (FCV=1, FCB=0)
+  // counts to 00 03:
+  //   68 05 05 68 01 05 08 00 03 11 16   (SD2, DA 1, SA 5, FC 08 = DL; FCS 01+05+08+00+03 = 0x11)
+  // and its repeat, executed although it must not be, counts on to 00 04:
+  //   68 05 05 68 01 05 08 00 04 12 16   (FCS 01+05+08+00+04 = 0x12)
   const BatteryRun r = run_checked("break_fcb", {"--break", "fcb"}, {{"FCB-01", "fail"}}, {"FCB-01"});
   EXPECT_EQ(r.rc, 1) << r.err << verdicts(r.report);
   expect_verdicts(r.report, {{"FCB-01", "fail"}});
   EXPECT_EQ(get(r.report, "tests.0.message"),
-            "repeat: expected the stored reply 68 05 05 68 01 05 08 00 02 10 16, got 68 05 05 68 01 05 08 00 "
-            "03 11 16");
+            "repeat: expected the stored reply 68 05 05 68 01 05 08 00 03 11 16, got 68 05 05 68 01 05 08 00 "
+            "04 12 16");
   std::remove(r.junit_file.c_str());
   EXPECT_EQ(r.slave_rc, 0) << r.slave_err;
 }

@@ -241,6 +241,10 @@ class OutsideContext final : public ContextBase {
       po.address = m_spec->address;
       po.timing = bus::PtyStation::Timing::Interface;
       po.reply_window_bits = m_timing.tsl_bits;
+      // Every frame on the line, as a UART on the cable would hear it (the program filters by
+      // DA, as a slave must): a program that takes a new address without acknowledging it
+      // positively is still heard, and probes at other addresses reach it.
+      po.forward_all = true;
       m_pty = std::make_unique<bus::PtyStation>(po);
     } catch (const std::exception& e) {
       error = std::string("cannot open a pty: ") + e.what();

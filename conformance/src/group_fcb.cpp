@@ -163,7 +163,7 @@ void add_fcb_tests(std::vector<TestCase>& out) {
                  "The responder keeps the frame count bit per requesting station: another master's "
                  "FCB sequence in between does not make the tester's next toggled frame a repeat "
                  "(§C.6: the FCB is stored per source address)",
-                 fcb_per_master, {}});
+                 fcb_per_master, {SlaveMutant::FcbGlobal}});
 }
 
 }  // namespace pbvbus::conformance::detail

@@ -74,6 +74,7 @@ dp::EngineMutation engine_mutation(std::optional<SlaveMutant> m) {
     case SlaveMutant::WrongDiagIdent: return E::WrongDiagIdent;
     case SlaveMutant::GetCfgSapsNotSwapped: return E::GetCfgSapsNotSwapped;
     case SlaveMutant::DataExchangeInWaitCfg: return E::DataExchangeInWaitCfg;
+    case SlaveMutant::FcbGlobal: return E::None;
   }
   return E::None;
 }
@@ -84,6 +85,7 @@ fdl::PassiveMutation passive_mutation(std::optional<SlaveMutant> m, std::uint32_
   if (m == SlaveMutant::TsdrTooLate) p.fixed_tsdr = mutant_tsdr;
   if (m == SlaveMutant::IgnoreMinTsdr) p.ignore_min_tsdr = true;
   if (m == SlaveMutant::IgnoreFcb) p.ignore_fcb = true;
+  if (m == SlaveMutant::FcbGlobal) p.shared_fcb = true;
   return p;
 }
 

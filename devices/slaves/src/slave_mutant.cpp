@@ -11,7 +11,7 @@ namespace {
 
 using M = SlaveMutant;
 
-constexpr std::array<MutantInfo, 20> kMutants{{
+constexpr std::array<MutantInfo, 21> kMutants{{
     {M::TsdrTooLate, "tsdr_too_late",
      "a responder answers no later than max TSDR (the GSD's MaxTsdr at the line's baud) after "
      "the request's last stop bit (IEC 61158-4-3 station delay; protocol-facts.md §C.2)"},
@@ -70,6 +70,9 @@ constexpr std::array<MutantInfo, 20> kMutants{{
     {M::DataExchangeInWaitCfg, "dx_in_wait_cfg",
      "after Set_Prm the slave waits for a good Chk_Cfg (Wait_Cfg) and refuses Data_Exchange "
      "until then (protocol-facts.md §D.8)"},
+    {M::FcbGlobal, "fcb_global",
+     "the responder keeps the frame count bit and the stored reply per requesting station "
+     "(IEC 61158-4-3; protocol-facts.md §C.6)"},
 }};
 
 constexpr bool table_in_enum_order() {
@@ -78,7 +81,7 @@ constexpr bool table_in_enum_order() {
   return true;
 }
 static_assert(table_in_enum_order(), "slave_mutants(): one row per enum value, in enum order");
-static_assert(static_cast<std::size_t>(M::DataExchangeInWaitCfg) + 1 == kMutants.size(),
+static_assert(static_cast<std::size_t>(M::FcbGlobal) + 1 == kMutants.size(),
               "a new SlaveMutant needs its row");
 
 }  // namespace

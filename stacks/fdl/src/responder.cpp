@@ -18,13 +18,13 @@ Responder::Check Responder::check(const Telegram& req) {
   const RequestFn fn = fc_request_fn(req.fc);
   if (!fn_uses_fcb(fn) || !fc_fcv(req.fc)) return Check::Execute;
   const std::uint8_t fcb = fc_fcb(req.fc) ? 1 : 0;
-  if (m_fcb[req.sa] == fcb) return Check::Repeat;
+  if (m_fcb[key(req.sa)] == fcb) return Check::Repeat;
   return Check::Execute;
 }
 
 const Frame& Responder::stored_reply(std::uint8_t sa) const {
-  if (!m_initialised || sa >= 128 || m_slot[sa] == kNone) return kEmptyFrame;
-  return m_replies[m_slot[sa]];
+  if (!m_initialised || sa >= 128 || m_slot[key(sa)] == kNone) return kEmptyFrame;
+  return m_replies[m_slot[key(sa)]];
 }
 
 void Responder::clear(Reply& reply) {
@@ -52,13 +52,14 @@ const Frame& Responder::finish(const Telegram& req, std::uint8_t own, StationTyp
   if (store) {
     // First frame (FCV=0, FCB=1) or a new action frame: remember its FCB, and encode the
     // answer straight into the SA's slot (no copy per frame).
-    m_fcb[req.sa] = fc_fcb(req.fc) ? 1 : 0;
-    if (m_slot[req.sa] == kNone) {
-      m_slot[req.sa] = static_cast<std::uint8_t>(m_replies.size());
+    const std::uint8_t k = key(req.sa);
+    m_fcb[k] = fc_fcb(req.fc) ? 1 : 0;
+    if (m_slot[k] == kNone) {
+      m_slot[k] = static_cast<std::uint8_t>(m_replies.size());
       m_replies.emplace_back();
     }
   }
-  Frame& out = store ? m_replies[m_slot[req.sa]] : m_scratch;
+  Frame& out = store ? m_replies[m_slot[key(req.sa)]] : m_scratch;
   out.len = 0;
   FrameSpec spec;
   spec.da = req.sa;

@@ -15,7 +15,7 @@
 namespace pbvbus::devices {
 namespace {
 
-constexpr std::size_t kMutantCount = 20;  // the enum's values, counted by hand
+constexpr std::size_t kMutantCount = 21;  // the enum's values, counted by hand
 
 TEST(SlaveMutant, EveryEnumValueHasItsRowInOrder) {
   const auto all = slave_mutants();
@@ -63,6 +63,7 @@ struct Expected {
   SlaveMutant m;
   dp::EngineMutation engine;
   bool fixed_tsdr, ignore_min_tsdr, ignore_fcb;
+  bool shared_fcb = false;
 };
 
 TEST(SlaveMutant, EveryMutantBuildsOnPbvb0a03WithExactlyOneHook) {
@@ -89,6 +90,7 @@ TEST(SlaveMutant, EveryMutantBuildsOnPbvb0a03WithExactlyOneHook) {
       {M::WrongDiagIdent, E::WrongDiagIdent, false, false, false},
       {M::GetCfgSapsNotSwapped, E::GetCfgSapsNotSwapped, false, false, false},
       {M::DataExchangeInWaitCfg, E::DataExchangeInWaitCfg, false, false, false},
+      {M::FcbGlobal, E::None, false, false, false, true},
   };
   ASSERT_EQ(std::size(expected), kMutantCount);
   const GsdFile gsd = load("PBVB0A03.gsd");
@@ -106,6 +108,7 @@ TEST(SlaveMutant, EveryMutantBuildsOnPbvb0a03WithExactlyOneHook) {
     EXPECT_EQ(pm.fixed_tsdr.has_value(), x.fixed_tsdr);
     EXPECT_EQ(pm.ignore_min_tsdr, x.ignore_min_tsdr);
     EXPECT_EQ(pm.ignore_fcb, x.ignore_fcb);
+    EXPECT_EQ(pm.shared_fcb, x.shared_fcb);
     if (x.fixed_tsdr) {
       // PBVB0A03: MaxTsdr_1.5M = 150; the mutant answers 20 t_bit later, unbounded.
       EXPECT_EQ(*pm.fixed_tsdr, 170u);

@@ -37,6 +37,7 @@ enum class SlaveMutant : std::uint8_t {
   WrongDiagIdent,        ///< Slave_Diag octets 5..6 carry the ident + 1
   GetCfgSapsNotSwapped,  ///< the Get_Cfg reply carries DSAP 59, SSAP 62 (not mirrored)
   DataExchangeInWaitCfg, ///< Data_Exchange answered after Set_Prm, before a good Chk_Cfg
+  FcbGlobal,             ///< one frame count bit (and stored reply) for all masters
 };
 
 struct MutantInfo {

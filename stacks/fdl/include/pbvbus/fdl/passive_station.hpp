@@ -49,7 +49,8 @@ struct PassiveMutation {
   std::optional<std::uint32_t> fixed_tsdr;
   bool ignore_min_tsdr = false;  ///< ignore_min_tsdr: Reply::new_min_tsdr is never applied
   bool ignore_fcb = false;       ///< ignore_fcb: an FCB repeat goes to the user as a new request
-  bool any() const { return fixed_tsdr || ignore_min_tsdr || ignore_fcb; }
+  bool shared_fcb = false;       ///< fcb_global: one FCB and stored reply for all requesters
+  bool any() const { return fixed_tsdr || ignore_min_tsdr || ignore_fcb || shared_fcb; }
 };
 
 class PassiveStation final : public bus::Device {
@@ -81,7 +82,10 @@ class PassiveStation final : public bus::Device {
   const BusParams& params() const { return m_params; }
   const PassiveStats& stats() const { return m_stats; }
   /// Test-only (mutant slaves): breaks one FDL rule on purpose; see PassiveMutation.
-  void set_mutation(const PassiveMutation& m) { m_mutation = m; }
+  void set_mutation(const PassiveMutation& m) {
+    m_mutation = m;
+    m_responder.set_shared_fcb(m.shared_fcb);
+  }
   const PassiveMutation& mutation() const { return m_mutation; }
 
  private:

@@ -56,7 +56,13 @@ class Responder {
   /// Encodes the FDL Status reply `10 SA DA FC FCS 16` with FC = type + OK.
   static Frame fdl_status_reply(const Telegram& req, std::uint8_t own, StationType type);
 
+  /// Test-only (mutant slaves, docs/mutants.md): one FCB and one stored reply for every
+  /// requester instead of one per source address (breaks §C.6 on purpose).
+  void set_shared_fcb(bool shared) { m_shared = shared; }
+
  private:
+  /// Where `sa`'s FCB and stored reply live: its own entry, or entry 0 for all (set_shared_fcb).
+  std::uint8_t key(std::uint8_t sa) const { return m_shared ? 0 : sa; }
   static constexpr std::uint8_t kNone = 0xFF;
   // Last FCB per source address: kNone, 0 or 1.
   std::array<std::uint8_t, 128> m_fcb{};
@@ -66,6 +72,7 @@ class Responder {
   std::vector<Frame> m_replies;
   Frame m_scratch;
   bool m_initialised = false;
+  bool m_shared = false;
 };
 
 }  // namespace pbvbus::fdl

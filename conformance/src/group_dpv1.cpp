@@ -38,6 +38,15 @@ namespace {
 
 constexpr const char* kDpv1Group = "DP-V1";
 
+/// The same before any session is opened (an n/a test needs no starting state).
+bool dpv1_slave(TestContext& ctx, TestResult& res) {
+  if (!ctx.spec().gsd->dpv1().dpv1_slave) {
+    not_applicable(res, "the GSD does not say DPV1_Slave = 1");
+    return false;
+  }
+  return true;
+}
+
 bool dpv1_slave(Run& run) {
   if (!run.ctx().spec().gsd->dpv1().dpv1_slave) {
     run.na("the GSD does not say DPV1_Slave = 1");
@@ -74,6 +83,7 @@ bool start_dpv1(Run& run, const dp::SlaveParams& p) {
 }
 
 void dpv1_start_up(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
   const auto p = dpv1_params(ctx);
@@ -86,13 +96,14 @@ void dpv1_start_up(TestContext& ctx, TestResult& res) {
 }
 
 void read_known(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return not_applicable(res, "the GSD says C1_Read_Write_supp = 0");
+  if (ctx.outside())
+    return not_applicable(
+        res, "the GSD names no data record, so the battery knows none to read on an outside slave");
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
-    return run.na("the GSD says C1_Read_Write_supp = 0");
-  if (!run.model())
-    return run.na(
-        "the GSD names no data record, so the battery knows none to read on an outside slave");
   run.model()->application().on_read(1, 1, [](const dp::RecordCall&, std::span<std::uint8_t> out) {
     const std::uint8_t v[2] = {0xAB, 0xCD};
     const std::size_t n = std::min<std::size_t>(out.size(), 2);
@@ -111,10 +122,11 @@ void read_known(TestContext& ctx, TestResult& res) {
 }
 
 void read_unknown_index(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return not_applicable(res, "the GSD says C1_Read_Write_supp = 0");
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
-    return run.na("the GSD says C1_Read_Write_supp = 0");
   if (!start_dpv1(run, dpv1_params(ctx))) return;
   const std::uint8_t rq[4] = {dp::kFnRead, 0x00, 0xFE, 0x10};
   const Reply r =
@@ -126,10 +138,11 @@ void read_unknown_index(TestContext& ctx, TestResult& res) {
 }
 
 void write_wrong_length(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return not_applicable(res, "the GSD says C1_Read_Write_supp = 0");
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
-    return run.na("the GSD says C1_Read_Write_supp = 0");
   if (!start_dpv1(run, dpv1_params(ctx))) return;
   const std::uint8_t rq[6] = {dp::kFnWrite, 0x00, 0xFE, 0x04, 0xAA, 0xBB};
   const Reply r =
@@ -141,10 +154,11 @@ void write_wrong_length(TestContext& ctx, TestResult& res) {
 }
 
 void not_enabled(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
+  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
+    return not_applicable(res, "the GSD says C1_Read_Write_supp = 0");
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().c1_read_write_supp)
-    return run.na("the GSD says C1_Read_Write_supp = 0");
   const auto p = dpv1_params(ctx, false);
   std::string why;
   if (!run.start_up(why, &p)) return run.fail("Set_Prm without DPV1_Enable (DP-V0 mode): " + why);
@@ -174,12 +188,13 @@ std::optional<std::pair<std::uint8_t, std::uint8_t>> find_alarm(std::span<const 
 }
 
 void alarm_ack(TestContext& ctx, TestResult& res) {
+  if (!dpv1_slave(ctx, res)) return;
+  if (!ctx.spec().gsd->dpv1().process_alarm_supp)
+    return not_applicable(res, "the GSD says Process_Alarm_supp = 0");
+  if (ctx.outside())
+    return not_applicable(res, "an outside slave cannot be made to raise an alarm on demand (white box only)");
   Run run(ctx, res);
   if (!run || !dpv1_slave(run)) return;
-  if (!ctx.spec().gsd->dpv1().process_alarm_supp)
-    return run.na("the GSD says Process_Alarm_supp = 0");
-  if (!run.model())
-    return run.na("an outside slave cannot be made to raise an alarm on demand (white box only)");
   auto p = dpv1_params(ctx);
   p.user_prm[1] |= dp::kEnableProcessAlarm;
   if (!start_dpv1(run, p)) return;

@@ -23,14 +23,15 @@ namespace {
 constexpr const char* kFailSafeGroup = "Fail-safe";
 
 void zero_length_outputs(TestContext& ctx, TestResult& res) {
-  Run run(ctx, res);
-  if (!run) return;
   if (!ctx.spec().gsd->slave_features().fail_safe)
-    return run.na(
+    return not_applicable(
+        res,
         "the GSD says Fail_Safe = 0: a Data_Exchange without output data is not part of "
         "this slave's contract");
   if (ctx.output_len() == 0)
-    return run.na("the configuration has no outputs: every Data_Exchange is zero-length already");
+    return not_applicable(res, "the configuration has no outputs: every Data_Exchange is zero-length already");
+  Run run(ctx, res);
+  if (!run) return;
   std::string why;
   if (!run.start_up(why)) return run.not_ready(why);
   const auto a = run.outputs(0xA5);
@@ -61,10 +62,10 @@ void zero_length_outputs(TestContext& ctx, TestResult& res) {
 }
 
 void wrong_output_length(TestContext& ctx, TestResult& res) {
+  const std::size_t n = ctx.output_len() + 1;
+  if (n > 244) return not_applicable(res, "the configuration already has 244 output octets");
   Run run(ctx, res);
   if (!run) return;
-  const std::size_t n = ctx.output_len() + 1;
-  if (n > 244) return run.na("the configuration already has 244 output octets");
   std::string why;
   if (!run.start_up(why)) return run.not_ready(why);
   const Reply r1 = reply_of(run.data_exchange(run.outputs(0x5A), "Data_Exchange outputs 5A"));

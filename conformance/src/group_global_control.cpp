@@ -172,11 +172,11 @@ void counting_inputs(Run& run) {
 }
 
 void freeze_unfreeze(TestContext& ctx, TestResult& res) {
+  if (!ctx.spec().gsd->slave_features().freeze_mode_supp)
+    return not_applicable(res, "the GSD says Freeze_Mode_supp = 0");
+  if (ctx.input_len() == 0) return not_applicable(res, "the configuration has no inputs");
   Run run(ctx, res);
   if (!run) return;
-  if (!ctx.spec().gsd->slave_features().freeze_mode_supp)
-    return run.na("the GSD says Freeze_Mode_supp = 0");
-  if (ctx.input_len() == 0) return run.na("the configuration has no inputs");
   counting_inputs(run);
   dp::SlaveParams p = ctx.params();
   p.station_status |= dp::kPrmFreezeReq;
@@ -239,6 +239,11 @@ void group_select_black_box(Run& run) {
 }
 
 void group_select(TestContext& ctx, TestResult& res) {
+  if (ctx.outside() && !ctx.spec().gsd->slave_features().sync_mode_supp)
+    return not_applicable(res, "an outside slave's Group_Select is seen through Sync_Mode, and "
+                               "the GSD says Sync_Mode_supp = 0");
+  if (!ctx.outside() && ctx.output_len() == 0)
+    return not_applicable(res, "the configuration has no outputs");
   Run run(ctx, res);
   if (!run) return;
   if (!run.model()) return group_select_black_box(run);

@@ -29,6 +29,15 @@ std::uint8_t other_address(std::uint8_t a) {
   return a == 100 ? 101 : 100;
 }
 
+/// The same before any session is opened (an n/a test needs no starting state).
+bool supported(TestContext& ctx, TestResult& res) {
+  if (!ctx.spec().gsd->slave_features().set_slave_add_supp) {
+    not_applicable(res, "the GSD says Set_Slave_Add_supp = 0");
+    return false;
+  }
+  return true;
+}
+
 bool supported(Run& run) {
   if (!run.ctx().spec().gsd->slave_features().set_slave_add_supp) {
     run.na("the GSD says Set_Slave_Add_supp = 0");
@@ -53,6 +62,7 @@ void restore(Run& run, std::uint8_t from, std::uint8_t to) {
 }
 
 void new_address_taken(TestContext& ctx, TestResult& res) {
+  if (!supported(ctx, res)) return;
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
@@ -86,12 +96,14 @@ void new_address_taken(TestContext& ctx, TestResult& res) {
 }
 
 void no_add_chg(TestContext& ctx, TestResult& res) {
-  Run run(ctx, res);
-  if (!run || !supported(run)) return;
-  if (!run.model())
-    return run.na(
+  if (!supported(ctx, res)) return;
+  if (ctx.outside())
+    return not_applicable(
+        res,
         "No_Add_Chg can be undone only by a reset of the device: an outside slave would "
         "stay at another address for the rest of the run");
+  Run run(ctx, res);
+  if (!run || !supported(run)) return;
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
   const std::uint8_t third = old_a == 102 ? 103 : 102;
   const std::uint16_t ident = ctx.params().ident;
@@ -114,6 +126,7 @@ void no_add_chg(TestContext& ctx, TestResult& res) {
 }
 
 void wrong_ident_refused(TestContext& ctx, TestResult& res) {
+  if (!supported(ctx, res)) return;
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   const std::uint8_t old_a = run.dut(), new_a = other_address(old_a);
@@ -135,6 +148,7 @@ void wrong_ident_refused(TestContext& ctx, TestResult& res) {
 }
 
 void in_data_exchange(TestContext& ctx, TestResult& res) {
+  if (!supported(ctx, res)) return;
   Run run(ctx, res);
   if (!run || !supported(run)) return;
   std::string why;

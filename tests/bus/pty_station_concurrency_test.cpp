@@ -1,4 +1,4 @@
-// Serial PROFIBUS over a real pseudo-terminal (design.md "Serial PROFIBUS"): a test plays the
+// (Also built under ASan+UBSan and TSan: a door, with the program's threads.) Serial PROFIBUS over a real pseudo-terminal (design.md "Serial PROFIBUS"): a test plays the
 // program on the slave side of the pty; probes on the line check bytes and bit timing.
 
 #include "pbvbus/bus/pty_station.hpp"

@@ -1,5 +1,6 @@
-// (Also built under ASan+UBSan and TSan: a door, with the program's threads.) Serial PROFIBUS over a real pseudo-terminal (design.md "Serial PROFIBUS"): a test plays the
-// program on the slave side of the pty; probes on the line check bytes and bit timing.
+// Serial PROFIBUS over a real pseudo-terminal (design.md "Serial PROFIBUS"): a test plays the
+// program on the slave side of the pty; probes on the line check bytes and bit timing. Built
+// also under ASan+UBSan and TSan (a door, with the program's threads: *_concurrency_test).
 
 #include "pbvbus/bus/pty_station.hpp"
 

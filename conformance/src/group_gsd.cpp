@@ -127,6 +127,10 @@ void user_prm_len(TestContext& ctx, TestResult& res) {
       return run.fail("Set_Prm with " + std::to_string(n + 1) +
                       " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
     msg += ", " + std::to_string(n + 1) + " refused";
+  } else {
+    msg += gsd.dpv1().prm_block_structure_supp
+               ? ", " + std::to_string(n + 1) + " not tried (Prm_Block_Structure_supp: blocks may follow)"
+               : ", " + std::to_string(n + 1) + " not tried (the Set_Prm would exceed 244 octets)";
   }
   if (n > 0) {
     // A fresh starting state, so that the Prm_Fault of the probe above cannot be read again.
@@ -142,6 +146,7 @@ void user_prm_len(TestContext& ctx, TestResult& res) {
                       " User_Prm_Data octets (GSD: " + std::to_string(n) + ") gave no Prm_Fault");
     msg += ", " + std::to_string(n - 1) + " refused";
   }
+  if (n == 0) msg += ", no shorter length exists";
   run.pass(msg + " (Prm_Fault)");
 }
 
@@ -170,7 +175,19 @@ void max_diag_len(TestContext& ctx, TestResult& res) {
   auto cfg = p.chk_cfg_du();
   cfg.push_back(0x10);  // one 1-octet input module too many
   run.chk_cfg(cfg, "Chk_Cfg with one module too many");
-  if (!check("Slave_Diag after a wrong Chk_Cfg")) return;
+  {
+    // The diagnosis after the wrong Chk_Cfg must be the Cfg_Fault one (with its identifier
+    // block where the slave gives one); otherwise the long case was not provoked.
+    const Reply r = reply_of(run.slave_diag("Slave_Diag after a wrong Chk_Cfg"));
+    if (!r.ok_with_data() || r.data.size() < 6 || (r.data[0] & dp::kDiagCfgFault) == 0)
+      return run.error("the wrong Chk_Cfg did not give a Cfg_Fault diagnosis (" + r.describe() +
+                       "), so the long diagnosis could not be provoked; CFG-03 says why");
+    longest = std::max(longest, r.data.size());
+    if (r.data.size() > max)
+      return run.fail("Slave_Diag after a wrong Chk_Cfg: " + std::to_string(r.data.size()) +
+                      " octets " + hex(r.data) + ", more than Max_Diag_Data_Len = " +
+                      std::to_string(max));
+  }
   std::string why;
   if (!run.start_up(why)) return run.not_ready(why);
   if (!check("Slave_Diag in Data_Exch")) return;
@@ -232,6 +249,11 @@ void sync_freeze(TestContext& ctx, TestResult& res) {
     if (c.supp && (ns || pf))
       return run.fail(std::string("the GSD supports it, but Set_Prm with ") + c.name +
                       " gave the diagnosis " + hex(d->encode()));
+    if (c.supp && d->master_add != run.tester())
+      return run.fail(std::string("the GSD supports it, but the Set_Prm with ") + c.name +
+                      " was not taken: the diagnosis " + hex(d->encode()) + " names master " +
+                      std::to_string(d->master_add) + ", not the tester " +
+                      std::to_string(run.tester()));
     if (!c.supp && !ns)
       return run.fail(std::string("the GSD does not support it, but Set_Prm with ") + c.name +
                       " gave no Not_Supported: " + hex(d->encode()));

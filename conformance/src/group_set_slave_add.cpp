@@ -84,6 +84,12 @@ void new_address_taken(TestContext& ctx, TestResult& res) {
   // No_Add_Chg was 0: the address may be changed again — after leaving data exchange.
   p.station_status = dp::kPrmUnlockReq;
   run.set_prm(p.set_prm_du(), "Set_Prm with Unlock_Req (back to Wait_Prm)");
+  // Set_Slave_Add is accepted only in Wait_Prm (§D.7): the unlock must have taken.
+  if (const auto d = run.diag(why, "Slave_Diag after the unlock (Wait_Prm expected)");
+      !d || !wait_prm_diag(*d))
+    return run.error("the slave is not back in Wait_Prm after the unlocking Set_Prm (" +
+                     (d ? hex(d->encode()) : why) +
+                     "), so moving it back could not be tried; the Set_Prm group's PRM-05 says why");
   const Reply back = reply_of(run.set_slave_add(new_a, old_a, ident, false, "Set_Slave_Add back"));
   if (back.kind != Reply::Kind::Sc)
     return run.fail("Set_Slave_Add back to " + std::to_string(old_a) +

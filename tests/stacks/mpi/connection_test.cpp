@@ -314,6 +314,32 @@ TEST(MpiConnection, CpuReleasesAConnectionWhoseAckNeverComes) {
   EXPECT_FALSE(cpu.deadline());
 }
 
+TEST(MpiConnection, PdusThatDoNotFitTheStateAreDroppedAndCounted) {
+  ConnectionPool cpu;
+  Connection pg = Connection::initiator(2, 0x14);
+  Outbox pg_out;
+  Outbox out;
+  pg.connect(0, pg_out);
+  ASSERT_EQ(cpu.on_frame(0, MpiLink::received(0, pg_out.frames[0]), out), FdlReply::Ack);
+  out.clear();
+  // Data before the connection acks: taken by FDL, dropped by MPI, no ack, no indication.
+  const Bytes data = {kData, 0x00, 0x32};
+  EXPECT_EQ(cpu.on_frame(0, Received{0, 0x14, 0x14, data}, out), FdlReply::Ack);
+  EXPECT_TRUE(out.frames.empty());
+  EXPECT_TRUE(out.events.empty());
+  ASSERT_NE(cpu.find(0x14), nullptr);
+  EXPECT_EQ(cpu.find(0x14)->state(), State::ConfirmSent);
+  EXPECT_EQ(cpu.find(0x14)->ignored_pdus(), 1u);
+  // The PG gets a second confirm after it is connected: dropped too.
+  MpiLink link;
+  link.connect();
+  const Bytes cc = {0xD0, 0x04, 0x00, 0x80, 0x00, 0x02, 0x00, 0x02, 0x01, 0x00, 0x01, 0x00};
+  EXPECT_EQ(link.pg.on_frame(0, Received{MpiLink::kCpu, 0x14, link.cpu_sap(), cc}, link.pg_out), FdlReply::Ack);
+  EXPECT_EQ(link.pg.state(), State::Connected);
+  EXPECT_EQ(link.pg.ignored_pdus(), 1u);
+  EXPECT_TRUE(link.pg_out.frames.empty());
+}
+
 TEST(MpiConnection, RepeatedDataIsAckedAgainButDeliveredOnce) {
   MpiLink link;
   link.connect();

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "pbvbus/fdl/telegram.hpp"
+#include "pbvbus/mpi/connection.hpp"
+#include "pbvbus/mpi/connection_pool.hpp"
 #include "pbvbus/mpi/pdu.hpp"
 
 namespace pbvbus::mpi {
@@ -123,6 +125,49 @@ TEST(MpiTraceFrames, SixOctetDataMessageTravelsAsSd3) {
   const Pdu p = unwrap(frame, t);
   EXPECT_EQ(t.type, fdl::FrameType::SD3);
   EXPECT_EQ(p.message_number, 5);
+}
+
+Bytes wrap_outgoing(std::uint8_t sa, std::uint8_t fc, const Outgoing& f) {
+  fdl::FrameSpec spec;
+  spec.da = f.peer;
+  spec.sa = sa;
+  spec.fc = fc;
+  spec.dsap = f.dsap;
+  spec.ssap = f.ssap;
+  spec.data = f.pdu.bytes();
+  fdl::Frame frame;
+  EXPECT_EQ(fdl::encode(spec, frame), fdl::EncodeError::None);
+  return Bytes(frame.bytes().begin(), frame.bytes().end());
+}
+
+TEST(MpiTraceFrames, TheCpuSideAnswersTheTracesRequestWithTheTracesConfirm) {
+  // The trace's connect request, as the CPU's FDL layer receives it, goes into a pool; the
+  // confirm it sends, wrapped with the trace's FC 6C, is the trace's confirm byte for byte.
+  fdl::Telegram t;
+  ASSERT_EQ(fdl::decode(kTraceConnectRequest, t), fdl::DecodeError::None);
+  ConnectionPool cpu;
+  Outbox out;
+  EXPECT_EQ(cpu.on_frame(0, Received{t.sa, *t.dsap, *t.ssap, t.data}, out), FdlReply::Ack);
+  ASSERT_EQ(out.frames.size(), 1u);
+  EXPECT_EQ(wrap_outgoing(kPlc, 0x6C, out.frames[0]), kTraceConnectConfirm);
+}
+
+TEST(MpiTraceFrames, ThePgSideSendsTheTracesRequestAndTakesTheTracesConfirm) {
+  Connection pg = Connection::initiator(kPlc, 0x14);
+  Outbox out;
+  ASSERT_EQ(pg.connect(0, out), RequestError::None);
+  ASSERT_EQ(out.frames.size(), 1u);
+  EXPECT_EQ(wrap_outgoing(kPg, 0x6D, out.frames[0]), kTraceConnectRequest);
+  pg.on_fdl_result(0, FdlResult::Delivered, out);
+  out.clear();
+  fdl::Telegram t;
+  ASSERT_EQ(fdl::decode(kTraceConnectConfirm, t), fdl::DecodeError::None);
+  EXPECT_EQ(pg.on_frame(0, Received{t.sa, *t.dsap, *t.ssap, t.data}, out), FdlReply::Ack);
+  EXPECT_EQ(pg.state(), State::AckSent);
+  ASSERT_EQ(out.frames.size(), 1u);
+  // Step 3 with the PG's next FC (5D), as worked out above.
+  EXPECT_EQ(wrap_outgoing(kPg, 0x5D, out.frames[0]),
+            (Bytes{0x68, 0x07, 0x07, 0x68, 0x82, 0x80, 0x5D, 0x14, 0x14, 0x05, 0x01, 0x8D, 0x16}));
 }
 
 }  // namespace

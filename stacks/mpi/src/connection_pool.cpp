@@ -35,7 +35,8 @@ const Connection* ConnectionPool::find(std::uint8_t local_sap) const {
 }
 
 std::optional<std::uint8_t> ConnectionPool::free_sap() const {
-  for (unsigned sap = config_.first_sap; sap <= kMaxSap; ++sap) {
+  // SAP 0 is the connection-management SAP of connect requests (§H.3), never a connection's.
+  for (unsigned sap = std::max<unsigned>(config_.first_sap, kConnectSap + 1u); sap <= kMaxSap; ++sap) {
     const bool used = std::any_of(slots_.begin(), slots_.end(),
                                   [&](const Connection& c) { return c.local_sap() == sap; });
     if (!used) return static_cast<std::uint8_t>(sap);

@@ -430,6 +430,18 @@ TEST(MpiConnection, FdlRepliesOfThePool) {
   EXPECT_EQ(cpu.disconnect(0, 0x33, out), RequestError::WrongState);
 }
 
+TEST(MpiConnection, ThePoolNeverGivesOutTheConnectSap) {
+  PoolConfig config;
+  config.first_sap = 0;
+  ConnectionPool cpu(config);
+  Connection pg = Connection::initiator(2, 0x14);
+  Outbox out;
+  pg.connect(0, out);
+  Outbox cpu_out;
+  ASSERT_EQ(cpu.on_frame(0, MpiLink::received(0, out.frames[0]), cpu_out), FdlReply::Ack);
+  EXPECT_EQ(cpu_out.frames[0].ssap, 1);
+}
+
 TEST(MpiConnection, RequestErrors) {
   Connection pg = Connection::initiator(2, 0x14);
   Outbox out;

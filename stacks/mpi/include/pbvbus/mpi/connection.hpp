@@ -134,13 +134,13 @@ class Connection {
   Role role_;
   State state_ = State::Closed;
   std::uint8_t peer_;
-  std::uint8_t local_sap_;
-  std::optional<std::uint8_t> peer_sap_;
+  std::uint8_t local_sap_;                ///< S4 `connectionNumber` on the PG side
+  std::optional<std::uint8_t> peer_sap_;  ///< S4 `connectionNumber2`: the confirm's SSAP
   ConnectionTiming timing_;
   ConnectParams params_ = kTraceConnectParams;
   std::optional<bus::Ticks> deadline_;
-  std::uint8_t tx_next_ = 0;
-  std::optional<std::uint8_t> tx_outstanding_;
+  std::uint8_t tx_next_ = 0;                     ///< S4 `messageNumber`
+  std::optional<std::uint8_t> tx_outstanding_;  ///< S4 `needAckNumber`
   std::optional<std::uint8_t> tx_last_acked_;
   std::optional<std::uint8_t> rx_last_;
   std::deque<Pending> unconfirmed_;

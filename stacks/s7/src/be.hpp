@@ -1,6 +1,6 @@
 #pragma once
 // Big-endian octet helpers: every multi-octet field of TPKT, COTP and S7 is big-endian
-// (RFC 1006 §6, protocol-facts.md §H.4).
+// (RFC 1006, protocol-facts.md §H.4).
 #include <cstddef>
 #include <cstdint>
 #include <span>

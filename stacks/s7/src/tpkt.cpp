@@ -1,4 +1,4 @@
-// TPKT framing and reassembly (RFC 1006 §6; tpkt.hpp).
+// TPKT framing and reassembly (RFC 1006; tpkt.hpp).
 #include "pbvbus/s7/tpkt.hpp"
 
 #include <algorithm>

@@ -32,6 +32,7 @@ struct Framing {
   std::vector<Bytes> tpkts;
   Error error = Error::None;
   std::size_t error_offset = 0;
+  bool over_bound = false;  ///< the reassembler held more than its bound
 };
 
 Framing frame(std::span<const std::uint8_t> stream, std::size_t chunk, std::size_t max) {
@@ -42,7 +43,7 @@ Framing frame(std::span<const std::uint8_t> stream, std::size_t chunk, std::size
     const auto piece = stream.subspan(at, std::min(chunk, stream.size() - at));
     const std::size_t n = r.feed(piece);
     at += n;
-    if (r.pending() > r.max_length()) f.error = Error::TpktLengthTooLarge;  // caught below
+    if (r.pending() > r.max_length()) f.over_bound = true;
     if (r.ready()) {
       f.tpkts.emplace_back(r.tpkt().begin(), r.tpkt().end());
       r.pop();
@@ -50,10 +51,8 @@ Framing frame(std::span<const std::uint8_t> stream, std::size_t chunk, std::size
       break;
     }
   }
-  if (f.error == Error::None) {
-    f.error = r.error();
-    f.error_offset = r.error_offset();
-  }
+  f.error = r.error();
+  f.error_offset = r.error_offset();
   return f;
 }
 
@@ -209,6 +208,7 @@ const char* iso_transport_oracle(std::span<const std::uint8_t> in) {
   const auto stream = in.subspan(1);
   const Framing whole = frame(stream, stream.size() + 1, max);
   const Framing chunked = frame(stream, chunk, max);
+  if (whole.over_bound || chunked.over_bound) return "reassembler held more than its bound";
   if (whole.tpkts != chunked.tpkts) return "chunking changed the TPKTs";
   if (whole.error != chunked.error || whole.error_offset != chunked.error_offset)
     return "chunking changed the error";

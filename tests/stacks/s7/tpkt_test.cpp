@@ -1,4 +1,4 @@
-// TPKT framing and the streaming reassembler (RFC 1006 §6; stacks/s7 tpkt.hpp).
+// TPKT framing and the streaming reassembler (RFC 1006; stacks/s7 tpkt.hpp).
 #include "pbvbus/s7/tpkt.hpp"
 
 #include <gtest/gtest.h>

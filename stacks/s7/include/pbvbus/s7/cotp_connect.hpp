@@ -27,7 +27,8 @@ inline constexpr std::uint8_t kParamCallingTsap = 0xC1;
 inline constexpr std::uint8_t kParamCalledTsap = 0xC2;
 inline constexpr std::uint8_t kTpduSizeMinCode = 0x07;  ///< 128 octets
 inline constexpr std::uint8_t kTpduSizeMaxCode = 0x0D;  ///< 8192 octets
-/// Class 0 allows TPDUs up to 2048 octets (ISO 8073 §14.6): the most a server confirms.
+/// Class 0 allows TPDUs up to 2048 octets (ISO 8073 class 0 rules; not in the reference notes,
+/// docs/s7.md): the most a server confirms.
 inline constexpr std::uint8_t kTpduSizeClass0MaxCode = 0x0B;
 inline constexpr std::size_t kMaxTsapLength = 32;
 

@@ -12,7 +12,7 @@ namespace pbvbus::s7 {
 
 enum class Error : std::uint8_t {
   None,
-  // TPKT (RFC 1006 §6)
+  // TPKT (RFC 1006)
   TpktBadVersion,       ///< octet 0 is not 3
   TpktLengthTooSmall,   ///< length field below 7 (header plus the smallest COTP TPDU)
   TpktLengthTooLarge,   ///< length field above the negotiated maximum

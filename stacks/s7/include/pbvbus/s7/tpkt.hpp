@@ -1,5 +1,5 @@
 #pragma once
-// TPKT framing, RFC 1006 §6 (tools-and-formats.md §3.4): `03 00 LL LL` then the COTP TPDU, LL
+// TPKT framing, RFC 1006 (tools-and-formats.md §3.4): `03 00 LL LL` then the COTP TPDU, LL
 // the total length including these 4 octets. TCP delivers a byte stream, so a door feeds
 // whatever recv() returned into a TpktReassembler and takes whole TPKTs out of it.
 //

@@ -2,7 +2,8 @@
 // (RFC 1006) over any byte stream and chunking, and the COTP CR/CC/DT/DR/DC/ER decoders on every
 // TPDU it yields. Octet 0 picks the chunk size and the reassembler bound, the rest is the stream.
 // Any broken invariant traps; the oracle is tests/stacks/s7/s7_oracle_helpers.cpp.
-//   build-fuzz/bin/fuzz_iso_transport -max_total_time=60 <scratch dir> tests/fuzz/corpus/iso_transport
+//   build-fuzz/bin/fuzz_iso_transport -max_total_time=60 <scratch dir>
+//   tests/fuzz/corpus/iso_transport
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>

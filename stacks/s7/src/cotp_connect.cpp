@@ -82,8 +82,8 @@ Error append_connect(std::vector<std::uint8_t>& out, const ConnectTpdu& t) {
     out.push_back(1);
     out.push_back(t.tpdu_size_code);
   }
-  for (const auto& [p, v] : {std::pair{kParamCallingTsap, t.calling_tsap},
-                             std::pair{kParamCalledTsap, t.called_tsap}}) {
+  for (const auto& [p, v] :
+       {std::pair{kParamCallingTsap, t.calling_tsap}, std::pair{kParamCalledTsap, t.called_tsap}}) {
     if (v.empty()) continue;
     out.push_back(p);
     out.push_back(static_cast<std::uint8_t>(v.size()));

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "be.hpp"
+
 #include "pbvbus/s7/cotp.hpp"
 
 namespace pbvbus::s7 {
@@ -76,7 +77,8 @@ void append_error_tpdu(std::vector<std::uint8_t>& out, std::uint16_t dst_ref, st
   if (n > 0) {
     out.push_back(kParamInvalidTpdu);
     out.push_back(static_cast<std::uint8_t>(n));
-    out.insert(out.end(), invalid_tpdu.begin(), invalid_tpdu.begin() + static_cast<std::ptrdiff_t>(n));
+    out.insert(out.end(), invalid_tpdu.begin(),
+               invalid_tpdu.begin() + static_cast<std::ptrdiff_t>(n));
   }
 }
 

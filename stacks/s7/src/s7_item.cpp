@@ -39,28 +39,37 @@ std::size_t element_size(std::uint8_t transport_size) {
   switch (transport_size) {
     case transport::kBit:
     case transport::kByte:
-    case transport::kChar: return 1;
+    case transport::kChar:
+      return 1;
     case transport::kWord:
     case transport::kInt:
     case transport::kCounter:
-    case transport::kTimer: return 2;
+    case transport::kTimer:
+      return 2;
     case transport::kDWord:
     case transport::kDInt:
-    case transport::kReal: return 4;
-    default: return 0;
+    case transport::kReal:
+      return 4;
+    default:
+      return 0;
   }
 }
 
 std::uint8_t data_transport_for(std::uint8_t transport_size) {
   switch (transport_size) {
-    case transport::kBit: return data_transport::kBit;
+    case transport::kBit:
+      return data_transport::kBit;
     case transport::kInt:
-    case transport::kDInt: return data_transport::kInteger;
-    case transport::kReal: return data_transport::kReal;
+    case transport::kDInt:
+      return data_transport::kInteger;
+    case transport::kReal:
+      return data_transport::kReal;
     case transport::kChar:
     case transport::kCounter:
-    case transport::kTimer: return data_transport::kOctetString;
-    default: return data_transport::kByte;
+    case transport::kTimer:
+      return data_transport::kOctetString;
+    default:
+      return data_transport::kByte;
   }
 }
 
@@ -72,11 +81,14 @@ Unit unit_of(std::uint8_t data_transport_size) {
   switch (data_transport_size) {
     case data_transport::kBit:
     case data_transport::kByte:
-    case data_transport::kInteger: return Unit::Bits;
+    case data_transport::kInteger:
+      return Unit::Bits;
     case data_transport::kDInteger:
     case data_transport::kReal:
-    case data_transport::kOctetString: return Unit::Octets;
-    default: return Unit::Unknown;
+    case data_transport::kOctetString:
+      return Unit::Octets;
+    default:
+      return Unit::Unknown;
   }
 }
 
@@ -84,9 +96,12 @@ Unit unit_of(std::uint8_t data_transport_size) {
 
 Decoded<std::size_t> data_octets(std::uint8_t data_transport_size, std::uint16_t length) {
   switch (unit_of(data_transport_size)) {
-    case Unit::Bits: return {(std::size_t{length} + 7) / 8};
-    case Unit::Octets: return {length};
-    case Unit::Unknown: break;
+    case Unit::Bits:
+      return {(std::size_t{length} + 7) / 8};
+    case Unit::Octets:
+      return {length};
+    case Unit::Unknown:
+      break;
   }
   return {0, Error::S7BadDataTransportSize, 0};
 }

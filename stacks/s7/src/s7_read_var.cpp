@@ -57,8 +57,8 @@ Encoded encode_read_var_response(std::uint16_t pdu_ref, std::span<const ReadVarR
   std::vector<std::uint8_t> data;
   for (std::size_t i = 0; i < items.size(); ++i) {
     const auto& it = items[i];
-    const Error e =
-        append_data_item(data, it.return_code, it.transport_size, it.data, i + 1 < items.size(), true);
+    const Error e = append_data_item(data, it.return_code, it.transport_size, it.data,
+                                     i + 1 < items.size(), true);
     if (e != Error::None) return {{}, e, i};
   }
   return encode_s7_pdu(S7Header{kS7AckData, pdu_ref, 0, 0}, params, data);

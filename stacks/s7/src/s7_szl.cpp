@@ -18,9 +18,11 @@ Decoded<UserdataParams> szl_params(const S7Pdu& pdu, std::uint8_t method, std::u
   auto u = decode_userdata_params(pdu);
   if (!u.ok()) return u;
   const std::size_t base = params_offset(pdu);
-  if (u.value.method != method || u.value.type != type) return {{}, Error::S7UnexpectedUserdata, base + 4};
+  if (u.value.method != method || u.value.type != type)
+    return {{}, Error::S7UnexpectedUserdata, base + 4};
   if (u.value.group != kUserdataGroupCpu) return {{}, Error::S7UnexpectedUserdata, base + 5};
-  if (u.value.subfunction != kSubfunctionReadSzl) return {{}, Error::S7UnexpectedUserdata, base + 6};
+  if (u.value.subfunction != kSubfunctionReadSzl)
+    return {{}, Error::S7UnexpectedUserdata, base + 6};
   return u;
 }
 

@@ -35,7 +35,8 @@ Decoded<std::vector<std::uint8_t>> decode_write_var_response(const S7Pdu& pdu) {
   if (p.size() != 2) return {{}, Error::S7BadParameterLength, 6};
   if (p[0] != kFnWriteVar) return {{}, Error::S7UnexpectedFunction, base};
   if (p[1] == 0) return {{}, Error::S7NoItems, base + 1};
-  if (pdu.data.size() < p[1]) return {{}, Error::S7DataTruncated, data_offset(pdu) + pdu.data.size()};
+  if (pdu.data.size() < p[1])
+    return {{}, Error::S7DataTruncated, data_offset(pdu) + pdu.data.size()};
   if (pdu.data.size() > p[1]) return {{}, Error::S7TrailingData, data_offset(pdu) + p[1]};
   return {std::vector<std::uint8_t>(pdu.data.begin(), pdu.data.end())};
 }

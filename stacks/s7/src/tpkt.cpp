@@ -18,7 +18,9 @@ Error append_tpkt(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> 
   return Error::None;
 }
 
-TpktReassembler::TpktReassembler(std::size_t max_length) { set_max_length(max_length); }
+TpktReassembler::TpktReassembler(std::size_t max_length) {
+  set_max_length(max_length);
+}
 
 void TpktReassembler::set_max_length(std::size_t max_length) {
   max_ = std::clamp(max_length, kTpktMinLength, kTpktMaxLength);

@@ -1,8 +1,10 @@
 // COTP class 0 CR/CC/DT/DR/DC/ER (ISO 8073; tools-and-formats.md §3.2, §3.4; stacks/s7).
+#include "pbvbus/s7/cotp.hpp"
+
 #include <gtest/gtest.h>
 
 #include "hex.hpp"
-#include "pbvbus/s7/cotp.hpp"
+
 #include "pbvbus/s7/cotp_connect.hpp"
 #include "pbvbus/s7/cotp_data.hpp"
 #include "pbvbus/s7/cotp_disconnect.hpp"
@@ -15,7 +17,9 @@ namespace {
 using test::hex;
 using Bytes = std::vector<std::uint8_t>;
 
-Bytes bytes(std::span<const std::uint8_t> s) { return Bytes(s.begin(), s.end()); }
+Bytes bytes(std::span<const std::uint8_t> s) {
+  return Bytes(s.begin(), s.end());
+}
 
 // The CC a server sends for a CR, TPKT included.
 Bytes cc_for(const Bytes& cr_tpdu, std::uint16_t own_ref = 1) {
@@ -128,7 +132,8 @@ TEST(CotpConnect, EveryDecodeErrorIsNamedWithItsOffset) {
       {"LI 0", "00 E0", Error::CotpBadLengthIndicator, 0},
       {"LI 255", "FF E0 00", Error::CotpBadLengthIndicator, 0},
       {"LI past the end", "11 E0 00 00 00 01 00 C0 01 0A", Error::CotpBadLengthIndicator, 0},
-      {"a CC", "11 D0 00 00 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02", Error::CotpUnexpectedType, 1},
+      {"a CC", "11 D0 00 00 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02", Error::CotpUnexpectedType,
+       1},
       {"a DT", "02 F0 80", Error::CotpUnexpectedType, 1},
       {"fixed part short", "05 E0 00 00 00 01", Error::CotpBadLengthIndicator, 0},
       {"parameter code only", "07 E0 00 00 00 01 00 C1", Error::CotpParameterTruncated, 7},
@@ -137,7 +142,8 @@ TEST(CotpConnect, EveryDecodeErrorIsNamedWithItsOffset) {
       {"size code 6", "09 E0 00 00 00 01 00 C0 01 06", Error::CotpBadTpduSize, 9},
       {"size code 14", "09 E0 00 00 00 01 00 C0 01 0E", Error::CotpBadTpduSize, 9},
       {"size twice", "0C E0 00 00 00 01 00 C0 01 0A C0 01 0A", Error::CotpDuplicateParameter, 10},
-      {"calling twice", "0E E0 00 00 00 01 00 C1 02 01 00 C1 02 01 00", Error::CotpDuplicateParameter, 11},
+      {"calling twice", "0E E0 00 00 00 01 00 C1 02 01 00 C1 02 01 00",
+       Error::CotpDuplicateParameter, 11},
       {"empty TSAP", "08 E0 00 00 00 01 00 C2 00", Error::CotpBadParameterLength, 8},
       {"no called TSAP", "0D E0 00 00 00 01 00 C0 01 0A C1 02 01 00", Error::CotpMissingTsap, 14},
       {"no calling TSAP", "0D E0 00 00 00 01 00 C0 01 0A C2 02 01 02", Error::CotpMissingTsap, 14},
@@ -207,7 +213,8 @@ TEST(CotpData, TpktDataFramesOneS7Pdu) {
   const auto pdu = hex("32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0");
   const auto f = encode_tpkt_data(pdu);
   ASSERT_TRUE(f.ok());
-  EXPECT_EQ(f.value, hex("03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0"));
+  EXPECT_EQ(f.value,
+            hex("03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0"));
   Bytes dt;
   append_data(dt, pdu, false);
   EXPECT_EQ(dt[2], 0x00);

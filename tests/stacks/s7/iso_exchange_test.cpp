@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "hex.hpp"
+
 #include "pbvbus/s7/cotp.hpp"
 #include "pbvbus/s7/cotp_connect.hpp"
 #include "pbvbus/s7/cotp_data.hpp"
@@ -22,10 +23,10 @@ const Bytes kClient = hex(
     "03 00 00 16 11 E0 00 00 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02"
     "03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0"
     "03 00 00 1F 02 F0 80 32 01 00 00 00 01 00 0E 00 00 04 01 12 0A 10 02 00 04 00 01 84 00 00 00");
-const Bytes kServer = hex(
-    "03 00 00 16 11 D0 00 01 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02"
-    "03 00 00 1B 02 F0 80 32 03 00 00 00 00 00 08 00 00 00 00 F0 00 00 01 00 01 00 F0"
-    "03 00 00 1D 02 F0 80 32 03 00 00 00 01 00 02 00 08 00 00 04 01 FF 04 00 20 DE AD BE EF");
+const Bytes kServer =
+    hex("03 00 00 16 11 D0 00 01 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02"
+        "03 00 00 1B 02 F0 80 32 03 00 00 00 00 00 08 00 00 00 00 F0 00 00 01 00 01 00 F0"
+        "03 00 00 1D 02 F0 80 32 03 00 00 00 01 00 02 00 08 00 00 04 01 FF 04 00 20 DE AD BE EF");
 
 // A toy CPU in slot 2 with DB1 = DE AD BE EF and PDU size 240: just enough server to answer.
 class ToyServer {

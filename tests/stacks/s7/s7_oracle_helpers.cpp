@@ -95,7 +95,8 @@ const char* check_tpdu(std::span<const std::uint8_t> tpdu) {
       else
         append_disconnect_confirm(out, d.value.dst_ref, d.value.src_ref);
       const auto back = decode_disconnect(out);
-      if (!back.ok() || back.value.dst_ref != d.value.dst_ref || back.value.reason != d.value.reason)
+      if (!back.ok() || back.value.dst_ref != d.value.dst_ref ||
+          back.value.reason != d.value.reason)
         return "DR/DC does not round-trip";
       return nullptr;
     }
@@ -110,7 +111,8 @@ const char* check_tpdu(std::span<const std::uint8_t> tpdu) {
         return "ER does not round-trip";
       return nullptr;
     }
-    default: return nullptr;
+    default:
+      return nullptr;
   }
 }
 
@@ -134,12 +136,15 @@ const char* check_read_var(const S7Pdu& pdu) {
       results.push_back({it.return_code, it.transport_size, it.data});
     }
     const auto again = encode_read_var_response(pdu.header.pdu_ref, results);
-    if (!again.ok()) return documented_item_refusal(again.error) ? nullptr : "Read Var response refused";
+    if (!again.ok())
+      return documented_item_refusal(again.error) ? nullptr : "Read Var response refused";
     const auto d = decode_s7_pdu(again.value);
     const auto back = d.ok() ? decode_read_var_response(d.value) : decltype(r){};
-    if (!back.ok() || back.value.size() != r.value.size()) return "Read Var response does not round-trip";
+    if (!back.ok() || back.value.size() != r.value.size())
+      return "Read Var response does not round-trip";
     for (std::size_t i = 0; i < r.value.size(); ++i) {
-      if (back.value[i].return_code != r.value[i].return_code || !same(back.value[i].data, r.value[i].data))
+      if (back.value[i].return_code != r.value[i].return_code ||
+          !same(back.value[i].data, r.value[i].data))
         return "Read Var response item changed";
     }
   }
@@ -155,12 +160,15 @@ const char* check_write_var(const S7Pdu& pdu) {
       items.push_back({r.value.items[i], r.value.values[i].transport_size, r.value.values[i].data});
     }
     const auto again = encode_write_var_request(pdu.header.pdu_ref, items);
-    if (!again.ok()) return documented_item_refusal(again.error) ? nullptr : "Write Var request refused";
+    if (!again.ok())
+      return documented_item_refusal(again.error) ? nullptr : "Write Var request refused";
     const auto d = decode_s7_pdu(again.value);
     const auto back = d.ok() ? decode_write_var_request(d.value) : decltype(r){};
-    if (!back.ok() || back.value.items != r.value.items) return "Write Var request does not round-trip";
+    if (!back.ok() || back.value.items != r.value.items)
+      return "Write Var request does not round-trip";
     for (std::size_t i = 0; i < items.size(); ++i)
-      if (!same(back.value.values[i].data, r.value.values[i].data)) return "Write Var value changed";
+      if (!same(back.value.values[i].data, r.value.values[i].data))
+        return "Write Var value changed";
   }
   if (const auto r = decode_write_var_response(pdu); r.ok()) {
     const auto again = encode_write_var_response(pdu.header.pdu_ref, r.value);
@@ -185,8 +193,8 @@ const char* check_userdata(const S7Pdu& pdu) {
   }
   if (const auto r = decode_szl_response(pdu); r.ok()) {
     if (!inside(r.value.records, pdu.data)) return "SZL records outside the data block";
-    const bool whole = r.value.records.size() ==
-                       std::size_t{r.value.record_length} * r.value.record_count;
+    const bool whole =
+        r.value.records.size() == std::size_t{r.value.record_length} * r.value.record_count;
     if (r.value.error_code == 0 && !whole) return nullptr;  // a part of a list: not re-encodable
     const auto again = encode_szl_response(pdu.header.pdu_ref, r.value);
     if (!again.ok()) return "SZL response refused";

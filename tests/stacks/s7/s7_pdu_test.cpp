@@ -82,7 +82,8 @@ TEST(S7Pdu, EveryDecodeError) {
 TEST(S7Pdu, EveryErrorHasItsOwnText) {
   for (int i = 0; i <= static_cast<int>(Error::S7BadSzlResponse); ++i) {
     for (int j = 0; j < i; ++j) {
-      EXPECT_NE(to_string(static_cast<Error>(i)), to_string(static_cast<Error>(j))) << i << " " << j;
+      EXPECT_NE(to_string(static_cast<Error>(i)), to_string(static_cast<Error>(j)))
+          << i << " " << j;
     }
     EXPECT_NE(to_string(static_cast<Error>(i)), "unknown error") << i;
   }

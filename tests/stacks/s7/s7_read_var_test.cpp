@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "hex.hpp"
+
 #include "pbvbus/s7/cotp_data.hpp"
 
 namespace pbvbus::s7 {
@@ -12,10 +13,14 @@ namespace {
 using test::hex;
 using Bytes = std::vector<std::uint8_t>;
 
-Bytes bytes(std::span<const std::uint8_t> s) { return Bytes(s.begin(), s.end()); }
+Bytes bytes(std::span<const std::uint8_t> s) {
+  return Bytes(s.begin(), s.end());
+}
 
 // The S7 PDU inside a TPKT + DT frame.
-Bytes s7_of(const Bytes& frame) { return Bytes(frame.begin() + 7, frame.end()); }
+Bytes s7_of(const Bytes& frame) {
+  return Bytes(frame.begin() + 7, frame.end());
+}
 
 Decoded<std::vector<VarItem>> request_of(const Bytes& pdu) {
   const auto d = decode_s7_pdu(pdu);
@@ -32,8 +37,8 @@ Decoded<std::vector<DataItem>> response_of(const Bytes& pdu) {
 // §3.4: nodes7 merged DB1,B0.4 and DB1,INT2 into one read of 4 bytes.
 const Bytes kNodes7Read = hex(
     "03 00 00 1F 02 F0 80 32 01 00 00 00 01 00 0E 00 00 04 01 12 0A 10 02 00 04 00 01 84 00 00 00");
-const Bytes kNodes7Answer = hex(
-    "03 00 00 1D 02 F0 80 32 03 00 00 00 01 00 02 00 08 00 00 04 01 FF 04 00 20 DE AD BE EF");
+const Bytes kNodes7Answer =
+    hex("03 00 00 1D 02 F0 80 32 03 00 00 00 01 00 02 00 08 00 00 04 01 FF 04 00 20 DE AD BE EF");
 
 TEST(S7ReadVar, Nodes7RequestDecodes) {
   const auto r = request_of(s7_of(kNodes7Read));
@@ -64,7 +69,8 @@ TEST(S7ReadVar, Db1Dbw0RequestAndAnswer) {
   const VarItem dbw0{transport::kWord, 1, 1, area::kDataBlock, 0};
   const auto job = encode_read_var_request(2, std::span(&dbw0, 1));
   ASSERT_TRUE(job.ok());
-  EXPECT_EQ(job.value, hex("32 01 00 00 00 02 00 0E 00 00 | 04 01 | 12 0A 10 04 00 01 00 01 84 00 00 00"));
+  EXPECT_EQ(job.value,
+            hex("32 01 00 00 00 02 00 0E 00 00 | 04 01 | 12 0A 10 04 00 01 00 01 84 00 00 00"));
   EXPECT_EQ(element_size(dbw0.transport_size) * dbw0.count, 2u);
   EXPECT_EQ(data_transport_for(dbw0.transport_size), data_transport::kByte);
 
@@ -73,8 +79,9 @@ TEST(S7ReadVar, Db1Dbw0RequestAndAnswer) {
   const auto ack = encode_read_var_response(2, std::span(&ok, 1));
   ASSERT_TRUE(ack.ok());
   EXPECT_EQ(ack.value, hex("32 03 00 00 00 02 00 02 00 06 00 00 | 04 01 | FF 04 00 10 12 34"));
-  EXPECT_EQ(encode_tpkt_data(ack.value).value,
-            hex("03 00 00 1B 02 F0 80 32 03 00 00 00 02 00 02 00 06 00 00 04 01 FF 04 00 10 12 34"));
+  EXPECT_EQ(
+      encode_tpkt_data(ack.value).value,
+      hex("03 00 00 1B 02 F0 80 32 03 00 00 00 02 00 02 00 06 00 00 04 01 FF 04 00 10 12 34"));
 }
 
 // protocol-facts.md §H.4 "Example read, DB1.DBB0, 10 bytes".
@@ -86,7 +93,8 @@ TEST(S7ReadVar, ProtocolFactsTenByteExample) {
   const Bytes ten = hex("00 01 02 03 04 05 06 07 08 09");
   const ReadVarResult res{return_code::kSuccess, data_transport::kByte, ten};
   const auto ack = encode_read_var_response(1, std::span(&res, 1));
-  EXPECT_EQ(ack.value, hex("32 03 00 00 00 01 00 02 00 0E 00 00 | 04 01 | FF 04 00 50 00 01 02 03 04 05 06 07 08 09"));
+  EXPECT_EQ(ack.value, hex("32 03 00 00 00 01 00 02 00 0E 00 00 | 04 01 | FF 04 00 50 00 01 02 03 "
+                           "04 05 06 07 08 09"));
 }
 
 // Several items: a bit (M10.3), a byte (MB5), a missing DB, an address out of range and a bad
@@ -136,15 +144,18 @@ TEST(S7ReadVar, LastOddItemHasNoFillOctet) {
   const ReadVarResult results[] = {{return_code::kSuccess, data_transport::kByte, a},
                                    {return_code::kSuccess, data_transport::kByte, b}};
   const auto ack = encode_read_var_response(3, results);
-  EXPECT_EQ(ack.value, hex("32 03 00 00 00 03 00 02 00 0B 00 00 | 04 02 | FF 04 00 10 11 22 | FF 04 00 08 33"));
+  EXPECT_EQ(
+      ack.value,
+      hex("32 03 00 00 00 03 00 02 00 0B 00 00 | 04 02 | FF 04 00 10 11 22 | FF 04 00 08 33"));
 }
 
 TEST(S7ReadVar, LengthUnitsFollowTheDataTransportSize) {
   // REAL and OCTET STRING count octets, INTEGER counts bits; a snap7-style failed item with a
   // length of 4 and no data decodes too.
-  const auto pdu = hex("32 03 00 00 00 04 00 02 00 18 00 00 | 04 04 |"
-                       "FF 07 00 04 41 20 00 00 | FF 05 00 10 00 2A | FF 09 00 02 00 05 |"
-                       "0A 00 00 04");
+  const auto pdu =
+      hex("32 03 00 00 00 04 00 02 00 18 00 00 | 04 04 |"
+          "FF 07 00 04 41 20 00 00 | FF 05 00 10 00 2A | FF 09 00 02 00 05 |"
+          "0A 00 00 04");
   const auto d = response_of(pdu);
   ASSERT_TRUE(d.ok()) << to_string(d.error) << " at " << d.at;
   EXPECT_EQ(bytes(d.value[0].data), hex("41 20 00 00"));
@@ -188,13 +199,19 @@ TEST(S7ReadVar, EveryRequestDecodeError) {
   const Bad cases[] = {
       {"32 03 00 00 00 01 00 02 00 00 00 00 | 04 01", Error::S7WrongPduType, 1},
       {"32 01 00 00 00 01 00 01 00 00 | 04", Error::S7BadParameterLength, 6},
-      {"32 01 00 00 00 01 00 0E 00 00 | 05 01 12 0A 10 02 00 04 00 01 84 00 00 00", Error::S7UnexpectedFunction, 10},
+      {"32 01 00 00 00 01 00 0E 00 00 | 05 01 12 0A 10 02 00 04 00 01 84 00 00 00",
+       Error::S7UnexpectedFunction, 10},
       {"32 01 00 00 00 01 00 02 00 00 | 04 00", Error::S7NoItems, 11},
-      {"32 01 00 00 00 01 00 0E 00 00 | 04 02 12 0A 10 02 00 04 00 01 84 00 00 00", Error::S7BadParameterLength, 6},
-      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 11 0A 10 02 00 04 00 01 84 00 00 00", Error::S7BadItemHeader, 12},
-      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 12 0A B2 02 00 04 00 01 84 00 00 00", Error::S7UnsupportedSyntaxId, 14},
-      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 12 0B 10 02 00 04 00 01 84 00 00 00", Error::S7BadItemLength, 13},
-      {"32 01 00 00 00 01 00 0E 00 01 | 04 01 12 0A 10 02 00 04 00 01 84 00 00 00 | 00", Error::S7UnexpectedData, 24},
+      {"32 01 00 00 00 01 00 0E 00 00 | 04 02 12 0A 10 02 00 04 00 01 84 00 00 00",
+       Error::S7BadParameterLength, 6},
+      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 11 0A 10 02 00 04 00 01 84 00 00 00",
+       Error::S7BadItemHeader, 12},
+      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 12 0A B2 02 00 04 00 01 84 00 00 00",
+       Error::S7UnsupportedSyntaxId, 14},
+      {"32 01 00 00 00 01 00 0E 00 00 | 04 01 12 0B 10 02 00 04 00 01 84 00 00 00",
+       Error::S7BadItemLength, 13},
+      {"32 01 00 00 00 01 00 0E 00 01 | 04 01 12 0A 10 02 00 04 00 01 84 00 00 00 | 00",
+       Error::S7UnexpectedData, 24},
   };
   for (const auto& c : cases) {
     const auto r = request_of(hex(c.octets));
@@ -212,8 +229,10 @@ TEST(S7ReadVar, EveryResponseDecodeError) {
       {"32 03 00 00 00 01 00 02 00 03 00 00 | 04 01 | FF 04 00", Error::S7DataTruncated, 14},
       {"32 03 00 00 00 01 00 02 00 05 00 00 | 04 01 | FF 04 00 10 12", Error::S7DataTruncated, 16},
       {"32 03 00 00 00 01 00 02 00 05 00 00 | 04 02 | FF 04 00 08 12", Error::S7DataTruncated, 19},
-      {"32 03 00 00 00 01 00 02 00 06 00 00 | 04 01 | FF 04 00 08 12 00", Error::S7TrailingData, 19},
-      {"32 03 00 00 00 01 00 02 00 05 00 00 | 04 01 | FF 08 00 04 12", Error::S7BadDataTransportSize, 15},
+      {"32 03 00 00 00 01 00 02 00 06 00 00 | 04 01 | FF 04 00 08 12 00", Error::S7TrailingData,
+       19},
+      {"32 03 00 00 00 01 00 02 00 05 00 00 | 04 01 | FF 08 00 04 12",
+       Error::S7BadDataTransportSize, 15},
   };
   for (const auto& c : cases) {
     const auto r = response_of(hex(c.octets));

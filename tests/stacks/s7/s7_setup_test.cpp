@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "hex.hpp"
+
 #include "pbvbus/s7/cotp_data.hpp"
 
 namespace pbvbus::s7 {
@@ -19,7 +20,8 @@ Decoded<SetupCommunication> setup_of(const std::vector<std::uint8_t>& pdu) {
 
 // §3.4: "Setup comm req : 03 00 00 19 02 F0 80 32 01 ... F0 00 00 01 00 01 01 E0"
 TEST(S7Setup, ReferenceRequestDecodesAndEncodes) {
-  const auto frame = hex("03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0");
+  const auto frame =
+      hex("03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0");
   const auto s = setup_of(std::vector<std::uint8_t>(frame.begin() + 7, frame.end()));
   ASSERT_TRUE(s.ok()) << to_string(s.error);
   EXPECT_EQ(s.value, (SetupCommunication{1, 1, 480}));
@@ -36,8 +38,9 @@ TEST(S7Setup, ServerAnswersTheLowerPduLength) {
   EXPECT_EQ(answer, (SetupCommunication{1, 1, 240}));
   const auto pdu = encode_setup_communication_response(0, answer);
   ASSERT_TRUE(pdu.ok());
-  EXPECT_EQ(encode_tpkt_data(pdu.value).value,
-            hex("03 00 00 1B 02 F0 80 32 03 00 00 00 00 00 08 00 00 00 00 F0 00 00 01 00 01 00 F0"));
+  EXPECT_EQ(
+      encode_tpkt_data(pdu.value).value,
+      hex("03 00 00 1B 02 F0 80 32 03 00 00 00 00 00 08 00 00 00 00 F0 00 00 01 00 01 00 F0"));
   const auto back = setup_of(pdu.value);
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back.value, answer);

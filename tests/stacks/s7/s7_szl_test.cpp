@@ -28,7 +28,9 @@ Decoded<SzlResponse> response_of(const Bytes& pdu) {
 TEST(S7Szl, RequestLayout) {
   const auto pdu = encode_szl_request(5, SzlRequest{0, 0x0011, 0x0000});
   ASSERT_TRUE(pdu.ok());
-  EXPECT_EQ(pdu.value, hex("32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00"));
+  EXPECT_EQ(
+      pdu.value,
+      hex("32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00"));
   const auto r = request_of(pdu.value);
   ASSERT_TRUE(r.ok()) << to_string(r.error);
   EXPECT_EQ(r.value, (SzlRequest{0, 0x0011, 0x0000}));
@@ -65,7 +67,9 @@ TEST(S7Szl, NotAvailableAnswer) {
   r.error_code = kSzlNotAvailable;
   const auto pdu = encode_szl_response(6, r);
   ASSERT_TRUE(pdu.ok());
-  EXPECT_EQ(pdu.value, hex("32 07 00 00 00 06 00 0C 00 04 | 00 01 12 08 12 84 01 00 00 00 D4 02 | 0A 00 00 00"));
+  EXPECT_EQ(
+      pdu.value,
+      hex("32 07 00 00 00 06 00 0C 00 04 | 00 01 12 08 12 84 01 00 00 00 D4 02 | 0A 00 00 00"));
   const auto back = response_of(pdu.value);
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back.value.error_code, kSzlNotAvailable);
@@ -73,8 +77,15 @@ TEST(S7Szl, NotAvailableAnswer) {
 }
 
 TEST(S7Szl, UserdataParamsRoundTrip) {
-  const UserdataParams u{kUserdataMethodResponse, kUserdataTypeResponse, kUserdataGroupCpu,
-                         kSubfunctionReadSzl, 9, true, 1, kLastDataUnitNo, 0x1234};
+  const UserdataParams u{kUserdataMethodResponse,
+                         kUserdataTypeResponse,
+                         kUserdataGroupCpu,
+                         kSubfunctionReadSzl,
+                         9,
+                         true,
+                         1,
+                         kLastDataUnitNo,
+                         0x1234};
   Bytes params;
   append_userdata_params(params, u);
   EXPECT_EQ(params, hex("00 01 12 08 12 84 01 09 01 01 12 34"));
@@ -88,8 +99,9 @@ TEST(S7Szl, UserdataParamsRoundTrip) {
 
 // A list split into data units: a middle unit carries part of the records.
 TEST(S7Szl, PartOfAListInOneDataUnitDecodes) {
-  const auto pdu = hex("32 07 00 00 00 05 00 0C 00 10 | 00 01 12 08 12 84 01 03 00 01 00 00 |"
-                       "FF 09 00 0C 00 11 00 00 00 04 00 03 AA BB CC DD");
+  const auto pdu =
+      hex("32 07 00 00 00 05 00 0C 00 10 | 00 01 12 08 12 84 01 03 00 01 00 00 |"
+          "FF 09 00 0C 00 11 00 00 00 04 00 03 AA BB CC DD");
   const auto r = response_of(pdu);
   ASSERT_TRUE(r.ok()) << to_string(r.error);
   EXPECT_EQ(r.value.records.size(), 4u);
@@ -104,18 +116,27 @@ struct Bad {
 
 TEST(S7Szl, EveryRequestDecodeError) {
   const Bad cases[] = {
-      {"32 01 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00", Error::S7WrongPduType, 1},
+      {"32 01 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00",
+       Error::S7WrongPduType, 1},
       {"32 07 00 00 00 05 00 03 00 00 | 00 01 12", Error::S7BadUserdataLength, 6},
       {"32 07 00 00 00 05 00 08 00 00 | 00 01 13 04 11 44 01 00", Error::S7BadUserdataHead, 10},
       {"32 07 00 00 00 05 00 08 00 00 | 00 01 12 05 11 44 01 00", Error::S7BadUserdataLength, 13},
-      {"32 07 00 00 00 05 00 0C 00 00 | 00 01 12 04 11 44 01 00 00 00 00 00", Error::S7BadUserdataLength, 13},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 12 44 01 00 | FF 09 00 04 00 11 00 00", Error::S7UnexpectedUserdata, 14},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 43 01 00 | FF 09 00 04 00 11 00 00", Error::S7UnexpectedUserdata, 15},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 02 00 | FF 09 00 04 00 11 00 00", Error::S7UnexpectedUserdata, 16},
-      {"32 07 00 00 00 05 00 08 00 06 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11", Error::S7BadSzlRequest, 8},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | 0A 09 00 04 00 11 00 00", Error::S7BadSzlRequest, 18},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 04 00 04 00 11 00 00", Error::S7BadSzlRequest, 19},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 05 00 11 00 00", Error::S7BadSzlRequest, 20},
+      {"32 07 00 00 00 05 00 0C 00 00 | 00 01 12 04 11 44 01 00 00 00 00 00",
+       Error::S7BadUserdataLength, 13},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 12 44 01 00 | FF 09 00 04 00 11 00 00",
+       Error::S7UnexpectedUserdata, 14},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 43 01 00 | FF 09 00 04 00 11 00 00",
+       Error::S7UnexpectedUserdata, 15},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 02 00 | FF 09 00 04 00 11 00 00",
+       Error::S7UnexpectedUserdata, 16},
+      {"32 07 00 00 00 05 00 08 00 06 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11",
+       Error::S7BadSzlRequest, 8},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | 0A 09 00 04 00 11 00 00",
+       Error::S7BadSzlRequest, 18},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 04 00 04 00 11 00 00",
+       Error::S7BadSzlRequest, 19},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 05 00 11 00 00",
+       Error::S7BadSzlRequest, 20},
   };
   for (const auto& c : cases) {
     const auto r = request_of(hex(c.octets));
@@ -126,14 +147,26 @@ TEST(S7Szl, EveryRequestDecodeError) {
 
 TEST(S7Szl, EveryResponseDecodeError) {
   const Bad cases[] = {
-      {"32 07 00 00 00 05 00 0C 00 03 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00", Error::S7BadSzlResponse, 8},
-      {"32 07 00 00 00 05 00 0C 00 04 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 01", Error::S7BadSzlResponse, 24},
-      {"32 07 00 00 00 05 00 0C 00 05 | 00 01 12 08 12 84 01 00 00 00 D4 02 | 0A 00 00 01 00", Error::S7BadSzlResponse, 26},
-      {"32 07 00 00 00 05 00 0C 00 0C | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 04 00 08 00 11 00 00 00 04 00 00", Error::S7BadSzlResponse, 23},
-      {"32 07 00 00 00 05 00 0C 00 08 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 04 00 11 00 00", Error::S7BadSzlResponse, 8},
-      {"32 07 00 00 00 05 00 0C 00 0E | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 0A 00 11 00 00 00 04 00 02 AA BB", Error::S7BadSzlResponse, 30},
-      {"32 07 00 00 00 05 00 0C 00 14 | 00 01 12 08 12 84 01 00 01 01 00 00 | FF 09 00 10 00 11 00 00 00 02 00 02 AA BB CC DD EE FF 00 11", Error::S7BadSzlResponse, 30},
-      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00", Error::S7UnexpectedUserdata, 14},
+      {"32 07 00 00 00 05 00 0C 00 03 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00",
+       Error::S7BadSzlResponse, 8},
+      {"32 07 00 00 00 05 00 0C 00 04 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 01",
+       Error::S7BadSzlResponse, 24},
+      {"32 07 00 00 00 05 00 0C 00 05 | 00 01 12 08 12 84 01 00 00 00 D4 02 | 0A 00 00 01 00",
+       Error::S7BadSzlResponse, 26},
+      {"32 07 00 00 00 05 00 0C 00 0C | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 04 00 08 00 11 00 "
+       "00 00 04 00 00",
+       Error::S7BadSzlResponse, 23},
+      {"32 07 00 00 00 05 00 0C 00 08 | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 04 00 11 00 "
+       "00",
+       Error::S7BadSzlResponse, 8},
+      {"32 07 00 00 00 05 00 0C 00 0E | 00 01 12 08 12 84 01 00 00 00 00 00 | FF 09 00 0A 00 11 00 "
+       "00 00 04 00 02 AA BB",
+       Error::S7BadSzlResponse, 30},
+      {"32 07 00 00 00 05 00 0C 00 14 | 00 01 12 08 12 84 01 00 01 01 00 00 | FF 09 00 10 00 11 00 "
+       "00 00 02 00 02 AA BB CC DD EE FF 00 11",
+       Error::S7BadSzlResponse, 30},
+      {"32 07 00 00 00 05 00 08 00 08 | 00 01 12 04 11 44 01 00 | FF 09 00 04 00 11 00 00",
+       Error::S7UnexpectedUserdata, 14},
   };
   for (const auto& c : cases) {
     const auto r = response_of(hex(c.octets));

@@ -11,7 +11,9 @@ namespace {
 using test::hex;
 using Bytes = std::vector<std::uint8_t>;
 
-Bytes bytes(std::span<const std::uint8_t> s) { return Bytes(s.begin(), s.end()); }
+Bytes bytes(std::span<const std::uint8_t> s) {
+  return Bytes(s.begin(), s.end());
+}
 
 Decoded<WriteVarRequest> request_of(const Bytes& pdu) {
   const auto d = decode_s7_pdu(pdu);
@@ -29,11 +31,13 @@ Decoded<std::vector<std::uint8_t>> response_of(const Bytes& pdu) {
 // item 00 04 0010 1234 (reserved 00, BYTE/WORD/DWORD, 16 bits).
 TEST(S7WriteVar, Db1Dbw2RequestAndAnswer) {
   const Bytes word = hex("12 34");
-  const WriteVarItem item{{transport::kWord, 1, 1, area::kDataBlock, 2 * 8}, data_transport::kByte, word};
+  const WriteVarItem item{
+      {transport::kWord, 1, 1, area::kDataBlock, 2 * 8}, data_transport::kByte, word};
   const auto job = encode_write_var_request(3, std::span(&item, 1));
   ASSERT_TRUE(job.ok());
-  EXPECT_EQ(job.value, hex("32 01 00 00 00 03 00 0E 00 06 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 |"
-                           "00 04 00 10 12 34"));
+  EXPECT_EQ(job.value,
+            hex("32 01 00 00 00 03 00 0E 00 06 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 |"
+                "00 04 00 10 12 34"));
   const auto r = request_of(job.value);
   ASSERT_TRUE(r.ok()) << to_string(r.error);
   ASSERT_EQ(r.value.items.size(), 1u);
@@ -60,9 +64,10 @@ TEST(S7WriteVar, BitAndByteWithFillOctet) {
       {{transport::kByte, 1, 0, area::kFlags, 8}, data_transport::kByte, b}};
   const auto job = encode_write_var_request(4, items);
   ASSERT_TRUE(job.ok());
-  EXPECT_EQ(job.value, hex("32 01 00 00 00 04 00 1A 00 0B | 05 02 |"
-                           "12 0A 10 01 00 01 00 00 83 00 00 01 | 12 0A 10 02 00 01 00 00 83 00 00 08 |"
-                           "00 03 00 01 01 00 | 00 04 00 08 7F"));
+  EXPECT_EQ(job.value,
+            hex("32 01 00 00 00 04 00 1A 00 0B | 05 02 |"
+                "12 0A 10 01 00 01 00 00 83 00 00 01 | 12 0A 10 02 00 01 00 00 83 00 00 08 |"
+                "00 03 00 01 01 00 | 00 04 00 08 7F"));
   const auto r = request_of(job.value);
   ASSERT_TRUE(r.ok());
   ASSERT_EQ(r.value.values.size(), 2u);
@@ -84,16 +89,21 @@ struct Bad {
 TEST(S7WriteVar, EveryRequestDecodeError) {
   const Bad cases[] = {
       {"32 07 00 00 00 01 00 00 00 00", Error::S7WrongPduType, 1},
-      {"32 01 00 00 00 01 00 0E 00 06 | 04 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 04 00 10 12 34",
+      {"32 01 00 00 00 01 00 0E 00 06 | 04 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 04 00 10 12 "
+       "34",
        Error::S7UnexpectedFunction, 10},
-      {"32 01 00 00 00 01 00 0E 00 00 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10", Error::S7DataTruncated, 24},
+      {"32 01 00 00 00 01 00 0E 00 00 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10",
+       Error::S7DataTruncated, 24},
       {"32 01 00 00 00 01 00 0E 00 05 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 04 00 10 12",
        Error::S7DataTruncated, 26},
-      {"32 01 00 00 00 01 00 0E 00 07 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 04 00 10 12 34 00",
+      {"32 01 00 00 00 01 00 0E 00 07 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 04 00 10 12 "
+       "34 00",
        Error::S7TrailingData, 30},
-      {"32 01 00 00 00 01 00 0E 00 06 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 01 00 10 12 34",
+      {"32 01 00 00 00 01 00 0E 00 06 | 05 01 12 0A 10 04 00 01 00 01 84 00 00 10 | 00 01 00 10 12 "
+       "34",
        Error::S7BadDataTransportSize, 25},
-      {"32 01 00 00 00 01 00 1A 00 05 | 05 02 12 0A 10 02 00 01 00 01 84 00 00 00 12 0A 10 02 00 01 00 01 84 00 00 08 |"
+      {"32 01 00 00 00 01 00 1A 00 05 | 05 02 12 0A 10 02 00 01 00 01 84 00 00 00 12 0A 10 02 00 "
+       "01 00 01 84 00 00 08 |"
        "00 04 00 08 12",
        Error::S7DataTruncated, 41},
   };
@@ -130,7 +140,8 @@ TEST(S7WriteVar, EncoderErrors) {
   const Bytes two = hex("01 00");
   const WriteVarItem bits{{transport::kBit, 1, 0, area::kFlags, 0}, data_transport::kBit, two};
   EXPECT_EQ(encode_write_var_request(1, std::span(&bits, 1)).error, Error::S7ItemLengthMismatch);
-  const WriteVarItem far{{transport::kByte, 1, 0, area::kFlags, 0x1000000}, data_transport::kByte, two};
+  const WriteVarItem far{
+      {transport::kByte, 1, 0, area::kFlags, 0x1000000}, data_transport::kByte, two};
   EXPECT_EQ(encode_write_var_request(1, std::span(&far, 1)).error, Error::S7AddressTooLarge);
 }
 

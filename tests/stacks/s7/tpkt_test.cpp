@@ -14,7 +14,8 @@ using test::hex;
 
 // Three TPKTs as a client sends them back to back (tools-and-formats.md §3.4): nodes7's CR,
 // the Setup Communication job and the Read Var job.
-const std::vector<std::uint8_t> kCr = hex("03 00 00 16 11 E0 00 00 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02");
+const std::vector<std::uint8_t> kCr =
+    hex("03 00 00 16 11 E0 00 00 00 01 00 C0 01 0A C1 02 01 00 C2 02 01 02");
 const std::vector<std::uint8_t> kSetup =
     hex("03 00 00 19 02 F0 80 32 01 00 00 00 00 00 08 00 00 F0 00 00 01 00 01 01 E0");
 const std::vector<std::uint8_t> kRead = hex(
@@ -28,8 +29,8 @@ std::vector<std::uint8_t> stream() {
 }
 
 // Feeds `chunks` in order; returns the whole TPKTs that came out.
-std::vector<std::vector<std::uint8_t>> run(TpktReassembler& r,
-                                           const std::vector<std::span<const std::uint8_t>>& chunks) {
+std::vector<std::vector<std::uint8_t>> run(
+    TpktReassembler& r, const std::vector<std::span<const std::uint8_t>>& chunks) {
   std::vector<std::vector<std::uint8_t>> out;
   for (auto c : chunks) {
     while (!c.empty()) {

@@ -32,7 +32,9 @@ inline constexpr std::uint8_t kTpduSizeMaxCode = 0x0D;  ///< 8192 octets
 inline constexpr std::uint8_t kTpduSizeClass0MaxCode = 0x0B;
 inline constexpr std::size_t kMaxTsapLength = 32;
 
-constexpr std::size_t tpdu_size_octets(std::uint8_t code) { return std::size_t{1} << code; }
+constexpr std::size_t tpdu_size_octets(std::uint8_t code) {
+  return std::size_t{1} << code;
+}
 
 /// A CR or a CC. The TSAP spans point into the decoded TPDU (keep it alive) or, for encoding,
 /// at the caller's octets. An empty span / tpdu_size_code 0 = parameter absent.

@@ -18,15 +18,15 @@ enum class Error : std::uint8_t {
   TpktLengthTooLarge,   ///< length field above the negotiated maximum
   TpktPayloadTooLarge,  ///< encoder: payload does not fit a 16-bit TPKT length
   // COTP (ISO 8073 class 0)
-  CotpTooShort,               ///< fewer octets than the fixed part of the TPDU
-  CotpBadLengthIndicator,     ///< LI does not fit the TPDU or its fixed part
-  CotpUnexpectedType,         ///< the TPDU code is not the one asked for
-  CotpParameterTruncated,     ///< a parameter runs past the header
-  CotpBadParameterLength,     ///< TPDU size parameter not 1 octet, or a TSAP of 0 or > 32 octets
-  CotpBadTpduSize,            ///< TPDU size code outside 7..13 (128..8192 octets)
-  CotpDuplicateParameter,     ///< the same parameter twice in one CR/CC
-  CotpMissingTsap,            ///< CR without a calling or called TSAP
-  CotpParameterTooLong,       ///< encoder: a TSAP longer than 32 octets
+  CotpTooShort,            ///< fewer octets than the fixed part of the TPDU
+  CotpBadLengthIndicator,  ///< LI does not fit the TPDU or its fixed part
+  CotpUnexpectedType,      ///< the TPDU code is not the one asked for
+  CotpParameterTruncated,  ///< a parameter runs past the header
+  CotpBadParameterLength,  ///< TPDU size parameter not 1 octet, or a TSAP of 0 or > 32 octets
+  CotpBadTpduSize,         ///< TPDU size code outside 7..13 (128..8192 octets)
+  CotpDuplicateParameter,  ///< the same parameter twice in one CR/CC
+  CotpMissingTsap,         ///< CR without a calling or called TSAP
+  CotpParameterTooLong,    ///< encoder: a TSAP longer than 32 octets
   // S7 PDU (protocol-facts.md §H.4)
   S7TooShort,              ///< fewer octets than the header of its type
   S7BadProtocolId,         ///< octet 0 is not 0x32

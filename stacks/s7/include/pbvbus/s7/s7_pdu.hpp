@@ -61,8 +61,12 @@ Decoded<S7Pdu> decode_s7_pdu(std::span<const std::uint8_t> pdu);
 
 /// Where the parameter / data block starts in the PDU: the decoders of the functions (Setup
 /// Communication, Read/Write Var, SZL) report `Decoded::at` as an offset in the whole PDU.
-constexpr std::size_t params_offset(const S7Pdu& p) { return s7_header_length(p.header.type); }
-constexpr std::size_t data_offset(const S7Pdu& p) { return params_offset(p) + p.params.size(); }
+constexpr std::size_t params_offset(const S7Pdu& p) {
+  return s7_header_length(p.header.type);
+}
+constexpr std::size_t data_offset(const S7Pdu& p) {
+  return params_offset(p) + p.params.size();
+}
 
 /// Header + params + data. S7PduTooLarge if either block exceeds 65535 octets.
 Encoded encode_s7_pdu(const S7Header& h, std::span<const std::uint8_t> params,

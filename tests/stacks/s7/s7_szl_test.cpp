@@ -38,26 +38,28 @@ TEST(S7Szl, RequestLayout) {
 
 // The answer: params 00 01 12 08 | 12 (response) | 84 | 01 | seq | 00 (data unit 0) | 00 (last)
 // | 0000 (no error); data FF 09 <len> ID INDEX LENTHDR N_DR records (len = 8 + records).
+// The list is W#16#0000 (the SZL-IDs a module has, one word per record); tshark 4.0.17's s7comm
+// dissector shows these octets as four records 0000, 0011, 001C, 0091 (docs/s7.md).
 TEST(S7Szl, ResponseLayoutAndRoundTrip) {
-  const Bytes records = hex("AA BB CC DD 11 22 33 44");
+  const Bytes records = hex("00 00 00 11 00 1C 00 91");
   SzlResponse r;
   r.sequence = 3;
-  r.id = 0x0011;
+  r.id = 0x0000;
   r.index = 0x0000;
-  r.record_length = 4;
-  r.record_count = 2;
+  r.record_length = 2;
+  r.record_count = 4;
   r.records = records;
   const auto pdu = encode_szl_response(5, r);
   ASSERT_TRUE(pdu.ok());
   EXPECT_EQ(pdu.value, hex("32 07 00 00 00 05 00 0C 00 14 | 00 01 12 08 12 84 01 03 00 00 00 00 |"
-                           "FF 09 00 10 00 11 00 00 00 04 00 02 AA BB CC DD 11 22 33 44"));
+                           "FF 09 00 10 00 00 00 00 00 02 00 04 00 00 00 11 00 1C 00 91"));
   const auto back = response_of(pdu.value);
   ASSERT_TRUE(back.ok()) << to_string(back.error);
   EXPECT_EQ(back.value.sequence, 3);
   EXPECT_EQ(back.value.error_code, 0);
-  EXPECT_EQ(back.value.id, 0x0011);
-  EXPECT_EQ(back.value.record_length, 4);
-  EXPECT_EQ(back.value.record_count, 2);
+  EXPECT_EQ(back.value.id, 0x0000);
+  EXPECT_EQ(back.value.record_length, 2);
+  EXPECT_EQ(back.value.record_count, 4);
   EXPECT_EQ(Bytes(back.value.records.begin(), back.value.records.end()), records);
 }
 

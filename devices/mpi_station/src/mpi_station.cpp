@@ -91,11 +91,27 @@ class MpiStation::Port final : public bus::DevicePort {
   MpiStation& s_;
 };
 
+/// The MAC's user: forwards to the station.
+class MpiStation::MacUser final : public fdl::InitiatorUser {
+ public:
+  explicit MacUser(MpiStation& s) : s_(s) {}
+  bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override {
+    return s_.next_request(prio, now, out);
+  }
+  void on_confirmation(const fdl::Confirmation& con) override { s_.on_confirmation(con); }
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override { s_.on_request(ind, reply); }
+  void on_token(bus::Ticks now, bus::Ticks /*trr*/) override { s_.on_token(now); }
+
+ private:
+  MpiStation& s_;
+};
+
 MpiStation::MpiStation(const MpiStationConfig& config, S7SessionFactory* server)
     : config_(config),
       server_(server),
       port_(std::make_unique<Port>(*this)),
-      mac_(config.address, config.bus, *this),
+      user_(std::make_unique<MacUser>(*this)),
+      mac_(config.address, config.bus, *user_),
       pool_(config.pool) {
   mac_.bind(*port_);
 }
@@ -464,7 +480,7 @@ void MpiStation::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
   flush(ind.now);
 }
 
-void MpiStation::on_token(bus::Ticks now, bus::Ticks /*trr*/) { run_due(now); }
+void MpiStation::on_token(bus::Ticks now) { run_due(now); }
 
 // --- ring watch and deadlines ----------------------------------------------------------------
 

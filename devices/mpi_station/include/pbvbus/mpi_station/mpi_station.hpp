@@ -133,7 +133,7 @@ struct MpiStationStats {
   std::array<std::uint64_t, kEndReasonCount> broken{};  ///< Broken events by EndReason
 };
 
-class MpiStation final : public bus::Device, private fdl::InitiatorUser {
+class MpiStation final : public bus::Device {
  public:
   /// `server` non-null: the station serves S7 over MPI (a CPU's MPI interface) with sessions
   /// from it; it must outlive the station.
@@ -181,6 +181,7 @@ class MpiStation final : public bus::Device, private fdl::InitiatorUser {
 
  private:
   class Port;
+  class MacUser;
   struct Watch {  // the peer's presence in the token ring
     bool seen = false;
     bus::Ticks absent_since = bus::kNever;
@@ -207,11 +208,12 @@ class MpiStation final : public bus::Device, private fdl::InitiatorUser {
     Handle handle = 0;
   };
 
-  // fdl::InitiatorUser
-  bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override;
-  void on_confirmation(const fdl::Confirmation& con) override;
-  void on_request(const fdl::Indication& ind, fdl::Reply& reply) override;
-  void on_token(bus::Ticks now, bus::Ticks trr) override;
+  // What the MAC asks of its user (fdl::InitiatorUser, through MacUser: Device and
+  // InitiatorUser both have an on_power_on(Ticks)).
+  bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out);
+  void on_confirmation(const fdl::Confirmation& con);
+  void on_request(const fdl::Indication& ind, fdl::Reply& reply);
+  void on_token(bus::Ticks now);
 
   bus::Ticks now() const;
   Client* client(Handle h);
@@ -241,6 +243,7 @@ class MpiStation final : public bus::Device, private fdl::InitiatorUser {
   MpiStationConfig config_;
   S7SessionFactory* server_;
   std::unique_ptr<Port> port_;
+  std::unique_ptr<MacUser> user_;
   fdl::ActiveStation mac_;
   bus::Ticks mac_timer_ = bus::kNever;
   bool powered_ = false;

@@ -515,7 +515,13 @@ void MpiStation::run_due(bus::Ticks now) {
   }
   if (const auto d = pool_.deadline(); d && *d <= now) pool_.on_timer(now, out_);
   flush(now);
-  const std::uint64_t losses = mac_.stats().token_losses;
+  // Token loss: our station claimed the token since the peer was last seen and its ring still
+  // holds nobody else (the line is dead, or we are cut off alone); otherwise the ring goes on
+  // without the peer.
+  const bool alone = mac_.las() == std::vector<std::uint8_t>{mac_.address()};
+  auto reason_of = [&](const Watch& w) {
+    return alone && mac_.stats().token_losses > w.token_losses ? EndReason::TokenLost : EndReason::PeerLeftRing;
+  };
   auto expired = [&](const Watch& w) {
     return w.absent_since != bus::kNever && now >= w.absent_since + config_.peer_absent_timeout;
   };
@@ -530,7 +536,7 @@ void MpiStation::run_due(bus::Ticks now) {
     ev.handle = c.handle;
     ev.local_sap = c.conn.local_sap();
     ev.peer = c.conn.peer();
-    ev.reason = losses > c.watch.token_losses ? EndReason::TokenLost : EndReason::PeerLeftRing;
+    ev.reason = reason_of(c.watch);
     count_end(ev.kind, ev.reason);
     emit(std::move(ev));
     // Tell the peer, in case it still holds the connection (it is released when the FDL layer
@@ -550,7 +556,7 @@ void MpiStation::run_due(bus::Ticks now) {
     ev.role = Role::Server;
     ev.local_sap = s.sap;
     ev.peer = s.peer;
-    ev.reason = losses > s.watch.token_losses ? EndReason::TokenLost : EndReason::PeerLeftRing;
+    ev.reason = reason_of(s.watch);
     count_end(ev.kind, ev.reason);
     emit(std::move(ev));
     pool_.disconnect(now, s.sap, out_);

@@ -25,7 +25,8 @@
 // Broken connections (reported once, as Broken with a reason): the mpi layer's (no confirm, no
 // data ack in time, FDL NoResponse = PeerGone, FDL refusal, sequence error); a peer that leaves
 // the token ring (our LAS loses it: cut, power off) for `peer_absent_timeout` -> PeerLeftRing,
-// or TokenLost when our own station claimed the token meanwhile (token loss); our own power loss
+// or TokenLost when our own station claimed the token meanwhile and is still alone in its ring
+// (the line is dead or we are cut off alone: token loss); our own power loss
 // -> PowerLoss (every connection, at once). A connection whose peer left the ring is also
 // released towards the peer (80), in case it still holds it.
 //
@@ -95,7 +96,7 @@ enum class EndReason : std::uint8_t {
   PeerRefused,      ///< the peer's FDL refused a frame (RR/RS/UE)
   SequenceError,    ///< message number out of sequence (mpi layer)
   PeerLeftRing,     ///< the peer left the token ring for peer_absent_timeout
-  TokenLost,        ///< the peer missing after our station claimed a lost token
+  TokenLost,        ///< the peer missing, our station alone after claiming a lost token
   PowerLoss,        ///< our own station lost power
   Refused,          ///< server: the session factory refused the connection
 };

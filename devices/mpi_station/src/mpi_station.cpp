@@ -518,9 +518,9 @@ void MpiStation::run_due(bus::Ticks now) {
   // Token loss: our station claimed the token since the peer was last seen and its ring still
   // holds nobody else (the line is dead, or we are cut off alone); otherwise the ring goes on
   // without the peer.
-  const bool alone = mac_.las() == std::vector<std::uint8_t>{mac_.address()};
   auto reason_of = [&](const Watch& w) {
-    return alone && mac_.stats().token_losses > w.token_losses ? EndReason::TokenLost : EndReason::PeerLeftRing;
+    return mac_.stats().token_losses > w.token_losses && alone_in_ring() ? EndReason::TokenLost
+                                                                          : EndReason::PeerLeftRing;
   };
   auto expired = [&](const Watch& w) {
     return w.absent_since != bus::kNever && now >= w.absent_since + config_.peer_absent_timeout;
@@ -562,6 +562,12 @@ void MpiStation::run_due(bus::Ticks now) {
     pool_.disconnect(now, s.sap, out_);
   }
   flush(now);
+}
+
+bool MpiStation::alone_in_ring() const {
+  for (std::uint8_t a = 0; a < 127; ++a)
+    if (a != mac_.address() && mac_.las_contains(a)) return false;
+  return true;
 }
 
 bus::Ticks MpiStation::next_deadline() const {

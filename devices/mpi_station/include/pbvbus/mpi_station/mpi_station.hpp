@@ -237,6 +237,7 @@ class MpiStation final : public bus::Device {
   void run_due(bus::Ticks now);
   void watch_ring(bus::Ticks now);
   void watch_one(bus::Ticks now, std::uint8_t peer, Watch& w);
+  bool alone_in_ring() const;
   bus::Ticks next_deadline() const;
   void rearm();
   void sweep();

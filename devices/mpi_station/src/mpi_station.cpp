@@ -403,8 +403,8 @@ void MpiStation::on_server_event(bus::Ticks now, const mpi::Event& e) {
 }
 
 void MpiStation::sweep() {
-  // A client connection is forgotten once it is closed, reported and has no frame in the FDL
-  // layer's hands (the pool does the same for its own, mpi::ConnectionPool).
+  // A client connection is forgotten once it is closed (its end has been reported) and has no
+  // frame in the FDL layer's hands (the pool does the same for its own, mpi::ConnectionPool).
   std::erase_if(clients_, [](const Client& c) {
     return c.conn.state() == mpi::State::Closed && c.conn.unconfirmed_frames() == 0;
   });

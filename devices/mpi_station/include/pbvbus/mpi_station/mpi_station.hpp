@@ -100,7 +100,7 @@ enum class EndReason : std::uint8_t {
   PowerLoss,        ///< our own station lost power
   Refused,          ///< server: the session factory refused the connection
 };
-inline constexpr std::size_t kEndReasonCount = 14;
+inline constexpr std::size_t kEndReasonCount = static_cast<std::size_t>(EndReason::Refused) + 1;
 std::string_view to_string(EndReason r);
 
 struct StationEvent {

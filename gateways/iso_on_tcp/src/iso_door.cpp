@@ -1,5 +1,6 @@
 #include "pbvbus/iso_on_tcp/iso_door.hpp"
 
+#include <algorithm>
 #include <array>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -19,6 +20,9 @@ using Clock = std::chrono::steady_clock;
 namespace {
 /// Octets taken per read wake-up of one connection.
 constexpr std::size_t kReadChunk = 4096;
+/// Octets handed to the session at a time, so that the output can be looked at in between: at
+/// most 8 jobs (31 octets is the shortest Read Var), i.e. 8 answers of at most one PDU each.
+constexpr std::size_t kFeedSlice = 256;
 }  // namespace
 
 struct IsoOnTcpDoor::Impl : std::enable_shared_from_this<IsoOnTcpDoor::Impl> {
@@ -55,7 +59,8 @@ struct IsoOnTcpDoor::Impl::Link : std::enable_shared_from_this<Link> {
 
   void start();
   void read_more();
-  void on_bytes(std::size_t n);
+  void consume();
+  std::size_t unsent() const { return out.size() + flying.size(); }
   void on_finish(SessionEnd e, const std::string& why);
   void queue_out(std::span<const std::uint8_t> octets);
   void write_out();
@@ -72,6 +77,9 @@ struct IsoOnTcpDoor::Impl::Link : std::enable_shared_from_this<Link> {
   Links::iterator pos;
   std::unique_ptr<IsoSession> session;
   std::array<std::uint8_t, kReadChunk> in{};
+  std::size_t in_at = 0;   // octets of `in` handed to the session
+  std::size_t in_end = 0;  // octets of `in` read
+  bool paused = false;     // reading stopped: too much output waits (flow control)
   std::vector<std::uint8_t> out;     // waiting for the socket
   std::vector<std::uint8_t> flying;  // handed to async_write
   bool writing = false;
@@ -186,23 +194,37 @@ void IsoOnTcpDoor::Impl::Link::read_more() {
       self->drop(nullptr, "");  // the client left (EOF, reset)
       return;
     }
-    self->on_bytes(n);
+    self->in_at = 0;
+    self->in_end = n;
+    self->consume();
   });
 }
 
-void IsoOnTcpDoor::Impl::Link::on_bytes(std::size_t n) {
-  session->feed(std::span<const std::uint8_t>(in.data(), n));
-  if (!door) return;
-  const std::uint64_t now_progress = session->jobs() + (session->connected() ? 1 : 0);
-  if (now_progress != progress) {
-    if (progress == 0 && session->connected()) ++door->stats.connects;
-    progress = now_progress;
-    last_progress = Clock::now();
+void IsoOnTcpDoor::Impl::Link::consume() {
+  // Flow control: while more than a quarter of max_output waits for the client, the door stops
+  // taking its input (TCP then holds the client back); it goes on when the output has drained.
+  // A client that never reads thus costs at most max_output, and the idle watch closes it.
+  while (in_at < in_end) {
+    if (unsent() >= door->opt.max_output / 4) {
+      paused = true;
+      return;
+    }
+    const std::size_t n = std::min(kFeedSlice, in_end - in_at);
+    session->feed(std::span<const std::uint8_t>(in.data() + in_at, n));
+    if (!door) return;
+    in_at += n;
+    const std::uint64_t now_progress = session->jobs() + (session->connected() ? 1 : 0);
+    if (now_progress != progress) {
+      if (progress == 0 && session->connected()) ++door->stats.connects;
+      progress = now_progress;
+      last_progress = Clock::now();
+    }
+    if (finishing) {
+      maybe_close();
+      return;
+    }
   }
-  if (finishing) {
-    maybe_close();
-    return;
-  }
+  paused = false;
   read_more();
 }
 
@@ -224,7 +246,7 @@ void IsoOnTcpDoor::Impl::Link::on_finish(SessionEnd e, const std::string& why) {
 
 void IsoOnTcpDoor::Impl::Link::queue_out(std::span<const std::uint8_t> octets) {
   if (!door) return;
-  if (out.size() + flying.size() + octets.size() > door->opt.max_output) {
+  if (unsent() + octets.size() > door->opt.max_output) {
     drop(&IsoDoorStats::closed_stalled,
          "more than " + std::to_string(door->opt.max_output) +
              " octets of answers wait for a client that does not read");
@@ -263,6 +285,9 @@ void IsoOnTcpDoor::Impl::Link::write_out() {
                       if (self->door && !self->writing && self->out.empty() &&
                           (self->finishing || self->peer_eof))
                         self->maybe_close();
+                      if (self->door && self->paused && !self->finishing &&
+                          self->unsent() < self->door->opt.max_output / 4)
+                        self->consume();
                     });
 }
 
@@ -280,9 +305,13 @@ void IsoOnTcpDoor::Impl::Link::watch_idle(Clock::time_point at) {
       self->watch_idle(deadline);
       return;
     }
-    self->drop(&IsoDoorStats::closed_idle,
-               "no CR or S7 job for " + std::to_string(self->door->opt.idle_timeout.count()) +
-                   " ms (half-open or stalled)");
+    const auto ms = std::to_string(self->door->opt.idle_timeout.count());
+    if (self->paused)
+      self->drop(&IsoDoorStats::closed_stalled,
+                 std::to_string(self->unsent()) + " octets of answers unread for " + ms +
+                     " ms: the client does not read");
+    else
+      self->drop(&IsoDoorStats::closed_idle, "no CR or S7 job for " + ms + " ms (half-open)");
   });
 }
 

@@ -90,6 +90,7 @@ class Client {
     sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
     timeval tv{20, 0};
     ::setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    ::setsockopt(fd_, SOL_SOCKET, SO_SNDTIMEO, &tv, sizeof tv);
     const int one = 1;
     ::setsockopt(fd_, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
     connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&sa), sizeof sa) == 0;
@@ -184,9 +185,21 @@ inline Bytes read_db1_10(std::uint16_t ref = 1) {
                   0x10, 0x02, 0x00, 0x0A, 0x00, 0x01, 0x84, 0x00, 0x00, 0x00});
 }
 
-/// CR, CC and Setup Communication on a fresh client.
+/// kCc with the door's reference of another connection (octets 8..9).
+inline Bytes cc_with_ref(std::uint16_t ref) {
+  Bytes cc = kCc;
+  cc[8] = static_cast<std::uint8_t>(ref >> 8);
+  cc[9] = static_cast<std::uint8_t>(ref);
+  return cc;
+}
+
+/// CR, CC (whatever the door's reference) and Setup Communication on a fresh client.
 inline bool open_s7(Client& c) {
-  return c.send(kCr) && c.recv_tpkt() == kCc && c.send(kSetupReq) && c.recv_tpkt() == kSetupResp;
+  if (!c.send(kCr)) return false;
+  const Bytes cc = c.recv_tpkt();
+  if (cc.size() != kCc.size() || cc != cc_with_ref(static_cast<std::uint16_t>((cc[8] << 8) | cc[9])))
+    return false;
+  return c.send(kSetupReq) && c.recv_tpkt() == kSetupResp;
 }
 
 }  // namespace pbvbus::iso_on_tcp::test

@@ -8,11 +8,18 @@
 //  - At most `max_clients` connections (32). One more is accepted and closed at once, counted
 //    and logged (throttled): every connection holds a CPU connection resource, so the door does
 //    not evict an open S7 connection for a newcomer (the Modbus door does, having none).
+//  - Flow control: while a quarter of `max_output` (64 KiB) or more of answers waits for the
+//    client, the door takes no more of its input (TCP then holds the client back) and goes on
+//    once the output has drained. A client that pipelines faster than it reads is slowed, not
+//    closed; input is handed to the session 256 octets at a time, so the output overshoots the
+//    quarter by at most 8 answers.
 //  - A connection that brings no progress (a CR confirmed or a whole S7 job) for
-//    `idle_timeout` (60 s wall time; zero = never) is closed: half-open sockets, stalled or
-//    byte-dribbling clients.
-//  - Output waiting for a client that does not read: more than `max_output` (64 KiB) closes the
-//    connection (accepted sockets also get the shared 32 KiB SO_SNDBUF, tcp_accept.hpp).
+//    `idle_timeout` (60 s wall time; zero = never) is closed: half-open sockets and
+//    byte-dribbling clients (closed_idle), and a client that does not read, whose input the
+//    door no longer takes (closed_stalled).
+//  - Output beyond `max_output` (possible only with a channel that answers later, for jobs
+//    queued before the pause) closes the connection at once (closed_stalled). Accepted sockets
+//    also get the shared 32 KiB SO_SNDBUF (tcp_accept.hpp).
 //  - Garbage (TPKT framing lost, a TPDU or S7 PDU the session refuses) closes the connection;
 //    pipelined jobs beyond AmQ + max_queued_jobs close it too. One log line each, throttled
 //    (ThrottledLog), and counted.

@@ -156,16 +156,25 @@ void IsoOnTcpDoor::Impl::Link::start() {
   sock.set_option(tcp::no_delay(true), ec);  // request/answer: Nagle would only delay
   sock.set_option(asio::socket_base::send_buffer_size(gateways::tcp_accept::kKernelSendBuffer), ec);
   sock.non_blocking(true, ec);
+  // The hooks hold the link weakly: a channel that answers later may still call into a session
+  // whose link has gone (its destruction is posted, detach()).
+  std::weak_ptr<Link> w = weak_from_this();
   IsoSession::Hooks hooks;
-  hooks.send = [this](std::span<const std::uint8_t> o) { queue_out(o); };
-  hooks.finish = [this](SessionEnd e, const std::string& why) { on_finish(e, why); };
-  hooks.capture = [this](const PduRecord& r) {
-    if (!door) return;
+  hooks.send = [w](std::span<const std::uint8_t> o) {
+    if (const auto l = w.lock(); l && l->door) l->queue_out(o);
+  };
+  hooks.finish = [w](SessionEnd e, const std::string& why) {
+    if (const auto l = w.lock(); l && l->door) l->on_finish(e, why);
+  };
+  hooks.capture = [w](const PduRecord& r) {
+    const auto l = w.lock();
+    if (!l || !l->door) return;
+    Impl* d = l->door;
     if (r.direction == PduDirection::FromClient)
-      ++door->stats.jobs;
+      ++d->stats.jobs;
     else
-      ++door->stats.answers;
-    if (door->opt.capture) door->opt.capture(r);
+      ++d->stats.answers;
+    if (d->opt.capture) d->opt.capture(r);
   };
   // COTP references are 16 bits and non-zero on our side.
   const auto ref = static_cast<std::uint16_t>((id - 1) % 0xFFFF + 1);

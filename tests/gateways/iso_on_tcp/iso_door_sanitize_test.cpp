@@ -200,5 +200,78 @@ TEST(IsoDoorSanitize, ClosingTheDoorWithOpenConnectionsEndsTheirRoutes) {
   EXPECT_EQ(f.on_io([&] { return f.router.connections(0, 2); }), 0u);
 }
 
+/// Wraps LocalCpuRouter's channels so that every answer comes on a later turn of the io_context,
+/// as a CPU across MPI answers later.
+class LaterRouter final : public S7Router {
+ public:
+  LaterRouter(LocalCpuRouter& inner, boost::asio::io_context& io) : inner_(inner), io_(io) {}
+  RouteResult open(const RouteRequest& r) override {
+    RouteResult res = inner_.open(r);
+    if (res.channel) res.channel = std::make_unique<Later>(std::move(res.channel), io_);
+    return res;
+  }
+
+ private:
+  struct Later final : S7Channel {
+    Later(std::unique_ptr<S7Channel> c, boost::asio::io_context& i) : inner(std::move(c)), io(i) {}
+    void request(std::vector<std::uint8_t> pdu, Reply reply) override {
+      inner->request(std::move(pdu), [this, reply](std::vector<std::uint8_t> a) {
+        boost::asio::post(io, [reply, a = std::move(a)] { reply(a); });
+      });
+    }
+    void on_closed(Closed) override {}
+    std::unique_ptr<S7Channel> inner;
+    boost::asio::io_context& io;
+  };
+  LocalCpuRouter& inner_;
+  boost::asio::io_context& io_;
+};
+
+auto later_router(std::unique_ptr<LaterRouter>& keep) {
+  return [&keep](LocalCpuRouter& r, boost::asio::io_context& io) -> S7Router& {
+    keep = std::make_unique<LaterRouter>(r, io);
+    return *keep;
+  };
+}
+
+TEST(IsoDoorSanitize, AChannelThatAnswersLaterGetsPipelinedJobsOneAtATimeInOrder) {
+  std::unique_ptr<LaterRouter> later;
+  DoorFixture f({}, {1, 1, 240}, later_router(later));
+  Client c(f.port);
+  ASSERT_TRUE(open_s7(c));
+  Bytes burst;
+  for (std::uint16_t i = 1; i <= 50; ++i) {
+    const Bytes j = read_db1_10(i);
+    burst.insert(burst.end(), j.begin(), j.end());
+  }
+  ASSERT_TRUE(c.send(burst));  // AmQ 1: the door queues 49 of them
+  for (int i = 1; i <= 50; ++i) {
+    const Bytes a = c.recv_tpkt();
+    ASSERT_EQ(a.size(), 35u);
+    EXPECT_EQ((a[11] << 8) | a[12], i);
+  }
+}
+
+TEST(IsoDoorSanitize, AnswersThatComeAfterTheClientLeftAreDropped) {
+  std::unique_ptr<LaterRouter> later;
+  DoorFixture f({}, {1, 1, 240}, later_router(later));
+  for (int round = 0; round < 20; ++round) {
+    Client c(f.port);
+    Bytes burst = kCr;
+    burst.insert(burst.end(), kSetupReq.begin(), kSetupReq.end());
+    for (std::uint16_t i = 1; i <= 10; ++i) {
+      const Bytes j = read_db1_10(i);
+      burst.insert(burst.end(), j.begin(), j.end());
+    }
+    ASSERT_TRUE(c.send(burst));
+    // Leave at once, with a reset: answers are still on their way through the io_context.
+    const linger l{1, 0};
+    ::setsockopt(c.fd(), SOL_SOCKET, SO_LINGER, &l, sizeof l);
+  }
+  Client ok(f.port);
+  EXPECT_TRUE(open_s7(ok));
+  EXPECT_EQ(f.stats().clients_now, 1u);
+}
+
 }  // namespace
 }  // namespace pbvbus::iso_on_tcp::test

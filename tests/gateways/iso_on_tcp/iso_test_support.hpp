@@ -32,7 +32,10 @@ using Bytes = std::vector<std::uint8_t>;
 /// (AmQ 1/1, PDU 240, as the §3.4 exchange) with DB1 of 64 octets.
 class DoorFixture {
  public:
-  explicit DoorFixture(IsoDoorOptions opt = {}, s7::SetupCommunication limits = {1, 1, 240}) {
+  /// `route_via` (built on this->router by the caller, e.g. a wrapper) replaces the router the
+  /// door sees; the default is `router` itself.
+  explicit DoorFixture(IsoDoorOptions opt = {}, s7::SetupCommunication limits = {1, 1, 240},
+                       std::function<S7Router&(LocalCpuRouter&, boost::asio::io_context&)> route_via = {}) {
     memory.create_db(1, 64);
     LocalCpu cpu;
     cpu.rack = 0;
@@ -44,7 +47,8 @@ class DoorFixture {
     opt.address = "127.0.0.1";
     opt.port = 0;
     if (!opt.log) opt.log = [this](const std::string& l) { log.push_back(l); };
-    door = std::make_unique<IsoOnTcpDoor>(io, router, std::move(opt));
+    door = std::make_unique<IsoOnTcpDoor>(io, route_via ? route_via(router, io) : router,
+                                          std::move(opt));
     port = door->port();
     thread = std::thread([this] { io.run(); });
   }

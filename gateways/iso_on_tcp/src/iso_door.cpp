@@ -241,16 +241,22 @@ void IsoOnTcpDoor::Impl::Link::on_finish(SessionEnd e, const std::string& why) {
   if (!door) return;
   finishing = true;
   auto& st = door->stats;
+  bool log = true;
   switch (e) {
-    case SessionEnd::ClientDisconnect: ++st.disconnects; return;
+    case SessionEnd::ClientDisconnect: ++st.disconnects; log = false; break;
     case SessionEnd::Refused: ++st.connects_refused; break;
     case SessionEnd::ChannelClosed: ++st.routes_closed; break;
     case SessionEnd::QueueFull: ++st.closed_queue_full; break;
     case SessionEnd::Garbage:
     case SessionEnd::NoAnswer: ++st.closed_garbage; break;
   }
-  door->complaints(door->who + ": connection " + std::to_string(id) + " from " + peer() +
-                   " closed (" + to_string(e) + "): " + why);
+  if (log)
+    door->complaints(door->who + ": connection " + std::to_string(id) + " from " + peer() +
+                     " closed (" + to_string(e) + "): " + why);
+  // The session's last octets (DR, DC, ER) are queued already: close once they are out. The end
+  // may come outside any read (the route broke, a later answer was empty), so not only consume()
+  // looks at `finishing`.
+  maybe_close();
 }
 
 void IsoOnTcpDoor::Impl::Link::queue_out(std::span<const std::uint8_t> octets) {

@@ -207,24 +207,34 @@ class LaterRouter final : public S7Router {
   LaterRouter(LocalCpuRouter& inner, boost::asio::io_context& io) : inner_(inner), io_(io) {}
   RouteResult open(const RouteRequest& r) override {
     RouteResult res = inner_.open(r);
-    if (res.channel) res.channel = std::make_unique<Later>(std::move(res.channel), io_);
+    if (res.channel) res.channel = std::make_unique<Later>(std::move(res.channel), io_, *this);
     return res;
   }
 
  private:
   struct Later final : S7Channel {
-    Later(std::unique_ptr<S7Channel> c, boost::asio::io_context& i) : inner(std::move(c)), io(i) {}
+    Later(std::unique_ptr<S7Channel> c, boost::asio::io_context& i, LaterRouter& r)
+        : inner(std::move(c)), io(i), router(r) {}
+    ~Later() override { router.closers.clear(); }
     void request(std::vector<std::uint8_t> pdu, Reply reply) override {
-      inner->request(std::move(pdu), [this, reply](std::vector<std::uint8_t> a) {
+      // A one-item Read Var of bit address 0x28 (byte 5) gets "no answer" (an empty one).
+      const bool silent = pdu.size() == 24 && pdu[10] == 0x04 && pdu[23] == 0x28;
+      inner->request(std::move(pdu), [this, reply, silent](std::vector<std::uint8_t> a) {
+        if (silent) a.clear();
         boost::asio::post(io, [reply, a = std::move(a)] { reply(a); });
       });
     }
-    void on_closed(Closed) override {}
+    void on_closed(Closed c) override { router.closers.push_back(std::move(c)); }
     std::unique_ptr<S7Channel> inner;
     boost::asio::io_context& io;
+    LaterRouter& router;
   };
   LocalCpuRouter& inner_;
   boost::asio::io_context& io_;
+
+ public:
+  /// The routes' close callbacks (the test breaks a route through them), on the door's thread.
+  std::vector<S7Channel::Closed> closers;
 };
 
 auto later_router(std::unique_ptr<LaterRouter>& keep) {
@@ -250,6 +260,36 @@ TEST(IsoDoorSanitize, AChannelThatAnswersLaterGetsPipelinedJobsOneAtATimeInOrder
     ASSERT_EQ(a.size(), 35u);
     EXPECT_EQ((a[11] << 8) | a[12], i);
   }
+}
+
+TEST(IsoDoorSanitize, ARouteThatBreaksSendsDrAndClosesTheConnection) {
+  std::unique_ptr<LaterRouter> later;
+  DoorFixture f({}, {1, 1, 240}, later_router(later));
+  Client c(f.port);
+  ASSERT_TRUE(open_s7(c));
+  f.on_io([&] {
+    ASSERT_EQ(later->closers.size(), 1u);
+    auto close = later->closers.front();
+    close("MPI connection lost");
+  });
+  // DR: LI 6, 80, dst-ref = the client's 00 01, src-ref = the door's 00 01, reason 00.
+  EXPECT_EQ(c.recv_tpkt(), (Bytes{0x03, 0x00, 0x00, 0x0B, 0x06, 0x80, 0x00, 0x01, 0x00, 0x01, 0x00}));
+  EXPECT_TRUE(c.closed_by_door());
+  EXPECT_EQ(f.stats().routes_closed, 1u);
+  EXPECT_TRUE(log_has(f, "MPI connection lost"));
+}
+
+TEST(IsoDoorSanitize, ALaterEmptyAnswerClosesTheConnection) {
+  std::unique_ptr<LaterRouter> later;
+  DoorFixture f({}, {1, 1, 240}, later_router(later));
+  Client c(f.port);
+  ASSERT_TRUE(open_s7(c));
+  // DB1.DBB5, 1 byte: the wrapper turns its answer into "no answer" (see Later::request).
+  ASSERT_TRUE(c.send(tpkt_dt({0x32, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00, 0x0E, 0x00, 0x00, 0x04,
+                              0x01, 0x12, 0x0A, 0x10, 0x02, 0x00, 0x01, 0x00, 0x01, 0x84, 0x00,
+                              0x00, 0x28})));
+  EXPECT_TRUE(c.closed_by_door());
+  EXPECT_EQ(f.stats().closed_garbage, 1u);
 }
 
 TEST(IsoDoorSanitize, AnswersThatComeAfterTheClientLeftAreDropped) {

@@ -122,8 +122,11 @@ void IsoSession::on_connect_request(std::span<const std::uint8_t> tpdu) {
     if (!alive.expired()) on_channel_closed(reason);
   });
   const s7::ConnectTpdu cc = s7::confirm_for(cr.value, own_ref_, limits_.max_tpdu_code);
+  // The confirmed size bounds what the door sends. What it takes stays bounded by class 0's
+  // 2048 + 4 (the reassembler's default): libnodave asks for TPDU 512 and Setup Communication
+  // PDU 960 on the same connection (protocol-facts §H.4, tools-and-formats §3.2) and sends a
+  // PDU as one DT, so holding clients to the confirmed size would close such connections.
   tpdu_size_ = cc.tpdu_size_code != 0 ? s7::tpdu_size_octets(cc.tpdu_size_code) : 128;
-  reasm_.set_max_length(tpdu_size_ + s7::kTpktHeaderLength);
   std::vector<std::uint8_t> out;
   s7::append_connect(out, cc);  // cannot fail: sizes and TSAPs come from a decoded CR
   send_tpdu(out);

@@ -154,6 +154,25 @@ TEST(IsoSession, DtSegmentsAreJoinedUntilEot) {
   EXPECT_EQ(r.router.pending.front().pdu, pdu);
 }
 
+TEST(IsoSession, ADtLargerThanTheConfirmedTpduSizeIsTaken) {
+  // libnodave's CR order and TPDU size 2^9 = 512 (tools-and-formats §3.2), then one DT of
+  // 3 + 600 octets: taken (class 0 allows 2048), handed on as one PDU.
+  SessionRig r;
+  r.feed({0x03, 0x00, 0x00, 0x16, 0x11, 0xE0, 0x00, 0x00, 0x00, 0x01, 0x00,
+          0xC1, 0x02, 0x01, 0x00, 0xC2, 0x02, 0x01, 0x02, 0xC0, 0x01, 0x09});
+  ASSERT_EQ(r.sent.size(), 1u);
+  EXPECT_EQ(r.sent[0][13], 0x09);  // CC: C0 01 09
+  // A Write Var job of DB1.DBB0, 572 octets: 10 + 14 + 4 + 572 = 600 octets of S7 PDU.
+  Bytes pdu = {0x32, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00, 0x0E, 0x02, 0x40, 0x05, 0x01,
+               0x12, 0x0A, 0x10, 0x02, 0x02, 0x3C, 0x00, 0x01, 0x84, 0x00, 0x00, 0x00,
+               0x00, 0x04, 0x11, 0xE0};
+  pdu.resize(600, 0x55);
+  r.feed(tpkt_dt(pdu));
+  EXPECT_FALSE(r.ended);
+  ASSERT_EQ(r.router.pending.size(), 1u);
+  EXPECT_EQ(r.router.pending.front().pdu.size(), 600u);
+}
+
 TEST(IsoSession, RouteClosingSendsDrReasonZeroAndEnds) {
   SessionRig r;
   r.feed(kCr);

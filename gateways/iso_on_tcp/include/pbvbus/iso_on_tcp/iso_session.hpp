@@ -5,8 +5,8 @@
 // plus a socket; the fuzz target drives it directly.
 //
 // What it does, in order (RFC 1006 TPKT, ISO 8073 class 0 COTP, S7 PDUs of protocol-facts §H.4):
-//  1. TPKTs are reassembled (stacks/s7 TpktReassembler). Before the CC they may be up to the
-//     class 0 maximum (2048 + 4); after it, up to the confirmed TPDU size + 4.
+//  1. TPKTs are reassembled (stacks/s7 TpktReassembler), each up to the class 0 maximum
+//     (2048 + 4), whatever TPDU size the CC confirmed (what the door sends keeps to it).
 //  2. The first TPDU must be a CR with both TSAPs. It goes to the S7Router: a refusal is answered
 //     with a DR carrying the router's reason; a channel is confirmed with a CC that echoes the
 //     CR's parameters (so libnodave's 22-octet check passes, tools-and-formats §3.2), the TPDU

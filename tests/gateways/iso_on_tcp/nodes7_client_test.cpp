@@ -1,6 +1,6 @@
 // nodes7 0.3.18 (npm, unmodified) through the door, against one CPU (rack 0, slot 2): connect by
-// rack/slot, a multi-item read of DB bytes, INT, REAL, WORD, M, I, Q and a bit, writes of each
-// kind checked in the CpuMemory and read back, and a read of a missing DB. `./pbvbus test`
+// rack/slot, a multi-item read of DB bytes, INT, REAL, WORD, M, I, Q, a bit, a counter and a
+// timer, writes of each kind checked in the CpuMemory and read back, and a read of a missing DB. `./pbvbus test`
 // installs nodes7 into the build folder (BUILD/nodes7) before the suite runs; without it (npm
 // unreachable) the test is skipped and says why.
 #include <gtest/gtest.h>
@@ -71,6 +71,10 @@ TEST(Nodes7, ReadsAndWritesASingleCpuThroughTheDoor) {
     m[11] = 0x02;  // M11.1 set
     f.memory.area(s7cpu::Area::Inputs)[0] = 0x81;
     f.memory.area(s7cpu::Area::Outputs)[0] = 0x42;
+    f.memory.counters()[5] = 42;
+    f.memory.counters()[40] = 43;
+    f.memory.timers()[3] = 0x1234;
+    f.memory.timers()[24] = 0x0111;
   });
   std::string all;
   const auto kv = run_client(f.port, all);
@@ -86,6 +90,11 @@ TEST(Nodes7, ReadsAndWritesASingleCpuThroughTheDoor) {
   EXPECT_EQ(kv.at("IB0"), "129");
   EXPECT_EQ(kv.at("QB0"), "66");
   EXPECT_EQ(kv.at("M11.1"), "true");
+  // Counters and timers: nodes7 writes the address of "C5" as 5 * 8 = 40, as for the byte
+  // areas, where snap7's client writes the cell number, which the CPU model follows
+  // (docs/s7cpu.md "Addresses"). So nodes7's C5 is cell 40 and its T3 cell 24 (Int16BE).
+  EXPECT_EQ(kv.at("C5"), "43");
+  EXPECT_EQ(kv.at("T3"), "273");
 
   EXPECT_EQ(kv.at("write_bad"), "false");
   f.on_io([&] {

@@ -29,8 +29,9 @@ function write(items, values) {
 }
 
 async function run() {
-  // One readAllItems over four areas: nodes7 puts them into one multi-item Read Var.
-  const multi = await read(['DB1,B0.4', 'DB1,INT4', 'DB1,REAL8', 'DB1,WORD12', 'MB10', 'IB0', 'QB0', 'M11.1']);
+  // One readAllItems over six areas: nodes7 puts them into one multi-item Read Var.
+  const multi = await read(['DB1,B0.4', 'DB1,INT4', 'DB1,REAL8', 'DB1,WORD12', 'MB10', 'IB0', 'QB0',
+                            'M11.1', 'C5', 'T3']);
   out('multi_bad', multi.anythingBad);
   for (const k of Object.keys(multi.values)) out(k, multi.values[k]);
 

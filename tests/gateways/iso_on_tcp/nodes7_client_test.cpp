@@ -1,8 +1,8 @@
 // nodes7 0.3.18 (npm, unmodified) through the door, against one CPU (rack 0, slot 2): connect by
 // rack/slot, a multi-item read of DB bytes, INT, REAL, WORD, M, I, Q, a bit, a counter and a
-// timer, writes of each kind checked in the CpuMemory and read back, and a read of a missing DB. `./pbvbus test`
-// installs nodes7 into the build folder (BUILD/nodes7) before the suite runs; without it (npm
-// unreachable) the test is skipped and says why.
+// timer, writes of each kind checked in the CpuMemory and read back, and a read of a missing DB.
+// `./pbvbus test` installs nodes7 into the build folder (BUILD/nodes7) before the suite runs;
+// without it (npm unreachable) the test is skipped and says why.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 

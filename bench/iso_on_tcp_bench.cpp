@@ -34,7 +34,9 @@ using Bytes = std::vector<std::uint8_t>;
 class MsTick final : public bus::EventTarget {
  public:
   explicit MsTick(bus::Scheduler& s) : s_(s) { s_.schedule(bus::kTicksPerMs, *this); }
-  void on_event(bus::Ticks now, std::uint64_t) override { s_.schedule(now + bus::kTicksPerMs, *this); }
+  void on_event(bus::Ticks now, std::uint64_t) override {
+    s_.schedule(now + bus::kTicksPerMs, *this);
+  }
 
  private:
   bus::Scheduler& s_;

@@ -30,7 +30,11 @@ struct IsoOnTcpDoor::Impl : std::enable_shared_from_this<IsoOnTcpDoor::Impl> {
   using Links = std::list<std::shared_ptr<Link>>;
 
   Impl(asio::io_context& i, S7Router& r, IsoDoorOptions o)
-      : io(i), router(r), opt(std::move(o)), acceptor(i), backoff(i, "iso_on_tcp", opt.log),
+      : io(i),
+        router(r),
+        opt(std::move(o)),
+        acceptor(i),
+        backoff(i, "iso_on_tcp", opt.log),
         complaints(opt.log) {}
 
   void listen();
@@ -77,9 +81,9 @@ struct IsoOnTcpDoor::Impl::Link : std::enable_shared_from_this<Link> {
   Links::iterator pos;
   std::unique_ptr<IsoSession> session;
   std::array<std::uint8_t, kReadChunk> in{};
-  std::size_t in_at = 0;   // octets of `in` handed to the session
-  std::size_t in_end = 0;  // octets of `in` read
-  bool paused = false;     // reading stopped: too much output waits (flow control)
+  std::size_t in_at = 0;             // octets of `in` handed to the session
+  std::size_t in_end = 0;            // octets of `in` read
+  bool paused = false;               // reading stopped: too much output waits (flow control)
   std::vector<std::uint8_t> out;     // waiting for the socket
   std::vector<std::uint8_t> flying;  // handed to async_write
   bool writing = false;
@@ -178,7 +182,8 @@ void IsoOnTcpDoor::Impl::Link::start() {
   };
   // COTP references are 16 bits and non-zero on our side.
   const auto ref = static_cast<std::uint16_t>((id - 1) % 0xFFFF + 1);
-  session = std::make_unique<IsoSession>(door->router, door->opt.session, std::move(hooks), id, ref);
+  session =
+      std::make_unique<IsoSession>(door->router, door->opt.session, std::move(hooks), id, ref);
   last_progress = Clock::now();
   if (door->opt.idle_timeout.count() > 0) watch_idle(last_progress + door->opt.idle_timeout);
   read_more();
@@ -243,12 +248,23 @@ void IsoOnTcpDoor::Impl::Link::on_finish(SessionEnd e, const std::string& why) {
   auto& st = door->stats;
   bool log = true;
   switch (e) {
-    case SessionEnd::ClientDisconnect: ++st.disconnects; log = false; break;
-    case SessionEnd::Refused: ++st.connects_refused; break;
-    case SessionEnd::ChannelClosed: ++st.routes_closed; break;
-    case SessionEnd::QueueFull: ++st.closed_queue_full; break;
+    case SessionEnd::ClientDisconnect:
+      ++st.disconnects;
+      log = false;
+      break;
+    case SessionEnd::Refused:
+      ++st.connects_refused;
+      break;
+    case SessionEnd::ChannelClosed:
+      ++st.routes_closed;
+      break;
+    case SessionEnd::QueueFull:
+      ++st.closed_queue_full;
+      break;
     case SessionEnd::Garbage:
-    case SessionEnd::NoAnswer: ++st.closed_garbage; break;
+    case SessionEnd::NoAnswer:
+      ++st.closed_garbage;
+      break;
   }
   if (log)
     door->complaints(door->who + ": connection " + std::to_string(id) + " from " + peer() +
@@ -322,9 +338,9 @@ void IsoOnTcpDoor::Impl::Link::watch_idle(Clock::time_point at) {
     }
     const auto ms = std::to_string(self->door->opt.idle_timeout.count());
     if (self->paused)
-      self->drop(&IsoDoorStats::closed_stalled,
-                 std::to_string(self->unsent()) + " octets of answers unread for " + ms +
-                     " ms: the client does not read");
+      self->drop(&IsoDoorStats::closed_stalled, std::to_string(self->unsent()) +
+                                                    " octets of answers unread for " + ms +
+                                                    " ms: the client does not read");
     else
       self->drop(&IsoDoorStats::closed_idle, "no CR or S7 job for " + ms + " ms (half-open)");
   });
@@ -363,10 +379,18 @@ IsoOnTcpDoor::IsoOnTcpDoor(asio::io_context& io, S7Router& router, IsoDoorOption
   m->listen();
 }
 
-IsoOnTcpDoor::~IsoOnTcpDoor() { m->shut(); }
+IsoOnTcpDoor::~IsoOnTcpDoor() {
+  m->shut();
+}
 
-std::uint16_t IsoOnTcpDoor::port() const { return m->port; }
-const IsoDoorStats& IsoOnTcpDoor::stats() const { return m->stats; }
-void IsoOnTcpDoor::close() { m->shut(); }
+std::uint16_t IsoOnTcpDoor::port() const {
+  return m->port;
+}
+const IsoDoorStats& IsoOnTcpDoor::stats() const {
+  return m->stats;
+}
+void IsoOnTcpDoor::close() {
+  m->shut();
+}
 
 }  // namespace pbvbus::iso_on_tcp

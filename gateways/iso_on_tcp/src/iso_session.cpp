@@ -12,12 +12,18 @@ namespace pbvbus::iso_on_tcp {
 
 const char* to_string(SessionEnd e) {
   switch (e) {
-    case SessionEnd::ClientDisconnect: return "client disconnect";
-    case SessionEnd::Refused: return "connect refused";
-    case SessionEnd::ChannelClosed: return "route closed";
-    case SessionEnd::Garbage: return "garbage";
-    case SessionEnd::QueueFull: return "too many pipelined jobs";
-    case SessionEnd::NoAnswer: return "no answer";
+    case SessionEnd::ClientDisconnect:
+      return "client disconnect";
+    case SessionEnd::Refused:
+      return "connect refused";
+    case SessionEnd::ChannelClosed:
+      return "route closed";
+    case SessionEnd::Garbage:
+      return "garbage";
+    case SessionEnd::QueueFull:
+      return "too many pipelined jobs";
+    case SessionEnd::NoAnswer:
+      return "no answer";
   }
   return "?";
 }
@@ -31,7 +37,9 @@ IsoSession::IsoSession(S7Router& router, const SessionLimits& limits, Hooks hook
       own_ref_(own_ref),
       reasm_(s7::kTpktDefaultMaxLength) {}
 
-IsoSession::~IsoSession() { alive_.reset(); }
+IsoSession::~IsoSession() {
+  alive_.reset();
+}
 
 void IsoSession::feed(std::span<const std::uint8_t> in) {
   while (!finished_ && !in.empty()) {
@@ -55,8 +63,8 @@ void IsoSession::on_tpdu(std::span<const std::uint8_t> tpdu) {
   const auto code = s7::cotp_code(tpdu);
   if (!code.ok()) {
     if (channel_) send_error(s7::er_cause::kNotSpecified, tpdu);
-    end(SessionEnd::Garbage, "COTP TPDU does not decode (" +
-                                 std::string(s7::to_string(code.error)) + ")");
+    end(SessionEnd::Garbage,
+        "COTP TPDU does not decode (" + std::string(s7::to_string(code.error)) + ")");
     return;
   }
   if (!channel_) {
@@ -94,8 +102,7 @@ void IsoSession::on_connect_request(std::span<const std::uint8_t> tpdu) {
   const auto cr = s7::decode_connect_request(tpdu);
   if (!cr.ok()) {
     send_error(s7::er_cause::kInvalidParameterValue, tpdu);
-    end(SessionEnd::Garbage,
-        "CR does not decode (" + std::string(s7::to_string(cr.error)) + ")");
+    end(SessionEnd::Garbage, "CR does not decode (" + std::string(s7::to_string(cr.error)) + ")");
     return;
   }
   peer_ref_ = cr.value.src_ref;
@@ -112,8 +119,8 @@ void IsoSession::on_connect_request(std::span<const std::uint8_t> tpdu) {
     std::vector<std::uint8_t> dr;
     s7::append_disconnect_request(dr, peer_ref_, own_ref_, route.dr_reason);
     send_tpdu(dr);
-    end(SessionEnd::Refused, "CR refused (DR reason " + std::to_string(route.dr_reason) +
-                                 "): " + route.why);
+    end(SessionEnd::Refused,
+        "CR refused (DR reason " + std::to_string(route.dr_reason) + "): " + route.why);
     return;
   }
   channel_ = std::move(route.channel);
@@ -169,8 +176,7 @@ void IsoSession::on_job(std::vector<std::uint8_t> pdu) {
   }
   if (queue_.size() >= limits_.max_queued_jobs) {
     end(SessionEnd::QueueFull, std::to_string(in_flight_) + " jobs outstanding (AmQ " +
-                                   std::to_string(amq_) + ") and " +
-                                   std::to_string(queue_.size()) +
+                                   std::to_string(amq_) + ") and " + std::to_string(queue_.size()) +
                                    " waiting (max_queued_jobs): the client pipelines more "
                                    "jobs than the connection allows");
     return;
@@ -210,9 +216,9 @@ void IsoSession::on_answer(std::vector<std::uint8_t> answer) {
   ++answers_;
   capture(PduDirection::ToClient, answer);
   // The Setup Communication answer fixes how many jobs may be outstanding (max AmQ called).
-  if (const auto h = s7::decode_s7_pdu(answer);
-      h.ok() && h.value.header.type == s7::kS7AckData && !h.value.params.empty() &&
-      h.value.params[0] == s7::kFnSetupCommunication) {
+  if (const auto h = s7::decode_s7_pdu(answer); h.ok() && h.value.header.type == s7::kS7AckData &&
+                                                !h.value.params.empty() &&
+                                                h.value.params[0] == s7::kFnSetupCommunication) {
     if (const auto setup = s7::decode_setup_communication(h.value); setup.ok())
       amq_ = std::max<std::size_t>(1, setup.value.max_amq_called);
   }

@@ -62,8 +62,7 @@ RouteResult LocalCpuRouter::open(const RouteRequest& request) {
     r.channel = std::make_unique<LocalChannel>(e.cpu, e.open);
     return r;
   }
-  return RouteResult::refuse(s7::dr_reason::kAddressUnknown,
-                             "no CPU at " + where(t.rack, t.slot));
+  return RouteResult::refuse(s7::dr_reason::kAddressUnknown, "no CPU at " + where(t.rack, t.slot));
 }
 
 std::size_t LocalCpuRouter::connections(std::uint8_t rack, std::uint8_t slot) const {

@@ -34,8 +34,9 @@ class DoorFixture {
  public:
   /// `route_via` (built on this->router by the caller, e.g. a wrapper) replaces the router the
   /// door sees; the default is `router` itself.
-  explicit DoorFixture(IsoDoorOptions opt = {}, s7::SetupCommunication limits = {1, 1, 240},
-                       std::function<S7Router&(LocalCpuRouter&, boost::asio::io_context&)> route_via = {}) {
+  explicit DoorFixture(
+      IsoDoorOptions opt = {}, s7::SetupCommunication limits = {1, 1, 240},
+      std::function<S7Router&(LocalCpuRouter&, boost::asio::io_context&)> route_via = {}) {
     memory.create_db(1, 64);
     LocalCpu cpu;
     cpu.rack = 0;
@@ -176,17 +177,38 @@ inline const Bytes kSetupResp = {0x03, 0x00, 0x00, 0x1B, 0x02, 0xF0, 0x80, 0x32,
 /// TPKT + DT around an S7 PDU.
 inline Bytes tpkt_dt(const Bytes& pdu) {
   const std::size_t len = 7 + pdu.size();
-  Bytes b = {0x03, 0x00, static_cast<std::uint8_t>(len >> 8), static_cast<std::uint8_t>(len),
-             0x02, 0xF0, 0x80};
+  Bytes b = {0x03, 0x00, static_cast<std::uint8_t>(len >> 8), static_cast<std::uint8_t>(len), 0x02,
+             0xF0, 0x80};
   b.insert(b.end(), pdu.begin(), pdu.end());
   return b;
 }
 
 /// Read Var of DB1.DBB0, 10 bytes (§H.4's example), PDU reference `ref`.
 inline Bytes read_db1_10(std::uint16_t ref = 1) {
-  return tpkt_dt({0x32, 0x01, 0x00, 0x00, static_cast<std::uint8_t>(ref >> 8),
-                  static_cast<std::uint8_t>(ref), 0x00, 0x0E, 0x00, 0x00, 0x04, 0x01, 0x12, 0x0A,
-                  0x10, 0x02, 0x00, 0x0A, 0x00, 0x01, 0x84, 0x00, 0x00, 0x00});
+  return tpkt_dt({0x32,
+                  0x01,
+                  0x00,
+                  0x00,
+                  static_cast<std::uint8_t>(ref >> 8),
+                  static_cast<std::uint8_t>(ref),
+                  0x00,
+                  0x0E,
+                  0x00,
+                  0x00,
+                  0x04,
+                  0x01,
+                  0x12,
+                  0x0A,
+                  0x10,
+                  0x02,
+                  0x00,
+                  0x0A,
+                  0x00,
+                  0x01,
+                  0x84,
+                  0x00,
+                  0x00,
+                  0x00});
 }
 
 /// kCc with the door's reference of another connection (octets 8..9).
@@ -201,7 +223,8 @@ inline Bytes cc_with_ref(std::uint16_t ref) {
 inline bool open_s7(Client& c) {
   if (!c.send(kCr)) return false;
   const Bytes cc = c.recv_tpkt();
-  if (cc.size() != kCc.size() || cc != cc_with_ref(static_cast<std::uint16_t>((cc[8] << 8) | cc[9])))
+  if (cc.size() != kCc.size() ||
+      cc != cc_with_ref(static_cast<std::uint16_t>((cc[8] << 8) | cc[9])))
     return false;
   return c.send(kSetupReq) && c.recv_tpkt() == kSetupResp;
 }

@@ -22,14 +22,15 @@ bool exists(const std::string& p) {
   return ::stat(p.c_str(), &st) == 0;
 }
 
-std::string nodes7_dir() { return std::string(PBVBUS_BINARY_DIR) + "/nodes7/node_modules"; }
+std::string nodes7_dir() {
+  return std::string(PBVBUS_BINARY_DIR) + "/nodes7/node_modules";
+}
 
 /// Runs the client script against `port`; its `key=value` lines (value as JSON text).
 std::map<std::string, std::string> run_client(std::uint16_t port, std::string& all) {
-  const std::string cmd = "NODE_PATH='" + nodes7_dir() + "' node '" +
-                          std::string(PBVBUS_SOURCE_DIR) +
-                          "/tests/gateways/iso_on_tcp/data/nodes7_client.js' " +
-                          std::to_string(port) + " 2>&1";
+  const std::string cmd =
+      "NODE_PATH='" + nodes7_dir() + "' node '" + std::string(PBVBUS_SOURCE_DIR) +
+      "/tests/gateways/iso_on_tcp/data/nodes7_client.js' " + std::to_string(port) + " 2>&1";
   std::map<std::string, std::string> kv;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return kv;
@@ -100,7 +101,7 @@ TEST(Nodes7, ReadsAndWritesASingleCpuThroughTheDoor) {
   f.on_io([&] {
     const auto db = *f.memory.db(1);
     EXPECT_EQ(db[20], 0x5A);
-    EXPECT_EQ(s7cpu::get_word(db, 22), 0xFB2E);      // -1234 as INT
+    EXPECT_EQ(s7cpu::get_word(db, 22), 0xFB2E);        // -1234 as INT
     EXPECT_EQ(s7cpu::get_dword(db, 24), 0x40600000u);  // 3.5 as REAL
     EXPECT_EQ(s7cpu::get_word(db, 28), 0xBEEF);
     EXPECT_EQ(f.memory.area(s7cpu::Area::Flags)[20], 7);

@@ -53,7 +53,7 @@ struct IsoDoorOptions {
   std::string address = "127.0.0.1";  ///< loopback unless told otherwise
   std::uint16_t port = kIsoTsapPort;  ///< 0 = an ephemeral port (see port())
   std::size_t max_clients = gateways::kDefaultMaxClients;
-  std::size_t max_output = 64 * 1024;  ///< octets of unsent answers per connection
+  std::size_t max_output = 64 * 1024;              ///< octets of unsent answers per connection
   std::chrono::milliseconds idle_timeout{60'000};  ///< zero = never
   SessionLimits session{};
   gateways::DoorLog log{};  ///< refusals, bad closes, accept() failures (empty: none)
@@ -61,20 +61,20 @@ struct IsoDoorOptions {
 };
 
 struct IsoDoorStats {
-  std::uint64_t clients_accepted = 0;  ///< TCP connections taken
-  std::uint64_t clients_now = 0;       ///< open now
-  std::uint64_t clients_refused = 0;   ///< closed at once: max_clients reached
-  std::uint64_t connects = 0;          ///< CRs confirmed (CC sent)
-  std::uint64_t connects_refused = 0;  ///< CRs the router refused (DR sent)
-  std::uint64_t disconnects = 0;       ///< DRs from clients (DC sent)
-  std::uint64_t routes_closed = 0;     ///< channels that closed (DR sent)
-  std::uint64_t closed_garbage = 0;    ///< framing, TPDU or S7 PDU refused; no answer
-  std::uint64_t closed_queue_full = 0; ///< pipelined past AmQ + max_queued_jobs
-  std::uint64_t closed_stalled = 0;    ///< more than max_output waiting
-  std::uint64_t closed_idle = 0;       ///< no progress for idle_timeout
-  std::uint64_t accept_pauses = 0;     ///< accept() failed (out of descriptors): paused
-  std::uint64_t jobs = 0;              ///< S7 jobs from clients
-  std::uint64_t answers = 0;           ///< S7 answers to clients
+  std::uint64_t clients_accepted = 0;   ///< TCP connections taken
+  std::uint64_t clients_now = 0;        ///< open now
+  std::uint64_t clients_refused = 0;    ///< closed at once: max_clients reached
+  std::uint64_t connects = 0;           ///< CRs confirmed (CC sent)
+  std::uint64_t connects_refused = 0;   ///< CRs the router refused (DR sent)
+  std::uint64_t disconnects = 0;        ///< DRs from clients (DC sent)
+  std::uint64_t routes_closed = 0;      ///< channels that closed (DR sent)
+  std::uint64_t closed_garbage = 0;     ///< framing, TPDU or S7 PDU refused; no answer
+  std::uint64_t closed_queue_full = 0;  ///< pipelined past AmQ + max_queued_jobs
+  std::uint64_t closed_stalled = 0;     ///< a client that does not read (held back, or max_output)
+  std::uint64_t closed_idle = 0;        ///< no progress for idle_timeout
+  std::uint64_t accept_pauses = 0;      ///< accept() failed (out of descriptors): paused
+  std::uint64_t jobs = 0;               ///< S7 jobs from clients
+  std::uint64_t answers = 0;            ///< S7 answers to clients
 };
 
 class IsoOnTcpDoor {

@@ -67,30 +67,7 @@ struct SessionRig {
 
 /// A Read Var job (DB1.DBB0, 1 byte) with PDU reference `ref`, in TPKT + DT.
 Bytes job(std::uint16_t ref) {
-  return tpkt_dt({0x32,
-                  0x01,
-                  0x00,
-                  0x00,
-                  static_cast<std::uint8_t>(ref >> 8),
-                  static_cast<std::uint8_t>(ref),
-                  0x00,
-                  0x0E,
-                  0x00,
-                  0x00,
-                  0x04,
-                  0x01,
-                  0x12,
-                  0x0A,
-                  0x10,
-                  0x02,
-                  0x00,
-                  0x01,
-                  0x00,
-                  0x01,
-                  0x84,
-                  0x00,
-                  0x00,
-                  0x00});
+  return read_db1(ref, 1);
 }
 std::uint16_t ref_of(const Bytes& pdu) {
   return static_cast<std::uint16_t>((pdu[4] << 8) | pdu[5]);

@@ -183,32 +183,17 @@ inline Bytes tpkt_dt(const Bytes& pdu) {
   return b;
 }
 
-/// Read Var of DB1.DBB0, 10 bytes (§H.4's example), PDU reference `ref`.
+/// Read Var of DB1.DBB0, `count` bytes, PDU reference `ref` (the layout of §H.4's example).
+inline Bytes read_db1(std::uint16_t ref, std::uint8_t count) {
+  const auto hi = static_cast<std::uint8_t>(ref >> 8);
+  const auto lo = static_cast<std::uint8_t>(ref);
+  return tpkt_dt({0x32, 0x01, 0x00, 0x00, hi,   lo,    0x00, 0x0E, 0x00, 0x00, 0x04, 0x01,
+                  0x12, 0x0A, 0x10, 0x02, 0x00, count, 0x00, 0x01, 0x84, 0x00, 0x00, 0x00});
+}
+
+/// §H.4's example: DB1.DBB0, 10 bytes.
 inline Bytes read_db1_10(std::uint16_t ref = 1) {
-  return tpkt_dt({0x32,
-                  0x01,
-                  0x00,
-                  0x00,
-                  static_cast<std::uint8_t>(ref >> 8),
-                  static_cast<std::uint8_t>(ref),
-                  0x00,
-                  0x0E,
-                  0x00,
-                  0x00,
-                  0x04,
-                  0x01,
-                  0x12,
-                  0x0A,
-                  0x10,
-                  0x02,
-                  0x00,
-                  0x0A,
-                  0x00,
-                  0x01,
-                  0x84,
-                  0x00,
-                  0x00,
-                  0x00});
+  return read_db1(ref, 10);
 }
 
 /// kCc with the door's reference of another connection (octets 8..9).

@@ -27,7 +27,7 @@
 #include <string_view>
 
 #include "pbvbus/bus/time.hpp"
-#include "tcp_accept.hpp"
+#include "pbvbus/tcp_door/tcp_accept.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;

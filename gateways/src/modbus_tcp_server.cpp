@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "pbvbus/gateways/modbus_frame.hpp"
-#include "tcp_accept.hpp"
-#include "throttled_log.hpp"
+#include "pbvbus/tcp_door/tcp_accept.hpp"
+#include "pbvbus/tcp_door/throttled_log.hpp"
 
 namespace pbvbus::gateways {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "door_stream.hpp"
-#include "throttled_log.hpp"
+#include "pbvbus/tcp_door/throttled_log.hpp"
 #include "pbvbus/bus/paced_runner.hpp"
 
 namespace pbvbus::gateways {

@@ -9,7 +9,8 @@ Checks, from the source tree alone:
      bottom first), so dependencies point downward only;
   3. every `#include "pbvbus/<name>/..."` in a target's folder names the target itself or one it
      reaches through its dependencies (a header-only upward include links, so CMake alone would
-     not catch it);
+     not catch it); a file in a nested target's folder (gateways/iso_on_tcp inside gateways/)
+     is checked as that target's only: the longest folder that contains it wins;
   4. the tests mirror the tree: every tests/<folder>/ with *_test.cpp files belongs to a target of
      the same folder (or is one of the cross-cutting suites: integration, hotpath, support, fuzz, layout).
 Exit status 0 when all hold; otherwise each problem on its own line and exit status 1.
@@ -102,9 +103,21 @@ def main():
     for name, (folder, _) in targets.items():
         for d in (ROOT / folder / "include/pbvbus").glob("*"):
             inc_owner[d.name] = name
+    # A target's folder may hold another target's folder (gateways/ holds gateways/iso_on_tcp):
+    # each file belongs to the target with the longest folder that contains it.
+    def owner_of(src):
+        rel = src.relative_to(ROOT).as_posix()
+        best = None
+        for n, (f, _) in targets.items():
+            if rel.startswith(f + "/") and (best is None or len(f) > len(targets[best][0])):
+                best = n
+        return best
+
     for name, (folder, _) in sorted(targets.items()):
         allowed = reach(name) | {name}
         for src in sorted((ROOT / folder).rglob("*.[ch]pp")):
+            if owner_of(src) != name:
+                continue
             for inc in re.findall(r'#include "pbvbus/(\w+)/', src.read_text()):
                 owner = inc_owner.get(inc)
                 if owner and owner not in allowed:

@@ -52,7 +52,7 @@
 #include <string>
 
 #include "pbvbus/gateways/modbus_handler.hpp"
-#include "pbvbus/gateways/tcp_door_limits.hpp"
+#include "pbvbus/tcp_door/tcp_door_limits.hpp"
 
 namespace pbvbus::gateways {
 

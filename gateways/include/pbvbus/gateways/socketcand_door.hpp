@@ -37,7 +37,7 @@
 
 #include "pbvbus/gateways/can_frame.hpp"
 #include "pbvbus/gateways/socketcand.hpp"
-#include "pbvbus/gateways/tcp_door_limits.hpp"
+#include "pbvbus/tcp_door/tcp_door_limits.hpp"
 
 namespace pbvbus::bus {
 class PacedRunner;

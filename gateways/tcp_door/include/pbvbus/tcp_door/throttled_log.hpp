@@ -1,5 +1,5 @@
 #pragma once
-// A DoorLog that passes at most one line per interval (private to the gateways layer). A door
+// A DoorLog that passes at most one line per interval (shared by the TCP doors). A door
 // logs each client it refuses or evicts, but a hostile client can cause thousands of those a
 // second: the first line goes out at once, the ones in the rest of the interval are only
 // counted, and the next line that goes out says how many were held back. The door's counters
@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string>
 
-#include "pbvbus/gateways/tcp_door_limits.hpp"
+#include "pbvbus/tcp_door/tcp_door_limits.hpp"
 
 namespace pbvbus::gateways {
 

@@ -1,4 +1,4 @@
-#include "throttled_log.hpp"
+#include "pbvbus/tcp_door/throttled_log.hpp"
 
 namespace pbvbus::gateways {
 

@@ -1,8 +1,8 @@
 #pragma once
-// The listening side every TCP door of the gateways layer shares (private to the layer): the
-// listen backlog, the kernel send buffer of accepted connections, and what accept() does when
-// it fails. Modbus TCP (an asio acceptor) and the CAN doors (door_stream::TcpListener) both use
-// it, so the rules are written once.
+// The listening side every TCP door shares: the listen backlog, the kernel send buffer of
+// accepted connections, and what accept() does when it fails. Modbus TCP and the ISO-on-TCP
+// door (asio acceptors) and the CAN doors (door_stream::TcpListener) all use it, so the rules
+// are written once.
 //
 // Decisions (also in docs/gateway-modbus-doors.md, docs/gateway-can-doors.md):
 //  - Backlog SOMAXCONN (4096 in glibc; the kernel clamps it to net.core.somaxconn): a burst of
@@ -30,7 +30,7 @@
 #include <memory>
 #include <string>
 
-#include "pbvbus/gateways/tcp_door_limits.hpp"
+#include "pbvbus/tcp_door/tcp_door_limits.hpp"
 
 namespace pbvbus::gateways::tcp_accept {
 

@@ -1,4 +1,4 @@
-#include "tcp_accept.hpp"
+#include "pbvbus/tcp_door/tcp_accept.hpp"
 
 #include <cstring>
 

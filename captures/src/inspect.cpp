@@ -68,6 +68,8 @@ std::string link_name(std::uint16_t lt) {
       return "USER0";
     case 148:
       return "USER1";
+    case 252:
+      return "UPPER_PDU";
     case 257:
       return "PROFIBUS_DL";
     default:

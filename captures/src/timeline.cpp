@@ -13,6 +13,7 @@
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "saturate.hpp"
 #include "capture_names.hpp"
+#include "timeline_mpi.hpp"
 
 namespace pbvbus::captures {
 
@@ -193,6 +194,7 @@ void finish_lane(LaneWork& w, std::int64_t from, i128 to) {
     lane_end = std::max(lane_end, f.end_ns);
   }
   if (!spans.empty()) spans.back().end_ns = std::max(spans.back().start_ns, lane_end);
+  lane.mpi = mpi_connections(frames, lane.mpi_marked, lane_end, from, to);
 
   // The window.
   auto overlaps = [&](std::int64_t s, std::int64_t e) {
@@ -417,6 +419,16 @@ std::string_view to_string(FrameKind k) {
   return "?";
 }
 
+std::string_view to_string(MpiState s) {
+  switch (s) {
+    case MpiState::Connecting:
+      return "connecting";
+    case MpiState::Connected:
+      return "connected";
+  }
+  return "?";
+}
+
 std::string_view to_string(EventStyle s) {
   switch (s) {
     case EventStyle::Fault:
@@ -468,6 +480,7 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
         w.lane.description = i.description;
         w.lane.link_type = i.link_type;
         w.lane.speed = i.speed <= kMaxSpeed ? i.speed : 0;
+        w.lane.mpi_marked = is_mpi_description(i.description);
         lane_of.push_back(static_cast<int>(lanes.size()));
         lanes.push_back(std::move(w));
       } else if (is_events_link(i.link_type)) {

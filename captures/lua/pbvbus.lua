@@ -13,7 +13,12 @@
 --   resource manager, negative responses.                                       fields pbdpv1.*
 --   Slave redundancy (PI 2.212, §G.2/G.3): the PrmCmd block in Set_Prm        fields pbdp.prmcmd.*
 --   and the Prm_Cmd_Ack/Red_Status status blocks in Slave_Diag.                fields pbdp.red.*
+--   MPI connection layer (§H.2/§H.3, docs/mpi.md): connect request/confirm, connection and
+--   data acks, data messages with their numbers, disconnect; the S7 PDU of a data message is
+--   handed to Wireshark's own s7comm (§H.4).                                    fields pbmpi.*
 -- and on USER1 (148) pbvbus event records (captures/include/pbvbus/captures/event_record.hpp).
+-- S7 PDUs that the writer stores as upper-PDU records (link type 252) need no script: tshark's
+-- exported_pdu dissector hands them to s7comm by the heuristic name in their tags.
 --                                                                               fields pbevent.*
 --
 -- Decisions where the wire alone cannot tell:
@@ -26,8 +31,9 @@
 --     blocks (with a warning); a pure PrmCmd is a Set_Prm of exactly 7 + 3 + 8 octets with one
 --     PrmCmd block (§G.2 [I]). The Specifier octet is read as Seq_Nr in bits 7..3 and the
 --     specifier in bits 1..0, the PrmCmd Properties bits in the AUMA order (both [U]).
---   * SAPs 0..48 with the class-2 master SAP 50 on the other side are MSAC_C2 connections; other
---     SAP pairs (MPI among them) are shown as FDL data and not decoded further.
+--   * SAPs 0..48 with the class-2 master SAP 50 on the other side are MSAC_C2 connections.
+--   * MPI is detected by the rule in the MPI section below (captures/README.md "MPI and S7");
+--     other SAP pairs are shown as FDL data and not decoded further.
 
 local fdl = Proto("pbfdl", "PROFIBUS FDL")
 local dp = Proto("pbdp", "PROFIBUS DP")

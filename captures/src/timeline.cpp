@@ -84,7 +84,7 @@ void flag_reasons(std::uint32_t flags, std::string& out) {
   }
 }
 
-TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed) {
+TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed, bool mpi_marked) {
   TimelineFrame f;
   f.start_ns = r.ts_ns;
   f.end_ns = saturate(static_cast<i128>(r.ts_ns) + frame_duration_ns(r.bytes.size(), speed));
@@ -123,6 +123,8 @@ TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed) {
     f.kind = FrameKind::Sc;
   } else {
     f.kind = fdl::fc_is_request(t.fc) ? FrameKind::Request : FrameKind::Response;
+    if (f.kind == FrameKind::Request)
+      if (const auto m = mpi_frame(f.bytes, mpi_marked)) f.mpi = mpi_pdu_words(m->pdu);
   }
   return f;
 }
@@ -499,7 +501,7 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     const int l = lane_of[r.interface];
     if (l >= 0) {
       LaneWork& w = lanes[static_cast<std::size_t>(l)];
-      w.frames.push_back(make_frame(r, w.lane.speed));
+      w.frames.push_back(make_frame(r, w.lane.speed, w.lane.mpi_marked));
       note(w.frames.back().start_ns, w.frames.back().end_ns);
     } else if (l == -1) {
       auto e = decode_event(r.bytes);
@@ -637,12 +639,17 @@ std::string describe(const TimelineFrame& f) {
        (f.ssap ? std::to_string(*f.ssap) : std::string("-"));
   const std::optional<std::uint8_t> sap = req ? f.dsap : f.ssap;
   std::string service;
-  if (sap) {
+  if (!f.mpi.empty()) {
+    service = "MPI " + f.mpi;
+  } else if (sap) {
     service = std::string(sap_service(*sap));
   } else if (req ? (f.fc != fdl::kFcClockValue && is_srd(f)) : is_data_response(f)) {
     service = "Data_Exchange";
   }
-  if (!service.empty()) o += " (" + service + (req ? ".req" : ".res") + ")";
+  if (!f.mpi.empty())
+    o += " (" + service + ")";
+  else if (!service.empty())
+    o += " (" + service + (req ? ".req" : ".res") + ")";
   o += "\n";
   std::snprintf(buf, sizeof buf, "%zu octets, %zu data octets", n, f.data_len);
   o += buf;

@@ -49,7 +49,9 @@ std::string addr(std::uint8_t a, int sap) {
   return std::to_string(a) + ":" + (sap < 0 ? std::string("?") : std::to_string(sap));
 }
 
-std::string pdu_words(const mpi::Pdu& p) {
+}  // namespace
+
+std::string mpi_pdu_words(const mpi::Pdu& p) {
   switch (p.type) {
     case mpi::PduType::ConnectRequest:
       return "connect request";
@@ -66,6 +68,8 @@ std::string pdu_words(const mpi::Pdu& p) {
   }
   return "?";
 }
+
+namespace {
 
 std::uint8_t first_octet(mpi::PduType t) {
   switch (t) {
@@ -103,6 +107,24 @@ void open_span(Work& w, std::int64_t at, MpiState s) {
 }
 
 }  // namespace
+
+std::string_view mpi_pdu_name(mpi::PduType t) {
+  switch (t) {
+    case mpi::PduType::ConnectRequest:
+      return "Connect request";
+    case mpi::PduType::ConnectConfirm:
+      return "Connect confirm";
+    case mpi::PduType::ConnectionAck:
+      return "Connection ack";
+    case mpi::PduType::Data:
+      return "Data";
+    case mpi::PduType::DataAck:
+      return "Data ack";
+    case mpi::PduType::DisconnectRequest:
+      return "Disconnect request";
+  }
+  return "?";
+}
 
 bool is_mpi_description(std::string_view d) {
   return d.substr(0, 3) == "MPI";
@@ -183,7 +205,7 @@ std::vector<MpiConnection> mpi_connections(const std::vector<TimelineFrame>& fra
     return it->second;
   };
   for (const TimelineFrame& f : frames) {
-    if (f.kind != FrameKind::Request) continue;
+    if (f.kind != FrameKind::Request || f.mpi.empty()) continue;  // make_frame() found no MPI
     const auto m = mpi_frame(f.bytes, marked);
     if (!m) continue;
     const mpi::Pdu& p = m->pdu;
@@ -191,7 +213,7 @@ std::vector<MpiConnection> mpi_connections(const std::vector<TimelineFrame>& fra
     mark.ts_ns = f.start_ns;
     mark.pdu = first_octet(p.type);
     if (p.type == mpi::PduType::Data || p.type == mpi::PduType::DataAck) mark.nr = p.message_number;
-    mark.text = pdu_words(p) + " " + addr(m->sa, m->ssap) + "\u2192" + addr(m->da, m->dsap);
+    mark.text = mpi_pdu_words(p) + " " + addr(m->sa, m->ssap) + "\u2192" + addr(m->da, m->dsap);
     if (p.type == mpi::PduType::Data) {
       const std::string s7 = s7_summary(p.data);
       if (!s7.empty()) mark.text += ": " + s7;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -24,6 +25,13 @@ struct MpiFrame {
 };
 /// The MPI PDU of a frame's octets, if the frame is MPI (`marked`: the interface is marked MPI).
 std::optional<MpiFrame> mpi_frame(std::span<const std::uint8_t> bytes, bool marked);
+
+/// "Connect request", "Connect confirm", "Connection ack", "Data", "Data ack",
+/// "Disconnect request" (the Lua dissector's pbmpi.pdu_name).
+std::string_view mpi_pdu_name(mpi::PduType t);
+
+/// "connect request", "data 0", "data ack 7", ... (the timeline's marks).
+std::string mpi_pdu_words(const mpi::Pdu& p);
 
 /// A few words on an S7 PDU for a mark: "S7 job Read Var, 1 item", "S7 ack-data Read Var,
 /// 1 item", "S7 ack-data error 0x81/0x04"; "" when it does not start like an S7 PDU (0x32).

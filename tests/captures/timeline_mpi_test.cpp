@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -127,6 +128,12 @@ TEST(TimelineMpi, OneConnectionFromTheTraceFrames) {
   EXPECT_EQ(c.marks[8].text, "disconnect request 0:20\u21922:20");
   EXPECT_EQ(c.data_messages, 2u);
   EXPECT_EQ(c.data_acks, 2u);
+  // The frame's own description names its MPI PDU instead of a DP service.
+  ASSERT_EQ(L.frames.size(), 9u);
+  EXPECT_EQ(L.frames[4].mpi, "data 0");
+  const std::string d = describe(L.frames[4]);
+  EXPECT_NE(d.find("DSAP 20, SSAP 20 (MPI data 0)\n"), std::string::npos) << d;
+  EXPECT_EQ(describe(L.frames[0]).find("MSAC_C2"), std::string::npos);
 }
 
 TEST(TimelineMpi, WindowCutsSpansAndMarks) {
@@ -255,13 +262,26 @@ TEST(S7UpperPdu, InspectCountsTheRecords) {
   ASSERT_TRUE(s) << err.to_string();
   ASSERT_EQ(s->interfaces.size(), 2u);
   EXPECT_EQ(s->interfaces[0].frames, 9u);
+  EXPECT_TRUE(s->interfaces[0].by_service.empty());  // no MSAC_C2 for the SAPs 0 and 20
+  EXPECT_EQ(s->interfaces[0].by_mpi,
+            (std::map<std::string, std::uint64_t>{{"Connect confirm", 1},
+                                                  {"Connect request", 1},
+                                                  {"Connection ack", 2},
+                                                  {"Data", 2},
+                                                  {"Data ack", 2},
+                                                  {"Disconnect request", 1}}));
   EXPECT_EQ(s->interfaces[1].link_type, 252);
   EXPECT_EQ(s->interfaces[1].frames, 2u);
   const std::string text = to_text(*s);
   EXPECT_NE(text.find("Interface 1 's7door' (UPPER_PDU, speed unknown): 2 records"),
             std::string::npos)
       << text;
+  EXPECT_NE(text.find("  MPI PDUs: Connect confirm 1, Connect request 1, Connection ack 2, Data 2, "
+                      "Data ack 2, Disconnect request 1\n"),
+            std::string::npos)
+      << text;
   EXPECT_NE(to_json(*s).find("\"link_type\":252"), std::string::npos);
+  EXPECT_NE(to_json(*s).find("\"mpi_pdus\":{\"Connect confirm\":1,"), std::string::npos);
 }
 
 TEST(S7UpperPdu, OnlyOnS7Interfaces) {

@@ -144,6 +144,9 @@ struct TimelineFrame {
   std::optional<std::uint8_t> dsap;
   std::optional<std::uint8_t> ssap;
   std::size_t data_len = 0;  ///< DU octets after the extension octets
+  /// The frame's MPI PDU in words ("data 0", "connect request") when it is MPI by the rule of
+  /// "MPI connections" below; "" otherwise.
+  std::string mpi;
   /// Why the frame is bad ("" if it is not): the writer's comment, else the epb_flags error
   /// bits in words, plus the decoder's reason.
   std::string problem;

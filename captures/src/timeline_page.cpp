@@ -395,7 +395,7 @@ function drawDx(s, L) {
 
 // MPI connection rows (timeline.hpp "MPI connections"), as in the SVG.
 const MPI_STATE_NAMES = ['connecting', 'connected'];
-function mpiSpanColour(st) { return st === 1 ? '#a5d8ff' : '#e7f5ff'; }
+function mpiSpanColour(st) { return st === 1 ? '#a5d8ff' : '#dee2e6'; }
 function mpiMarkColour(m) {
   switch (m[1]) {
     case 0xE0: case 0xD0: return '#7048e8';

@@ -239,7 +239,7 @@ constexpr const char* kObColour = "#212529";
 
 // MPI connection rows (timeline.hpp "MPI connections").
 const char* mpi_span_colour(MpiState s) {
-  return s == MpiState::Connected ? "#a5d8ff" : "#e7f5ff";
+  return s == MpiState::Connected ? "#a5d8ff" : "#dee2e6";
 }
 /// Connect request/confirm purple, connection acks grey, data from the initiator blue, data
 /// from the responder green, data acks light grey, disconnect orange.
@@ -1111,8 +1111,9 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     for (const auto& S : L.slaves) summary.push_back("    " + cycle_text(S, L.speed));
     for (const auto& C : L.mpi)
       summary.push_back("    MPI " + mpi_connection_label(C) + ": " +
-                        std::to_string(C.data_messages) + " data messages, " +
-                        std::to_string(C.data_acks) + " data acks" +
+                        std::to_string(C.data_messages) +
+                        (C.data_messages == 1 ? " data message, " : " data messages, ") +
+                        std::to_string(C.data_acks) + (C.data_acks == 1 ? " data ack" : " data acks") +
                         (C.setup_seen ? "" : " (set-up not in the capture)"));
   }
   const int height = lanes_end + 24 + static_cast<int>(summary.size()) * 16 + 10;

@@ -100,8 +100,14 @@ void close_span(Work& w, std::int64_t at) {
   w.open = false;
 }
 
+/// A new span from `at`, or from the end of the row's last span if that is later (a connect
+/// confirm opens its span at the connect request, which may lie before PDUs already seen).
 void open_span(Work& w, std::int64_t at, MpiState s) {
   close_span(w, at);
+  // A span closed at the instant it opened says nothing.
+  if (!w.c.spans.empty() && w.c.spans.back().end_ns == w.c.spans.back().start_ns)
+    w.c.spans.pop_back();
+  if (!w.c.spans.empty()) at = std::max(at, w.c.spans.back().end_ns);
   w.c.spans.push_back({at, at, s});
   w.open = true;
 }

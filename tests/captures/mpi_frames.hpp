@@ -62,4 +62,53 @@ inline const std::vector<Bytes>& mpi_exchange() {
   return v;
 }
 
+/// Seeded mutations of the MPI exchange for robustness tests: the DU after DSAP/SSAP is cut,
+/// overwritten or grown (also the PDU type octet and the S7 PDU inside data messages), and the
+/// SAP octets and addresses sometimes changed; LE and the FCS are set right again so that every
+/// frame reaches the MPI decoders. Not a golden: only "no crash, no Lua error" is checked.
+class MpiMutator {
+ public:
+  explicit MpiMutator(std::uint64_t seed) : m_rng(seed) {}
+  Bytes next_frame() {
+    const auto& ex = mpi_exchange();
+    Bytes b = ex[next() % ex.size()];
+    const std::size_t du = 9, end = b.size() - 2;
+    switch (next() % 5) {
+      case 0:
+        b.erase(b.begin() + static_cast<std::ptrdiff_t>(du + next() % (end - du)),
+                b.begin() + static_cast<std::ptrdiff_t>(end));
+        break;
+      case 1:
+        for (int k = 0; k < 3; ++k) b[du + next() % (end - du)] = static_cast<std::uint8_t>(next());
+        break;
+      case 2:
+        b.insert(b.begin() + static_cast<std::ptrdiff_t>(end), static_cast<std::uint8_t>(next()));
+        break;
+      case 3:  // another PDU type octet, the rest kept
+        b[du] = kTypes[next() % sizeof kTypes];
+        break;
+      default:  // other SAPs (with the extension bits kept) or addresses
+        b[7] = static_cast<std::uint8_t>(next() % 64);
+        b[8] = static_cast<std::uint8_t>(next() % 64);
+        if (next() % 2) b[4] = static_cast<std::uint8_t>(0x80 | (next() % 8));
+        break;
+    }
+    b[1] = b[2] = static_cast<std::uint8_t>(b.size() - 6);
+    unsigned sum = 0;
+    for (std::size_t k = 4; k + 2 < b.size(); ++k) sum += b[k];
+    b[b.size() - 2] = static_cast<std::uint8_t>(sum);
+    return b;
+  }
+
+ private:
+  static constexpr std::uint8_t kTypes[] = {0xE0, 0xD0, 0x05, 0xF1, 0xB0, 0x80, 0x32, 0x00};
+  std::uint64_t next() {
+    m_rng ^= m_rng << 13;
+    m_rng ^= m_rng >> 7;
+    m_rng ^= m_rng << 17;
+    return m_rng;
+  }
+  std::uint64_t m_rng;
+};
+
 }  // namespace pbvbus::captures::test

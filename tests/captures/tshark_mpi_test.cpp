@@ -184,5 +184,28 @@ TEST_F(TsharkMpi, InterfacesAsDeclared) {
       << r.out;
 }
 
+TEST(TsharkMpiRobustness, MutatedMpiFramesDecodeWithoutLuaErrors) {
+  if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  const auto path = test::temp_capture_path("pbvbus_tshark_mpi_garbage");
+  {
+    bus::Scheduler sched;
+    bus::Line mpi(sched, "mpiA", bus::Baud::k187_5);
+    bus::Line dp(sched, "dpA", bus::Baud::k187_5);
+    auto w = PcapngWriter::open(path, {});
+    ASSERT_TRUE(w);
+    w->mark_mpi(mpi);
+    test::MpiMutator mut(0x5EED'0187'0005ULL);
+    for (int i = 0; i < 400; ++i)
+      w->on_frame(test::tap_frame(i % 2 ? mpi : dp, mut.next_frame(), (i + 1) * 100'000));
+  }
+  const auto r = ts::tshark(path, {"-V"});
+  std::filesystem::remove(path);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  const auto at = r.out.find("Lua Error");
+  EXPECT_EQ(at, std::string::npos) << r.out.substr(at > 1500 ? at - 1500 : 0, 2000);
+  EXPECT_EQ(r.err.find("Lua"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("MPI connection layer"), std::string::npos);  // some still are MPI
+}
+
 }  // namespace
 }  // namespace pbvbus::captures

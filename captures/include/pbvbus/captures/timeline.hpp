@@ -92,7 +92,10 @@
 //    request (the confirm when the request is not in the capture) to the responder's
 //    connection ack, connected from then (or from the first data message or data ack) to a
 //    disconnect request of either side; the last span lasts to the lane's last frame end.
-//    A new connect request of the same row ends its current span. Connect requests that no
+//    A new connect request of the same row ends its current span; a span never starts before
+//    the end of the row's previous one (a confirm whose request came before PDUs of the old
+//    connection starts its span after them), and a span that ends where it starts is dropped
+//    when the next one opens. Connect requests that no
 //    confirm answers give a row with responder SAP -1, marks only. Every MPI PDU is a mark,
 //    repeats by the FDL layer included (the wire's view). Rows are worked out on the whole
 //    capture and cut to the window like the DX rows; every row is kept, also without spans or

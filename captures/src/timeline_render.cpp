@@ -1113,7 +1113,8 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
       summary.push_back("    MPI " + mpi_connection_label(C) + ": " +
                         std::to_string(C.data_messages) +
                         (C.data_messages == 1 ? " data message, " : " data messages, ") +
-                        std::to_string(C.data_acks) + (C.data_acks == 1 ? " data ack" : " data acks") +
+                        std::to_string(C.data_acks) +
+                        (C.data_acks == 1 ? " data ack" : " data acks") +
                         (C.setup_seen ? "" : " (set-up not in the capture)"));
   }
   const int height = lanes_end + 24 + static_cast<int>(summary.size()) * 16 + 10;

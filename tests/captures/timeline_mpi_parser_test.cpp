@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "capture_fixture.hpp"
 #include "mpi_frames.hpp"
 
@@ -63,7 +65,8 @@ TEST(TimelineMpiParser, MutatedFramesKeepTheRowsConsistent) {
       test::MpiMutator mut(seed * 0x9E37'79B9'7F4A'7C15ULL);
       for (int i = 0; i < 300; ++i) {
         // Mostly intact frames, so that connections build up and break down.
-        const Bytes b = i % 3 ? test::mpi_exchange()[static_cast<std::size_t>(i) % 9] : mut.next_frame();
+        const Bytes b =
+            i % 3 ? test::mpi_exchange()[static_cast<std::size_t>(i) % 9] : mut.next_frame();
         w.on_frame(test::tap_frame(i % 5 ? mpi : dp, b, (i + 1) * 200'000));
         if (i % 50 == 0) w.write_s7_pdu(s7, (i + 1) * 200'000, b);  // any octets, not only S7
       }

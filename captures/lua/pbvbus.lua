@@ -13,7 +13,12 @@
 --   resource manager, negative responses.                                       fields pbdpv1.*
 --   Slave redundancy (PI 2.212, §G.2/G.3): the PrmCmd block in Set_Prm        fields pbdp.prmcmd.*
 --   and the Prm_Cmd_Ack/Red_Status status blocks in Slave_Diag.                fields pbdp.red.*
+--   MPI connection layer (§H.2/§H.3, docs/mpi.md): connect request/confirm, connection and
+--   data acks, data messages with their numbers, disconnect; the S7 PDU of a data message is
+--   handed to Wireshark's own s7comm (§H.4).                                    fields pbmpi.*
 -- and on USER1 (148) pbvbus event records (captures/include/pbvbus/captures/event_record.hpp).
+-- S7 PDUs that the writer stores as upper-PDU records (link type 252) need no script: tshark's
+-- exported_pdu dissector hands them to s7comm by the heuristic name in their tags.
 --                                                                               fields pbevent.*
 --
 -- Decisions where the wire alone cannot tell:
@@ -26,8 +31,9 @@
 --     blocks (with a warning); a pure PrmCmd is a Set_Prm of exactly 7 + 3 + 8 octets with one
 --     PrmCmd block (§G.2 [I]). The Specifier octet is read as Seq_Nr in bits 7..3 and the
 --     specifier in bits 1..0, the PrmCmd Properties bits in the AUMA order (both [U]).
---   * SAPs 0..48 with the class-2 master SAP 50 on the other side are MSAC_C2 connections; other
---     SAP pairs (MPI among them) are shown as FDL data and not decoded further.
+--   * SAPs 0..48 with the class-2 master SAP 50 on the other side are MSAC_C2 connections.
+--   * MPI is detected by the rule in the MPI section below (captures/README.md "MPI and S7");
+--     other SAP pairs are shown as FDL data and not decoded further.
 
 local fdl = Proto("pbfdl", "PROFIBUS FDL")
 local dp = Proto("pbdp", "PROFIBUS DP")
@@ -1089,6 +1095,130 @@ local function dissect_dp(tvb, off, len, tree, fr)
 end
 
 ------------------------------------------------------------------------------------------------
+-- MPI connection layer (protocol-facts.md §H.2/§H.3, docs/mpi.md) on FDL SRD requests with SAP
+-- extensions, and the S7 PDU of its data messages handed to Wireshark's own s7comm (§H.4).
+--
+-- Detection rule (captures/README.md "MPI and S7"): a frame is MPI when
+--   * it is an intact SD2 or SD3 request with FC SRD_low or SRD_high, both DA and SA carry an
+--     extension with a SAP (DSAP and SSAP present), and
+--   * its DU (after the SAP octets) is a whole MPI PDU as stacks/mpi/pdu.hpp decodes it:
+--     E0 + 11 connect parameters sent to DSAP 0; D0 + 11; 05 01; F1 nr + at least one octet;
+--     B0 01 nr; 80 — each with exactly that length (a data message up to 244 octets), and
+--   * either the interface is marked MPI (its if_description starts with "MPI", as the pbvbus
+--     writer writes it for an MPI line: "MPI 187.5 kbit/s, probe at ..."), or neither SAP is a
+--     DP SAP (49..63: the DP-V0 and DP-V1 service SAPs, the class-2 master's SAP 50 that every
+--     MSAC_C2 frame carries, the global SAP 63).
+-- Every DP frame with SAPs has one SAP in 49..62 (§D SAP table; MSAC_C2 frames carry 50 on the
+-- master's side) and Data_Exchange has no SAPs, so outside an interface marked MPI no DP frame
+-- is taken for MPI. On a marked interface MPI is tried first (a CPU hands out connection SAPs
+-- up to 63, docs/mpi.md decision 5), and a frame that is no MPI PDU still goes to DP.
+local mpi = Proto("pbmpi", "MPI connection layer")
+local mpi_pdu_names = {
+  [0xE0] = "Connect request", [0xD0] = "Connect confirm", [0x05] = "Connection ack",
+  [0xF1] = "Data", [0xB0] = "Data ack", [0x80] = "Disconnect request",
+}
+local M = {
+  pdu = ProtoField.uint8("pbmpi.pdu", "PDU type", base.HEX, mpi_pdu_names),
+  pdu_name = ProtoField.string("pbmpi.pdu_name", "PDU"),
+  subcode = ProtoField.uint8("pbmpi.subcode", "Ack subcode", base.HEX),
+  msg_nr = ProtoField.uint8("pbmpi.msg_nr", "Message number", base.DEC),
+  ack_nr = ProtoField.uint8("pbmpi.ack_nr", "Acknowledged message number", base.DEC),
+  connect_params = ProtoField.bytes("pbmpi.connect_params", "Connect parameters (not decoded)"),
+  s7 = ProtoField.bytes("pbmpi.s7_pdu", "S7 PDU"),
+  s7_len = ProtoField.uint16("pbmpi.s7_len", "S7 PDU length", base.DEC),
+  src = ProtoField.string("pbmpi.src", "Sender (address:SAP)"),
+  dst = ProtoField.string("pbmpi.dst", "Receiver (address:SAP)"),
+  marked = ProtoField.bool("pbmpi.line_marked", "Interface marked MPI"),
+}
+mpi.fields = {}
+for _, f in pairs(M) do table.insert(mpi.fields, f) end
+local E_mpi_s7 = ProtoExpert.new("pbmpi.s7_undecoded", "Data message not decoded by s7comm",
+  expert.group.UNDECODED, expert.severity.NOTE)
+mpi.experts = { E_mpi_s7 }
+local f_if_desc = Field.new("frame.interface_description")
+local cotp_heuristics_ok = true  -- set false if try_heuristics is missing (older Wireshark)
+
+local function interface_is_mpi()
+  local d = f_if_desc()
+  if d == nil then return false end
+  local s = tostring(d.value)
+  return s:sub(1, 3) == "MPI"
+end
+
+-- The MPI PDU type of `len` octets at `off`, or nil when they are no whole MPI PDU.
+local function mpi_pdu_type(tvb, off, len, dsap)
+  if len < 1 then return nil end
+  local t = tvb(off, 1):uint()
+  if t == 0xE0 then return (len == 12 and dsap == 0) and t or nil end
+  if t == 0xD0 then return len == 12 and t or nil end
+  if t == 0x05 then return (len == 2 and tvb(off + 1, 1):uint() == 0x01) and t or nil end
+  if t == 0xF1 then return (len >= 3 and len <= 244) and t or nil end
+  if t == 0xB0 then return (len == 3 and tvb(off + 1, 1):uint() == 0x01) and t or nil end
+  if t == 0x80 then return len == 1 and t or nil end
+  return nil
+end
+
+-- Whether the frame is MPI by the rule above; returns the PDU type and whether the interface
+-- is marked MPI.
+local function mpi_detect(tvb, off, len, fr)
+  if not fr.request or (fr.fn ~= 0xC and fr.fn ~= 0xD) then return nil end
+  if fr.sd ~= 0x68 and fr.sd ~= 0xA2 then return nil end
+  if fr.dsap == nil or fr.ssap == nil then return nil end
+  local t = mpi_pdu_type(tvb, off, len, fr.dsap)
+  if t == nil then return nil end
+  local marked = interface_is_mpi()
+  if not marked and (fr.dsap >= 49 or fr.ssap >= 49) then return nil end
+  return t, marked
+end
+
+-- Decodes the MPI PDU (type `t`) at [off, off+len) into the tree; returns the info text.
+local function dissect_mpi(tvb, pinfo, tree, off, len, fr, t, marked)
+  local m = tree:add(mpi, tvb(off, len))
+  local name = mpi_pdu_names[t]
+  m:set_text("MPI connection layer, " .. name)
+  m:add(M.pdu, tvb(off, 1))
+  m:add(M.pdu_name, tvb(off, 1), name)
+  m:add(M.src, tvb(off, len), string.format("%d:%d", fr.sa, fr.ssap)):set_generated()
+  m:add(M.dst, tvb(off, len), string.format("%d:%d", fr.da, fr.dsap)):set_generated()
+  m:add(M.marked, tvb(off, len), marked):set_generated()
+  local info = "MPI " .. name
+  if t == 0xE0 or t == 0xD0 then
+    m:add(M.connect_params, tvb(off + 1, 11))
+    info = string.format("%s SAP %d→%d", info, fr.ssap, fr.dsap)
+  elseif t == 0x05 then
+    m:add(M.subcode, tvb(off + 1, 1))
+  elseif t == 0xB0 then
+    m:add(M.subcode, tvb(off + 1, 1))
+    m:add(M.ack_nr, tvb(off + 2, 1))
+    info = string.format("%s nr %d", info, tvb(off + 2, 1):uint())
+  elseif t == 0xF1 then
+    m:add(M.msg_nr, tvb(off + 1, 1))
+    local s7off, s7len = off + 2, len - 2
+    m:add(M.s7, tvb(s7off, s7len))
+    m:add(M.s7_len, tvb(s7off, s7len), s7len):set_generated()
+    info = string.format("%s nr %d", info, tvb(off + 1, 1):uint())
+    -- Hand the S7 PDU to s7comm, a heuristic dissector of COTP (tools-and-formats.md §3.4,
+    -- §4.2: DissectorTable.try_heuristics("cotp", ...) works from Lua in tshark 4.0).
+    local s7info = nil
+    if cotp_heuristics_ok then
+      local ok, taken = pcall(DissectorTable.try_heuristics, "cotp", tvb(s7off, s7len):tvb(), pinfo, tree)
+      if not ok then cotp_heuristics_ok = false end
+      if ok and taken then
+        s7info = tostring(pinfo.cols.info)
+        -- s7comm fences the info column; the FDL line below replaces it as a whole.
+        pcall(function() pinfo.cols.info:clear_fence() end)
+      end
+    end
+    if s7info then
+      info = info .. ": S7 " .. s7info
+    else
+      m:add_proto_expert_info(E_mpi_s7)
+    end
+  end
+  return info
+end
+
+------------------------------------------------------------------------------------------------
 -- FDL
 local function fcs_of(tvb, off, len)
   local s = 0
@@ -1264,10 +1394,19 @@ function fdl.dissector(tvb, pinfo, tree)
   pinfo.cols.dst = tostring(da)
   -- DP on top (only for frames whose extension chains make sense)
   local proto, dptext
-  if ok_ext then
+  fr.da, fr.sa = da, sa
+  if ok_ext and not truncated and fcs_ok then
+    local mt, marked = mpi_detect(tvb, du_off, du_len, fr)
+    if mt ~= nil then
+      proto, dptext = "MPI", dissect_mpi(tvb, pinfo, tree, du_off, du_len, fr, mt, marked)
+    end
+  end
+  if ok_ext and dptext == nil then
     proto, dptext = dissect_dp(tvb, du_off, du_len, tree, fr)
   end
-  if dptext ~= nil then
+  if dptext ~= nil and proto == "MPI" then
+    -- decoded in the MPI subtree (pbmpi.*); pbfdl.service stays the DP service
+  elseif dptext ~= nil then
     t:add(F.service, tvb(du_off, du_len), dptext)
   elseif fr.dsap ~= nil or fr.ssap ~= nil then
     dptext = string.format("SAP %s→%s", fr.ssap ~= nil and tostring(fr.ssap) or "-",

@@ -7,6 +7,7 @@
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 #include "capture_names.hpp"
+#include "timeline_mpi.hpp"
 
 namespace pbvbus::captures {
 
@@ -68,6 +69,8 @@ std::string link_name(std::uint16_t lt) {
       return "USER0";
     case 148:
       return "USER1";
+    case 252:
+      return "UPPER_PDU";
     case 257:
       return "PROFIBUS_DL";
     default:
@@ -180,7 +183,12 @@ void count_frame(InterfaceSummary& s, Tracker& tr, const PcapngRecord& r) {
     const bool req = t.is_request();
     const std::optional<std::uint8_t> sap = req ? t.dsap : t.ssap;
     std::string service;
-    if (sap) {
+    const auto mpi = (r.flags & pcapng::kFlagErrorMask) == 0 && req
+                         ? mpi_frame(b, is_mpi_description(s.description))
+                         : std::nullopt;
+    if (mpi) {
+      ++s.by_mpi[std::string(mpi_pdu_name(mpi->pdu.type))];
+    } else if (sap) {
       service = std::string(sap_service(*sap));
     } else if (req) {
       const auto fn = fdl::fc_request_fn(t.fc);
@@ -294,6 +302,7 @@ std::string to_text(const CaptureSummary& s) {
     o += "  requests: " + text_map(is.by_request) + "\n";
     o += "  responses: " + text_map(is.by_response) + "\n";
     o += "  DP services: " + text_map(is.by_service) + "\n";
+    if (!is.by_mpi.empty()) o += "  MPI PDUs: " + text_map(is.by_mpi) + "\n";
     o += "  bad frames: " + std::to_string(is.bad_frames);
     if (is.bad_frames) o += " (" + text_map(is.bad_by_reason) + ")";
     o += "\n";
@@ -326,7 +335,7 @@ std::string to_json(const CaptureSummary& s) {
     if (is_line_link(is.link_type)) {
       o += ",\"frame_types\":" + json_map(is.by_type) + ",\"requests\":" + json_map(is.by_request) +
            ",\"responses\":" + json_map(is.by_response) +
-           ",\"services\":" + json_map(is.by_service) +
+           ",\"services\":" + json_map(is.by_service) + ",\"mpi_pdus\":" + json_map(is.by_mpi) +
            ",\"bad_frames\":" + std::to_string(is.bad_frames) +
            ",\"bad_by_reason\":" + json_map(is.bad_by_reason) +
            ",\"min_idle_bits\":" + json_opt(is.min_idle_bits) +

@@ -47,7 +47,7 @@ std::size_t put_option(std::uint8_t* p, std::uint16_t code, const void* value, s
   return total;
 }
 
-std::string baud_description(std::uint64_t speed) {
+std::string baud_description(std::uint64_t speed, std::string_view profile = "PROFIBUS-DP") {
   // "PROFIBUS-DP 1.5 Mbit/s", "PROFIBUS-DP 187.5 kbit/s"; integer arithmetic only.
   auto frac = [](std::uint64_t v, std::uint64_t unit) {
     std::string s = std::to_string(v / unit);
@@ -62,9 +62,10 @@ std::string baud_description(std::uint64_t speed) {
     }
     return s;
   };
-  if (speed >= 1'000'000) return "PROFIBUS-DP " + frac(speed, 1'000'000) + " Mbit/s";
-  if (speed >= 1'000) return "PROFIBUS-DP " + frac(speed, 1'000) + " kbit/s";
-  return "PROFIBUS-DP " + std::to_string(speed) + " bit/s";
+  const std::string p(profile);
+  if (speed >= 1'000'000) return p + " " + frac(speed, 1'000'000) + " Mbit/s";
+  if (speed >= 1'000) return p + " " + frac(speed, 1'000) + " kbit/s";
+  return p + " " + std::to_string(speed) + " bit/s";
 }
 
 void append_reason(std::string& s, std::string_view r) {
@@ -174,6 +175,7 @@ PcapngWriter::PcapngWriter(Sink sink, PcapngWriterOptions opts)
   m_buf.resize(kBufferSize);
   m_event_buf.resize(kEventHeaderSize + kEventMaxText);
   m_comment.reserve(256);
+  m_s7_buf.reserve(512);
   m_lines.reserve(16);
   m_known_lines.reserve(16);
   m_held.reserve(256);
@@ -301,7 +303,9 @@ std::uint32_t PcapngWriter::declare(const bus::Line& line, int probe, std::strin
   for (const LineIf& l : m_lines)
     if (l.line == &line && l.probe == probe) return l.id;
   const auto speed = static_cast<std::uint64_t>(line.baud());
-  std::string desc = baud_description(speed);
+  const bool mpi =
+      std::find(m_mpi_lines.begin(), m_mpi_lines.end(), &line) != m_mpi_lines.end();
+  std::string desc = baud_description(speed, mpi ? "MPI" : "PROFIBUS-DP");
   if (probe >= 0) desc += ", probe at " + (where.empty() ? station_name(line, probe) : std::string(where));
   const std::uint32_t id = add_interface(name.empty() ? std::string_view(line.name()) : name, desc,
                                          m_opts.line_link_type, speed);
@@ -352,6 +356,71 @@ std::uint32_t PcapngWriter::events_interface() {
   if (m_events_if < 0)
     m_events_if = add_interface("events", "pbvbus event records v1", pcapng::LinkType::User1, 0);
   return static_cast<std::uint32_t>(m_events_if);
+}
+
+bool PcapngWriter::mark_mpi(const bus::Line& line) {
+  for (const LineIf& l : m_lines)
+    if (l.line == &line) return false;
+  if (std::find(m_mpi_lines.begin(), m_mpi_lines.end(), &line) == m_mpi_lines.end())
+    m_mpi_lines.push_back(&line);
+  return true;
+}
+
+std::uint32_t PcapngWriter::add_s7_interface(std::string_view name, std::string_view description) {
+  const std::uint32_t id =
+      add_interface(name, description.empty() ? "S7 PDUs (exported PDU for s7comm)" : description,
+                    pcapng::LinkType::UpperPdu, 0);
+  m_s7_ifs.push_back(id);
+  return id;
+}
+
+bool PcapngWriter::write_s7_pdu(std::uint32_t iface, bus::Ticks time,
+                                std::span<const std::uint8_t> s7_pdu, const S7PduInfo& info) {
+  if (!m_ok) return false;
+  if (std::find(m_s7_ifs.begin(), m_s7_ifs.end(), iface) == m_s7_ifs.end()) return false;
+  // Exported-PDU tags (pcapng_format.hpp): big-endian code, length, value.
+  std::vector<std::uint8_t>& b = m_s7_buf;
+  b.clear();
+  auto be16 = [&](std::uint16_t v) {
+    b.push_back(static_cast<std::uint8_t>(v >> 8));
+    b.push_back(static_cast<std::uint8_t>(v));
+  };
+  auto be32 = [&](std::uint32_t v) {
+    be16(static_cast<std::uint16_t>(v >> 16));
+    be16(static_cast<std::uint16_t>(v));
+  };
+  const std::string_view heur = pcapng::kS7commHeuristic;
+  const std::size_t heur_len = pcapng::pad4(heur.size() + 1);  // NUL, padded to 4
+  be16(pcapng::kExpPduHeurProtoName);
+  be16(static_cast<std::uint16_t>(heur_len));
+  b.insert(b.end(), heur.begin(), heur.end());
+  b.resize(b.size() + heur_len - heur.size(), 0);
+  if (info.src_ip != 0 || info.dst_ip != 0) {
+    be16(pcapng::kExpPduIpv4Src);
+    be16(4);
+    be32(info.src_ip);
+    be16(pcapng::kExpPduIpv4Dst);
+    be16(4);
+    be32(info.dst_ip);
+  }
+  if (info.src_port != 0 || info.dst_port != 0) {
+    be16(pcapng::kExpPduPortType);
+    be16(4);
+    be32(pcapng::kExpPduPortTcp);
+    be16(pcapng::kExpPduSrcPort);
+    be16(4);
+    be32(info.src_port);
+    be16(pcapng::kExpPduDstPort);
+    be16(4);
+    be32(info.dst_port);
+  }
+  be16(pcapng::kExpPduEnd);
+  be16(0);
+  b.insert(b.end(), s7_pdu.begin(), s7_pdu.end());
+  const std::uint32_t flags = static_cast<std::uint32_t>(info.direction);
+  put_epb(time, time, iface, b, flags, info.comment);
+  ++m_s7_pdus;
+  return true;
 }
 
 bus::Ticks PcapngWriter::earliest_in_flight() const {

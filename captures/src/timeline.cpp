@@ -13,6 +13,7 @@
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "saturate.hpp"
 #include "capture_names.hpp"
+#include "timeline_mpi.hpp"
 
 namespace pbvbus::captures {
 
@@ -83,7 +84,7 @@ void flag_reasons(std::uint32_t flags, std::string& out) {
   }
 }
 
-TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed) {
+TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed, bool mpi_marked) {
   TimelineFrame f;
   f.start_ns = r.ts_ns;
   f.end_ns = saturate(static_cast<i128>(r.ts_ns) + frame_duration_ns(r.bytes.size(), speed));
@@ -122,6 +123,8 @@ TimelineFrame make_frame(const PcapngRecord& r, std::uint64_t speed) {
     f.kind = FrameKind::Sc;
   } else {
     f.kind = fdl::fc_is_request(t.fc) ? FrameKind::Request : FrameKind::Response;
+    if (f.kind == FrameKind::Request)
+      if (const auto m = mpi_frame(f.bytes, mpi_marked)) f.mpi = mpi_pdu_words(m->pdu);
   }
   return f;
 }
@@ -193,6 +196,7 @@ void finish_lane(LaneWork& w, std::int64_t from, i128 to) {
     lane_end = std::max(lane_end, f.end_ns);
   }
   if (!spans.empty()) spans.back().end_ns = std::max(spans.back().start_ns, lane_end);
+  lane.mpi = mpi_connections(frames, lane.mpi_marked, lane_end, from, to);
 
   // The window.
   auto overlaps = [&](std::int64_t s, std::int64_t e) {
@@ -417,6 +421,16 @@ std::string_view to_string(FrameKind k) {
   return "?";
 }
 
+std::string_view to_string(MpiState s) {
+  switch (s) {
+    case MpiState::Connecting:
+      return "connecting";
+    case MpiState::Connected:
+      return "connected";
+  }
+  return "?";
+}
+
 std::string_view to_string(EventStyle s) {
   switch (s) {
     case EventStyle::Fault:
@@ -468,6 +482,7 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
         w.lane.description = i.description;
         w.lane.link_type = i.link_type;
         w.lane.speed = i.speed <= kMaxSpeed ? i.speed : 0;
+        w.lane.mpi_marked = is_mpi_description(i.description);
         lane_of.push_back(static_cast<int>(lanes.size()));
         lanes.push_back(std::move(w));
       } else if (is_events_link(i.link_type)) {
@@ -486,7 +501,7 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
     const int l = lane_of[r.interface];
     if (l >= 0) {
       LaneWork& w = lanes[static_cast<std::size_t>(l)];
-      w.frames.push_back(make_frame(r, w.lane.speed));
+      w.frames.push_back(make_frame(r, w.lane.speed, w.lane.mpi_marked));
       note(w.frames.back().start_ns, w.frames.back().end_ns);
     } else if (l == -1) {
       auto e = decode_event(r.bytes);
@@ -624,12 +639,17 @@ std::string describe(const TimelineFrame& f) {
        (f.ssap ? std::to_string(*f.ssap) : std::string("-"));
   const std::optional<std::uint8_t> sap = req ? f.dsap : f.ssap;
   std::string service;
-  if (sap) {
+  if (!f.mpi.empty()) {
+    service = "MPI " + f.mpi;
+  } else if (sap) {
     service = std::string(sap_service(*sap));
   } else if (req ? (f.fc != fdl::kFcClockValue && is_srd(f)) : is_data_response(f)) {
     service = "Data_Exchange";
   }
-  if (!service.empty()) o += " (" + service + (req ? ".req" : ".res") + ")";
+  if (!f.mpi.empty())
+    o += " (" + service + ")";
+  else if (!service.empty())
+    o += " (" + service + (req ? ".req" : ".res") + ")";
   o += "\n";
   std::snprintf(buf, sizeof buf, "%zu octets, %zu data octets", n, f.data_len);
   o += buf;

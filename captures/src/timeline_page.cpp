@@ -55,7 +55,7 @@ const CPU_STATE_COLOURS = ['#ced4da', '#e03131', '#fab005', '#2f9e44', '#74c0fc'
   '#9c36b5', '#5c0a0a', '#15aabf'];
 const ROW_CPU = 22, OB_COLOUR = '#212529';
 const LABEL_W = 210, AXIS_H = 34, EV_H = 46, PAD_R = 18;
-const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18;
+const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18, ROW_MPI = 16;
 const MIN_SPAN = 100;  // ns: a few bit times even at 12 Mbit/s
 
 const chart = document.getElementById('chart');
@@ -135,8 +135,10 @@ const lanes = D.lanes.map(L => {
     for (let i = 0; i < k; i++) { u += S.t[i]; tt[i] = u; }
     return { a: S.a, t: tt, c0: S.c0, m: S.m, un: S.un, unSet: new Set(S.un) };
   });
+  // MPI connections: label, spans [start, end, state], marks [t, pdu, from initiator, text].
+  const mpi = (L.mpi || []).map(C => ({ l: C.l, s: C.s, m: C.m, mt: Float64Array.from(C.m.map(m => m[0])) }));
   return { name: L.name, desc: L.desc, speed: L.speed, iface: L['if'], start, end, kind, maxDur,
-           e: L.e, ts, te, th: L.th, tp: L.tp, dx };
+           e: L.e, ts, te, th: L.th, tp: L.tp, dx, mpi };
 });
 const holders = Array.from(holderSet).sort((a, b) => a - b);
 const holderColour = {};
@@ -203,7 +205,8 @@ function layout() {
   for (const L of lanes) {
     L.y = y;
     L.yF = y; L.yT = L.yF + ROW_FRAMES + 3; L.yR = L.yT + ROW_TOKEN + 2; L.yD = L.yR + ROW_RULER;
-    L.h = L.yD + L.dx.length * ROW_DX - y;
+    L.yM = L.yD + L.dx.length * ROW_DX;
+    L.h = L.yM + L.mpi.length * ROW_MPI - y;
     y += L.h + LANE_GAP;
   }
   acY = y;
@@ -390,6 +393,54 @@ function drawDx(s, L) {
   });
 }
 
+// MPI connection rows (timeline.hpp "MPI connections"), as in the SVG.
+const MPI_STATE_NAMES = ['connecting', 'connected'];
+function mpiSpanColour(st) { return st === 1 ? '#a5d8ff' : '#dee2e6'; }
+function mpiMarkColour(m) {
+  switch (m[1]) {
+    case 0xE0: case 0xD0: return '#7048e8';
+    case 0x05: return '#868e96';
+    case 0xF1: return m[2] ? '#1971c2' : '#2b8a3e';
+    case 0xB0: return '#adb5bd';
+    case 0x80: return '#e8590c';
+  }
+  return '#495057';
+}
+let drawnMpiMarks = 0;
+function drawMpi(s, L) {
+  L.mpi.forEach((C, j) => {
+    const y = L.yM + j * ROW_MPI;
+    s.push(`<g class="mpi-conn" data-conn="${esc(C.l)}"><rect x="${plotX}" y="${y}" width="${plotW}" height="${ROW_MPI - 1}" fill="${j % 2 ? '#fbfbfc' : '#f4f6f8'}"/>`);
+    for (const sp of C.s) {
+      if (sp[1] < v0 || sp[0] > v1) continue;
+      const xa = Math.max(plotX, X(sp[0])), xb = Math.min(plotX + plotW, X(sp[1]));
+      s.push(`<rect class="mpi-span" data-state="${MPI_STATE_NAMES[sp[2]]}" x="${xa.toFixed(2)}" y="${y + 3}" width="${Math.max(1, xb - xa).toFixed(2)}" height="${ROW_MPI - 7}" fill="${mpiSpanColour(sp[2])}"/>`);
+    }
+    const i0 = lowerBound(C.mt, v0), i1 = lowerBound(C.mt, v1);
+    const dense = (i1 - i0) > plotW / 3;
+    let last = -1e9;
+    for (let i = i0; i < i1; i++) {
+      const x = X(C.mt[i]);
+      if (dense && x - last < 1) continue;
+      last = x;
+      s.push(`<rect class="mpi-mark" data-pdu="${C.m[i][1]}" x="${(x - 0.5).toFixed(2)}" y="${y + 1}" width="${dense ? 1 : 2}" height="${ROW_MPI - 3}" fill="${mpiMarkColour(C.m[i])}"/>`);
+      drawnMpiMarks++;
+    }
+    s.push('</g>');
+  });
+}
+function mpiText(L, C, t, tol) {
+  const j = lowerBound(C.mt, t - tol);
+  const near = [];
+  for (let i = j; i < C.mt.length && C.mt[i] <= t + tol && near.length < 20; i++)
+    near.push(`${fmtAbs(C.m[i][0], 9)}  ${D.desc[C.m[i][3]]}`);
+  if (near.length) return `MPI ${C.l}   lane ${L.name}\n` + near.join('\n');
+  for (const sp of C.s)
+    if (t >= sp[0] - tol && t <= sp[1] + tol)
+      return `MPI ${C.l}   ${MPI_STATE_NAMES[sp[2]]}\nfrom ${fmtAbs(sp[0], 9)}\nto   ${fmtAbs(sp[1], 9)}\nfor  ${fmtDur(sp[1] - sp[0])}`;
+  return null;
+}
+
 function drawLabels(s, L) {
   s.push(`<rect x="0" y="${L.y - 6}" width="${LABEL_W - 8}" height="${L.h + 12}" fill="#f7f8fa"><title>${esc(`interface ${L.iface}: ${L.name} \u2014 ${L.desc || 'no description'}, ${speedText(L.speed)}`)}</title></rect>`);
   if (acRows.length) s.push(`<rect class="lane-colour" x="3" y="${L.yF + 1}" width="4" height="${ROW_FRAMES - 2}" fill="${laneColour(lanes.indexOf(L))}"/>`);
@@ -399,6 +450,7 @@ function drawLabels(s, L) {
   r(L.yT + 13, 'token holder');
   r(L.yR + 14, ref && ref.lane === L ? 'bit times from ref' : 'bit times');
   L.dx.forEach((S, j) => r(L.yD + j * ROW_DX + 11, 'DX slave ' + S.a));
+  L.mpi.forEach((C, j) => r(L.yM + j * ROW_MPI + 12, 'MPI ' + C.l));
 }
 
 function acLineName(sp) {
@@ -501,7 +553,7 @@ function drawEvents(s) {
 function render() {
   const W = Math.max(600, chart.clientWidth || 1200);
   plotX = LABEL_W; plotW = W - LABEL_W - PAD_R; scale = plotW / (v1 - v0);
-  drawnFrames = 0;
+  drawnFrames = 0; drawnMpiMarks = 0;
   const s = [];
   s.push(`<defs><clipPath id="plotclip"><rect x="${plotX}" y="0" width="${plotW}" height="${totalH}"/></clipPath>` +
     '<pattern id="achatch" width="6" height="6" patternUnits="userSpaceOnUse" patternTransform="rotate(45)">' +
@@ -511,7 +563,7 @@ function render() {
     s.push(`<g class="lane" data-lane="${esc(L.name)}" data-interface="${L.iface}" data-frames="${L.start.length}">`);
     drawLabels(s, L);
     s.push('<g clip-path="url(#plotclip)">');
-    drawFrames(s, L); drawToken(s, L); drawRuler(s, L); drawDx(s, L);
+    drawFrames(s, L); drawToken(s, L); drawRuler(s, L); drawDx(s, L); drawMpi(s, L);
     s.push('</g></g>');
   }
   drawActive(s);
@@ -533,6 +585,8 @@ function render() {
   document.body.dataset.cpuRows = String(cpuRows.length);
   document.body.dataset.cpuSpansDrawn = String(drawnCpuSpans);
   document.body.dataset.cpuObsDrawn = String(drawnObs);
+  document.body.dataset.mpiRows = String(lanes.reduce((n, L) => n + L.mpi.length, 0));
+  document.body.dataset.mpiMarksDrawn = String(drawnMpiMarks);
   if (history.replaceState) history.replaceState(null, '', '#v=' + Math.round(v0) + ',' + Math.round(v1));
 }
 
@@ -617,6 +671,10 @@ function hitTest(x, y) {
       if (i < 0 || L.te[i] < t - tol) return null;
       const d = L.te[i] - L.ts[i];
       return `TOKEN HOLDER ${L.th[i]}   lane ${L.name}\npassed by ${L.tp[i]} at ${fmtAbs(L.ts[i], 9)}\nheld for ${fmtDur(d)}${fmtBits(d, L.speed)}\n(until the next token frame starts)`;
+    }
+    if (y >= L.yM && L.mpi.length) {
+      const C = L.mpi[Math.floor((y - L.yM) / ROW_MPI)];
+      return C ? mpiText(L, C, t, tol) : null;
     }
     if (y >= L.yD) {
       const S = L.dx[Math.floor((y - L.yD) / ROW_DX)];
@@ -744,6 +802,13 @@ window.addEventListener('resize', schedule);
     Array.from(states).sort((a, b) => a - b).forEach(n => parts.push(`<span><span class="sw" style="background:${cpuStateColour(n)}"></span>${esc(cpuStateName(n))}</span>`));
     parts.push(`<span><span class="vl" style="background:${OB_COLOUR}"></span>OB</span>`);
     parts.push('<span>(lighter: standby)</span>');
+  }
+  if (lanes.some(L => L.mpi.length)) {
+    parts.push('<span><b>MPI connection</b></span>');
+    [0, 1].forEach(n => parts.push(`<span><span class="sw" style="background:${mpiSpanColour(n)}"></span>${MPI_STATE_NAMES[n]}</span>`));
+    [[[0, 0xE0, 1], 'connect'], [[0, 0xF1, 1], 'data from PG'], [[0, 0xF1, 0], 'data to PG'], [[0, 0xB0, 1], 'data ack'],
+     [[0, 0x05, 1], 'connection ack'], [[0, 0x80, 1], 'disconnect']].forEach(([m, k]) =>
+      parts.push(`<span><span class="vl" style="background:${mpiMarkColour(m)}"></span>${k}</span>`));
   }
   parts.push('<span><b>events</b></span>');
   for (const k of ['fault', 'repair', 'event']) parts.push(`<span><span class="vl" style="background:${EVENT_COLOURS[k]}"></span>${k}</span>`);

@@ -237,6 +237,30 @@ const char* cpu_text_colour(int state) {
 }
 constexpr const char* kObColour = "#212529";
 
+// MPI connection rows (timeline.hpp "MPI connections").
+const char* mpi_span_colour(MpiState s) {
+  return s == MpiState::Connected ? "#a5d8ff" : "#dee2e6";
+}
+/// Connect request/confirm purple, connection acks grey, data from the initiator blue, data
+/// from the responder green, data acks light grey, disconnect orange.
+const char* mpi_mark_colour(const MpiMark& m) {
+  switch (m.pdu) {
+    case 0xE0:
+    case 0xD0:
+      return "#7048e8";
+    case 0x05:
+      return "#868e96";
+    case 0xF1:
+      return m.from_initiator ? "#1971c2" : "#2b8a3e";
+    case 0xB0:
+      return "#adb5bd";
+    case 0x80:
+      return "#e8590c";
+    default:
+      return "#495057";
+  }
+}
+
 /// The CPU rows of a Timeline: (system, rack) in the order of cpu_states / cpu_obs (both by
 /// system, then rack), and whether several systems share the picture (then the labels name it).
 struct CpuRowIndex {
@@ -396,6 +420,28 @@ std::string page_json(const Timeline& tl, std::int64_t origin, std::int64_t view
       }
       lanes += "],\"un\":[" + un + "]}";
     }
+    // MPI connections (timeline.hpp): "l" label, spans "s" [start, end, state 0 connecting /
+    // 1 connected], marks "m" [time, first PDU octet, 1 = from the initiator, text index].
+    lanes += "],\"mpi\":[";
+    for (std::size_t ci = 0; ci < L.mpi.size(); ++ci) {
+      const MpiConnection& C = L.mpi[ci];
+      if (ci) lanes += ',';
+      lanes += "{\"l\":" + json_str(mpi_connection_label(C)) + ",\"s\":[";
+      for (std::size_t k = 0; k < C.spans.size(); ++k) {
+        const MpiSpan& sp = C.spans[k];
+        lanes += std::string(k ? "," : "") + "[" + std::to_string(rel(sp.start_ns, origin)) + "," +
+                 std::to_string(rel(sp.end_ns, origin)) + "," +
+                 std::to_string(static_cast<int>(sp.state)) + "]";
+      }
+      lanes += "],\"m\":[";
+      for (std::size_t k = 0; k < C.marks.size(); ++k) {
+        const MpiMark& m = C.marks[k];
+        lanes += std::string(k ? "," : "") + "[" + std::to_string(rel(m.ts_ns, origin)) + "," +
+                 std::to_string(m.pdu) + "," + (m.from_initiator ? "1" : "0") + "," +
+                 std::to_string(tables.str(m.text)) + "]";
+      }
+      lanes += "]}";
+    }
     lanes += "]}";
   }
   lanes += "]";
@@ -472,7 +518,7 @@ std::uint64_t count_frames(const Timeline& tl) {
 
 constexpr int kLabelW = 210, kPadR = 18, kHeadH = 52, kAxisH = 34, kEvH = 46;
 constexpr int kRowFrames = 30, kRowToken = 18, kRowRuler = 20, kRowDx = 14, kLaneGap = 18;
-constexpr int kRowAc = 14, kRowCpu = 22;
+constexpr int kRowAc = 14, kRowCpu = 22, kRowMpi = 16;
 
 std::int64_t nice_step(double raw) {
   if (!(raw > 1)) return 1;
@@ -694,6 +740,44 @@ void svg_dx(SvgCtx& c, const TimelineLane& L, int y0) {
                  xml(fmt_dur(*S.polls[i + 1].cycle_ns)) + "</text>\n";
       }
     }
+  }
+}
+
+/// One row per MPI connection of a lane from y0 (timeline.hpp "MPI connections"): a band for
+/// the span (lighter while connecting), a tick per PDU coloured by its kind.
+void svg_mpi(SvgCtx& c, const TimelineLane& L, int y0) {
+  for (std::size_t j = 0; j < L.mpi.size(); ++j) {
+    const MpiConnection& C = L.mpi[j];
+    const int y = y0 + static_cast<int>(j) * kRowMpi;
+    const std::string label = mpi_connection_label(C);
+    c.o += "<g class=\"mpi-conn\" data-conn=\"" + xml(label) + "\">\n<rect x=\"" + num(c.plot_x) +
+           "\" y=\"" + std::to_string(y) + "\" width=\"" + num(c.plot_w) + "\" height=\"" +
+           std::to_string(kRowMpi - 1) + "\" fill=\"" + (j % 2 ? "#fbfbfc" : "#f4f6f8") + "\"/>\n";
+    for (const MpiSpan& s : C.spans) {
+      const double xa = c.clampx(c.x(s.start_ns)), xb = c.clampx(c.x(s.end_ns));
+      const double w = std::max(1.0, xb - xa);
+      const std::string state(to_string(s.state));
+      const std::string title = "MPI " + label + " " + state + "\nfrom " + fmt_abs(s.start_ns, 9) +
+                                "\nto " + fmt_abs(s.end_ns, 9) + " (" +
+                                fmt_dur(diff(s.start_ns, s.end_ns)) + ")";
+      c.o += "<rect class=\"mpi-span\" data-state=\"" + state + "\" x=\"" + num(xa) + "\" y=\"" +
+             std::to_string(y + 3) + "\" width=\"" + num(w) + "\" height=\"" +
+             std::to_string(kRowMpi - 7) + "\" fill=\"" + mpi_span_colour(s.state) + "\"><title>" +
+             xml(title) + "</title></rect>\n";
+    }
+    const bool dense = static_cast<double>(C.marks.size()) > c.plot_w / 3;
+    double last = -1e9;
+    for (const MpiMark& m : C.marks) {
+      const double x = c.x(m.ts_ns);
+      if (dense && x - last < 1) continue;
+      last = x;
+      c.o += "<rect class=\"mpi-mark\" data-pdu=\"" + std::to_string(m.pdu) + "\" x=\"" +
+             num(x - 0.5) + "\" y=\"" + std::to_string(y + 1) + "\" width=\"" +
+             (dense ? "1" : "2") + "\" height=\"" + std::to_string(kRowMpi - 3) + "\" fill=\"" +
+             mpi_mark_colour(m) + "\"><title>" + xml(fmt_abs(m.ts_ns, 9) + " " + m.text) +
+             "</title></rect>\n";
+    }
+    c.o += "</g>\n";
   }
 }
 
@@ -997,13 +1081,15 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   // Layout.
   // The CPU rows' legend takes a second line in the header.
   const CpuRowIndex cpu_rows(tl);
-  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16);
+  bool any_mpi = false;
+  for (const auto& L : tl.lanes) any_mpi |= !L.mpi.empty();
+  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16) + (any_mpi ? 16 : 0);
   int y = head_h + kAxisH + kEvH;
   std::vector<int> lane_y;
   for (const auto& L : tl.lanes) {
     lane_y.push_back(y);
     y += kRowFrames + 3 + kRowToken + 2 + kRowRuler + static_cast<int>(L.slaves.size()) * kRowDx +
-         kLaneGap;
+         static_cast<int>(L.mpi.size()) * kRowMpi + kLaneGap;
   }
   const int ac_y = y;
   int ac_rows = 0;
@@ -1023,6 +1109,13 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
            std::to_string(by_kind[k]);
     summary.push_back(s);
     for (const auto& S : L.slaves) summary.push_back("    " + cycle_text(S, L.speed));
+    for (const auto& C : L.mpi)
+      summary.push_back("    MPI " + mpi_connection_label(C) + ": " +
+                        std::to_string(C.data_messages) +
+                        (C.data_messages == 1 ? " data message, " : " data messages, ") +
+                        std::to_string(C.data_acks) +
+                        (C.data_acks == 1 ? " data ack" : " data acks") +
+                        (C.setup_seen ? "" : " (set-up not in the capture)"));
   }
   const int height = lanes_end + 24 + static_cast<int>(summary.size()) * 16 + 10;
 
@@ -1086,6 +1179,26 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
              "\" font-size=\"12\" fill=\"#68717d\">(lighter: standby)</text>\n";
       lx += 18 * 6.8 + 12;
     }
+    if (any_mpi) {
+      lx = 12;
+      ly += 16;
+      head("MPI connection");
+      sw(mpi_span_colour(MpiState::Connecting), "connecting", false);
+      sw(mpi_span_colour(MpiState::Connected), "connected", false);
+      MpiMark m;
+      m.pdu = 0xE0;
+      sw(mpi_mark_colour(m), "connect", true);
+      m.pdu = 0xF1;
+      sw(mpi_mark_colour(m), "data from PG", true);
+      m.from_initiator = false;
+      sw(mpi_mark_colour(m), "data to PG", true);
+      m.pdu = 0xB0;
+      sw(mpi_mark_colour(m), "data ack", true);
+      m.pdu = 0x05;
+      sw(mpi_mark_colour(m), "connection ack", true);
+      m.pdu = 0x80;
+      sw(mpi_mark_colour(m), "disconnect", true);
+    }
     head("events");
     sw(event_colour(EventStyle::Fault), "fault", true);
     sw(event_colour(EventStyle::Repair), "repair", true);
@@ -1126,7 +1239,8 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     const TimelineLane& L = tl.lanes[li];
     const int ly = lane_y[li];
     const int yt = ly + kRowFrames + 3, yr = yt + kRowToken + 2, yd = yr + kRowRuler;
-    const int lh = yd + static_cast<int>(L.slaves.size()) * kRowDx - ly;
+    const int ym = yd + static_cast<int>(L.slaves.size()) * kRowDx;
+    const int lh = ym + static_cast<int>(L.mpi.size()) * kRowMpi - ly;
     c.o += "<g class=\"lane\" data-lane=\"" + xml(L.name) + "\">\n";
     c.o += "<rect x=\"0\" y=\"" + std::to_string(ly - 6) + "\" width=\"" +
            std::to_string(kLabelW - 8) + "\" height=\"" + std::to_string(lh + 12) +
@@ -1153,11 +1267,14 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     for (std::size_t j = 0; j < L.slaves.size(); ++j)
       row_label(yd + static_cast<int>(j) * kRowDx + 11,
                 "DX slave " + std::to_string(L.slaves[j].address));
+    for (std::size_t j = 0; j < L.mpi.size(); ++j)
+      row_label(ym + static_cast<int>(j) * kRowMpi + 12, "MPI " + mpi_connection_label(L.mpi[j]));
     c.o += "<g clip-path=\"url(#plotclip)\">\n";
     svg_frames(c, L, ly);
     svg_token(c, L, yt, holder_colour);
     svg_ruler(c, L, yr);
     svg_dx(c, L, yd);
+    svg_mpi(c, L, ym);
     c.o += "</g>\n</g>\n";
   }
   if (ac_rows) {

@@ -14,7 +14,10 @@
 //    next, rounded to whole bit times (timestamps are ns, rounded down; a bit is >= 83 ns).
 //    Overlapping frames (collisions) are counted as overlaps, not as gaps.
 //  - The DP service is the SAP's service (the request's DSAP, the response's SSAP) or
-//    Data_Exchange for SRD/data on the default SAP, as in the Lua dissector.
+//    Data_Exchange for SRD/data on the default SAP, as in the Lua dissector. A frame that is
+//    MPI (the dissector's rule, captures/README.md "MPI and S7") counts as its MPI PDU instead.
+//  - Interfaces of other link types (S7 upper-PDU records, 252, among them) are counted
+//    (records, octets, time span) and not decoded.
 
 #include <cstdint>
 #include <map>
@@ -37,6 +40,9 @@ struct InterfaceSummary {
   std::map<std::string, std::uint64_t> by_request;   ///< SRD_high, SDN_high, FDL_Status ...
   std::map<std::string, std::uint64_t> by_response;  ///< DL, OK, DH, RS ...
   std::map<std::string, std::uint64_t> by_service;   ///< Slave_Diag.req, Data_Exchange.res ...
+  /// MPI PDUs ("Data", "Data ack", "Connect request", ...) of the frames that are MPI by the
+  /// rule of captures/README.md "MPI and S7"; such frames count under no DP service.
+  std::map<std::string, std::uint64_t> by_mpi;
   std::uint64_t bad_frames = 0;
   std::map<std::string, std::uint64_t> bad_by_reason;
   std::optional<std::int64_t> first_ns;

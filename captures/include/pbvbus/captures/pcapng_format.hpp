@@ -38,8 +38,30 @@ inline constexpr std::uint16_t kEpbFlags = 2;
 enum class LinkType : std::uint16_t {
   User0 = 147,  ///< FDL telegrams, SD to ED
   User1 = 148,  ///< pbvbus event records (event_record.hpp)
+  /// LINKTYPE_WIRESHARK_UPPER_PDU: exported-PDU tags, then a PDU for the dissector they name
+  /// (S7 PDUs for s7comm, tools-and-formats.md §4.2).
+  UpperPdu = 252,
   ProfibusDl = 257,
 };
+
+// Exported-PDU tags of LINKTYPE_WIRESHARK_UPPER_PDU (Wireshark epan/exported_pdu.h, 4.0): each
+// tag is u16 code, u16 length (big-endian), then the value; the list ends with tag 0, length 0.
+inline constexpr std::uint16_t kExpPduEnd = 0;
+/// Name of a heuristic dissector, NUL-terminated, padded to 4 octets.
+inline constexpr std::uint16_t kExpPduHeurProtoName = 13;
+inline constexpr std::uint16_t kExpPduIpv4Src = 20;  ///< 4 octets
+inline constexpr std::uint16_t kExpPduIpv4Dst = 21;  ///< 4 octets
+inline constexpr std::uint16_t kExpPduPortType = 24;  ///< u32, kExpPduPortTcp
+inline constexpr std::uint16_t kExpPduSrcPort = 25;  ///< u32
+inline constexpr std::uint16_t kExpPduDstPort = 26;  ///< u32
+inline constexpr std::uint32_t kExpPduPortTcp = 2;
+/// The heuristic name of s7comm under COTP; tag 12 (dissector name) "s7comm" does not work in
+/// tshark 4.0, s7comm being registered only as a heuristic (tools-and-formats.md §3.4, §4.2).
+inline constexpr const char* kS7commHeuristic = "s7comm_cotp";
+
+// epb_flags direction (bits 0..1).
+inline constexpr std::uint32_t kFlagInbound = 1;
+inline constexpr std::uint32_t kFlagOutbound = 2;
 
 // epb_flags link-layer-dependent error bits (bits 16..31).
 inline constexpr std::uint32_t kFlagSymbolError = 1u << 24;

@@ -14,7 +14,8 @@
 //    if_speed = baud, if_tsresol = 9 (ns); if_name = the line's name, or what add_probe() was
 //    given (e.g. "A@14" when a line has several probes); if_description
 //    "PROFIBUS-DP 1.5 Mbit/s, probe at station 14" (the `where` given to add_probe(), else the
-//    attachment's label), "PROFIBUS-DP 1.5 Mbit/s" for a whole-line tap. Interfaces the caller
+//    attachment's label), "PROFIBUS-DP 1.5 Mbit/s" for a whole-line tap; "MPI ..." instead of
+//    "PROFIBUS-DP ..." for a line marked with mark_mpi(). Interfaces the caller
 //    did not declare are declared when the line first reports something (event or frame), all
 //    of the writer's taps on that line at once, in the order they were added; a lazily declared
 //    probe is named after the line, or "LINE@label" when the writer has other taps there.
@@ -65,6 +66,23 @@
 
 namespace pbvbus::captures {
 
+/// What write_s7_pdu() knows about an S7 PDU besides its octets.
+struct S7PduInfo {
+  /// epb_flags direction: Inbound = towards the S7 server (a client's job), Outbound = from it
+  /// (the server's ack or ack-data); Unknown writes no direction.
+  enum class Direction : std::uint8_t { Unknown = 0, Inbound = 1, Outbound = 2 };
+  Direction direction = Direction::Unknown;
+  /// IPv4 addresses (host order, 127.0.0.1 = 0x7F000001) and TCP ports of sender and receiver,
+  /// for door traffic: written as exported-PDU tags (tshark shows them as the packet's source
+  /// and destination). 0 = left out.
+  std::uint32_t src_ip = 0;
+  std::uint32_t dst_ip = 0;
+  std::uint16_t src_port = 0;
+  std::uint16_t dst_port = 0;
+  /// opt_comment of the record, e.g. "door connection 3 -> CPU rack 0 slot 3" ("" = none).
+  std::string_view comment;
+};
+
 struct PcapngWriterOptions {
   /// Link type of the line interfaces: User0 (default) or ProfibusDl.
   pcapng::LinkType line_link_type = pcapng::LinkType::User0;
@@ -103,6 +121,24 @@ class PcapngWriter final : public bus::Tap {
   /// The "events" interface (USER1), created on first use.
   std::uint32_t events_interface();
 
+  /// Marks `line` as an MPI subnet (protocol-facts.md §H): its interfaces get the if_description
+  /// "MPI 187.5 kbit/s[, probe at ...]" instead of "PROFIBUS-DP ...", which the Lua dissector
+  /// and the timeline take as "decode MPI here" (captures/README.md "MPI and S7"). Call it
+  /// before the line's interfaces are declared (add_line/add_probe or the line's first record);
+  /// false if one of them already is (it keeps its description).
+  bool mark_mpi(const bus::Line& line);
+  /// Declares an interface for S7 PDUs: link type 252 (LINKTYPE_WIRESHARK_UPPER_PDU), no
+  /// speed; `description` empty: "S7 PDUs (exported PDU for s7comm)". Several are allowed (e.g.
+  /// one per door or per CPU); each call declares a new one.
+  std::uint32_t add_s7_interface(std::string_view name, std::string_view description = {});
+  /// Writes one S7 PDU (starting with 0x32, §H.4; written as given) at virtual time `time` on an
+  /// interface from add_s7_interface(), in time order with the frames: the exported-PDU tags
+  /// (heuristic dissector "s7comm_cotp", then IPv4 addresses and TCP ports when `info` has
+  /// them, then the end tag) and the PDU. False (nothing written) for an interface that is not
+  /// an S7 interface or once the sink failed.
+  bool write_s7_pdu(std::uint32_t iface, bus::Ticks time, std::span<const std::uint8_t> s7_pdu,
+                    const S7PduInfo& info = {});
+
   /// Writes one telegram as it was on the wire (or at the probe) on its interface, in start
   /// order (held back while an earlier transmission is still on the wire).
   void write_frame(const bus::TapFrame& f);
@@ -125,6 +161,7 @@ class PcapngWriter final : public bus::Tap {
 
   std::uint64_t frames_written() const { return m_frames; }
   std::uint64_t events_written() const { return m_events; }
+  std::uint64_t s7_pdus_written() const { return m_s7_pdus; }
 
  private:
   struct LineIf {
@@ -176,6 +213,10 @@ class PcapngWriter final : public bus::Tap {
   std::string m_error;
   std::uint64_t m_frames = 0;
   std::uint64_t m_events = 0;
+  std::uint64_t m_s7_pdus = 0;
+  std::vector<const bus::Line*> m_mpi_lines;
+  std::vector<std::uint32_t> m_s7_ifs;
+  std::vector<std::uint8_t> m_s7_buf;
 };
 
 /// Link-layer error bits and the comment for one frame (shared with the tests and inspect).

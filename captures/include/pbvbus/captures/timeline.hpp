@@ -81,6 +81,25 @@
 //    number, event ID and reason from the value and the record's text; a record for both CPUs
 //    (a = -1, "CPU 0+1: ...") gives one mark on each row of its system. OB records of CPUs
 //    without a row are not marked (they are still events). By system, rack, then time.
+//  - MPI connections (captures/README.md "MPI and S7"): per lane, the frames that are MPI by
+//    the dissector's rule (an intact SD2/SD3 SRD request with DSAP and SSAP whose DU is a whole
+//    MPI PDU, mpi::decode(); a connect request only to DSAP 0; on a lane whose if_description
+//    does not start with "MPI" only when neither SAP is a DP SAP 49..63). A connection is
+//    (initiator address, SAP, responder address, SAP): a connect request from (a, s) to b waits
+//    for the confirm from (b, r) to (a, s), which names the row (a, s, b, r); every other PDU
+//    between (a, s) and (b, r), either way, belongs to it. A PDU of no known connection opens a
+//    row with its sender as initiator (setup_seen false). Spans: connecting from the connect
+//    request (the confirm when the request is not in the capture) to the responder's
+//    connection ack, connected from then (or from the first data message or data ack) to a
+//    disconnect request of either side; the last span lasts to the lane's last frame end.
+//    A new connect request of the same row ends its current span; a span never starts before
+//    the end of the row's previous one (a confirm whose request came before PDUs of the old
+//    connection starts its span after them), and a span that ends where it starts is dropped
+//    when the next one opens. Connect requests that no
+//    confirm answers give a row with responder SAP -1, marks only. Every MPI PDU is a mark,
+//    repeats by the FDL layer included (the wire's view). Rows are worked out on the whole
+//    capture and cut to the window like the DX rows; every row is kept, also without spans or
+//    marks in the window.
 //  - Window [from_ns, to_ns): frames, token spans, active-channel spans and CPU state spans that
 //    overlap it, polls, events and OB marks that start in it. Without a window: from the earliest record to 1 ns
 //    after the end of the latest frame or event (so that what happens last is inside; to_ns
@@ -128,6 +147,9 @@ struct TimelineFrame {
   std::optional<std::uint8_t> dsap;
   std::optional<std::uint8_t> ssap;
   std::size_t data_len = 0;  ///< DU octets after the extension octets
+  /// The frame's MPI PDU in words ("data 0", "connect request") when it is MPI by the rule of
+  /// "MPI connections" below; "" otherwise.
+  std::string mpi;
   /// Why the frame is bad ("" if it is not): the writer's comment, else the epb_flags error
   /// bits in words, plus the decoder's reason.
   std::string problem;
@@ -163,6 +185,42 @@ struct SlaveCycles {
   CycleStats cycle;
 };
 
+/// What an MPI connection was doing in a span (captures/README.md "MPI and S7").
+enum class MpiState : std::uint8_t { Connecting, Connected };
+std::string_view to_string(MpiState s);  ///< "connecting", "connected"
+
+struct MpiSpan {
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  MpiState state = MpiState::Connecting;
+};
+
+/// One MPI PDU of a connection on the wire, drawn as a mark on the connection's row.
+struct MpiMark {
+  std::int64_t ts_ns = 0;            ///< start of the frame
+  std::uint8_t pdu = 0;              ///< first octet: E0, D0, 05, F1, B0, 80 (mpi/pdu.hpp)
+  bool from_initiator = true;        ///< sent by the side that sent the connect request
+  std::optional<std::uint8_t> nr;    ///< data: its message number; data ack: the number acked
+  std::string text;                  ///< "data 0 0:20→2:20: S7 job Read Var, 1 item"
+};
+
+/// One MPI connection seen on a lane: (initiator address, SAP) ↔ (responder address, SAP).
+struct MpiConnection {
+  std::uint8_t initiator = 0;      ///< the PG/OP: sender of the connect request
+  std::uint8_t initiator_sap = 0;
+  std::uint8_t responder = 0;      ///< the CPU
+  int responder_sap = -1;          ///< the CPU's connection SAP; -1: no confirm seen
+  /// False when the capture shows the connection only from a later PDU on (it started before
+  /// the capture): then the initiator is a guess, the sender of the first PDU seen.
+  bool setup_seen = false;
+  std::vector<MpiSpan> spans;  ///< in the window, by start time
+  std::vector<MpiMark> marks;  ///< in the window, by time
+  std::uint64_t data_messages = 0;  ///< in the window
+  std::uint64_t data_acks = 0;      ///< in the window
+};
+/// "0:20↔2:20" (responder SAP "?" when unknown).
+std::string mpi_connection_label(const MpiConnection& c);
+
 struct TimelineLane {
   std::uint32_t interface = 0;  ///< pcapng interface index
   std::string name;             ///< if_name
@@ -173,6 +231,10 @@ struct TimelineLane {
   std::vector<TokenSpan> token;       ///< in the window, by start time
   std::vector<SlaveCycles> slaves;    ///< by address
   std::uint64_t bad_frames = 0;       ///< in the window
+  /// Whether the interface is marked MPI (if_description starts with "MPI").
+  bool mpi_marked = false;
+  /// MPI connections (captures/README.md "MPI and S7"), by initiator, its SAP, responder, SAP.
+  std::vector<MpiConnection> mpi;
 };
 
 enum class EventStyle : std::uint8_t { Fault, Repair, Event };

@@ -232,3 +232,43 @@ TEST(S7Scenario, ItemSyntax) {
 
 }  // namespace
 }  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+namespace {
+
+TEST(S7Scenario, TheHCpusSitOnTheMpiLineWithTheirOwnAddresses) {
+  const auto r = load(R"(h_system { name: "H" t_wa: "100ms" t_prog: "10ms" cpu { mpi { line: "MPI" } } }
+mpi_station { line: "MPI" read { cpu: 3 item: "MW0" } }
+s7_door { name: "D" listen: "127.0.0.1:0" route { rack: 0 slot: 3 h_system: "H" } }
+)");
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  const ScenarioPlan& p = *r.plan;
+  ASSERT_EQ(p.s7.h_mpi.size(), 1u);
+  EXPECT_EQ(p.s7.h_mpi[0].h_system, 0);
+  EXPECT_EQ(p.s7.h_mpi[0].address[0], 2);
+  EXPECT_EQ(p.s7.h_mpi[0].address[1], 3);
+  EXPECT_EQ(p.s7.h_mpi[0].max_connections, 32u);
+  const auto& st = p.lines[0].stations;
+  ASSERT_EQ(st.size(), 3u);
+  EXPECT_EQ(st[0].kind, StationKind::HCpuMpi);
+  EXPECT_EQ(st[0].source, 0);  // h_system 0, rack 0
+  EXPECT_EQ(st[1].source, 1);  // rack 1
+  EXPECT_EQ(st[1].address, 3);
+  EXPECT_EQ(p.s7.doors[0].routes[0].kind, S7RoutePlan::Kind::HSystem);
+  EXPECT_EQ(p.s7.doors[0].routes[0].connection, -1);
+}
+
+TEST(S7Scenario, BothHCpusAtOneAddressIsAnError) {
+  // `h_system { name: "H" t_wa: "100ms" t_prog: "10ms" cpu { mpi { line: "MPI" ` is 74 columns,
+  // `address_cpu0: 5 ` 16 more: address_cpu1 at 91.
+  EXPECT_EQ(
+      errors("h_system { name: \"H\" t_wa: \"100ms\" t_prog: \"10ms\" cpu { mpi { line: \"MPI\" "
+             "address_cpu0: 5 address_cpu1: 5 } } }\n"),
+      (std::vector<std::string>{
+          "s7.textproto:6:91: address 5 is already used on line \"MPI\" (at 6:75)",
+          "s7.textproto:6:91: both CPUs have MPI address 5: CPU 1 differs from CPU 0 in its MPI "
+          "address"}));
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

@@ -10,11 +10,6 @@
 
 namespace pbvbus::tools {
 
-fdl::BusParams mpi_bus_params(bus::Baud baud) {
-  fdl::BusParams p = fdl::BusParams::defaults(baud);
-  p.hsa = 31;
-  return p;
-}
 
 namespace {
 

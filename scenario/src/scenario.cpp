@@ -1,5 +1,7 @@
 #include "pbvbus/scenario/scenario.hpp"
 
+#include "pbvbus/mpi_station/mpi_bus_params.hpp"
+
 #include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
@@ -307,7 +309,7 @@ class Planner {
       pl.mpi = l.kind() == scenario::Line::MPI;
       // An MPI subnet: 187.5 kbit/s unless named, HSA 31 (s7_plan.hpp).
       if (pl.mpi && l.speed_case() == scenario::Line::SPEED_NOT_SET) pl.baud = bus::Baud::k187_5;
-      pl.params = pl.mpi ? mpi_bus_params(pl.baud) : fdl::BusParams::defaults(pl.baud);
+      pl.params = pl.mpi ? mpi_station::mpi_bus_params(pl.baud) : fdl::BusParams::defaults(pl.baud);
       if (l.has_bus_params()) {
         const Where bw = nested(w, ld, "bus_params");
         apply(bw, l.bus_params(), pl.params);

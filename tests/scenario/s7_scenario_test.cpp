@@ -42,10 +42,12 @@ TEST(S7Scenario, AnMpiLineRunsAt187_5kWithHsa31) {
   EXPECT_TRUE(mpi.mpi);
   EXPECT_EQ(mpi.baud, bus::Baud::k187_5);
   EXPECT_EQ(mpi.params.hsa, 31);
-  // The rest of its timing is the DP profile's at 187.5 kbit/s (s7_plan.hpp mpi_bus_params).
-  const auto dp187 = fdl::BusParams::defaults(bus::Baud::k187_5);
-  EXPECT_EQ(mpi.params.tsl, dp187.tsl);
-  EXPECT_EQ(mpi.params.ttr, dp187.ttr);
+  // docs/mpi.md "MPI bus parameters": TSL 415, min TSDR 20, max TSDR 400 (libnodave's adapter
+  // record), TTR 20 000.
+  EXPECT_EQ(mpi.params.tsl, 415u);
+  EXPECT_EQ(mpi.params.min_tsdr, 20u);
+  EXPECT_EQ(mpi.params.max_tsdr, 400u);
+  EXPECT_EQ(mpi.params.ttr, 20000u);
   const auto& dp = r.plan->lines[1];
   EXPECT_FALSE(dp.mpi);
   EXPECT_EQ(dp.params.hsa, 126);

@@ -5,7 +5,8 @@
 //
 // Decisions (the loader reports each violation with FILE:LINE:COLUMN):
 //  - A line of kind MPI runs at 187.5 kbit/s unless it names a baud (protocol-facts.md §H.1),
-//    with HSA 31 (STEP 7's default, §H.1 [U]) unless its bus_params say otherwise. It carries
+//    with the MPI bus parameters (mpi_station::mpi_bus_params: HSA 31, docs/mpi.md "MPI bus
+//    parameters") under its own bus_params. It carries
 //    no DP: a dp_master, dp_slave or switched station on it is an error (a CPU's MPI/DP
 //    interface is either MPI or DP, as on the real module). Plain masters, passive stations
 //    and serial attachments are allowed (an outside PG joins through a serial STATION).
@@ -138,11 +139,6 @@ struct S7Plan {
 /// A field inside Scenario.<repeated>[index]: path of (field, element) steps as HLocator.
 using S7Locator = std::function<std::pair<int, int>(const char* repeated, int index,
                                                     const std::vector<std::pair<const char*, int>>& path)>;
-
-/// The bus parameters of an MPI line at `baud` before its own bus_params: the DP profile's
-/// timing for that baud (fdl::BusParams::defaults; the MPI bus-parameter broadcast that would
-/// tell STEP 7's values is not documented, protocol-facts.md §H.1) and HSA 31.
-fdl::BusParams mpi_bus_params(bus::Baud baud);
 
 /// Plans the S7 entries (after the stations, the dp masters, the h_systems and the gateways:
 /// it refers to all of them).

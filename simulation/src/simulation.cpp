@@ -91,6 +91,18 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
                                       m_plan.lines.at(static_cast<std::size_t>(rp.line[1])).params};
     m_redundant.push_back(std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params));
   }
+  for (const auto& c : m_plan.s7.cpus)
+    m_s7_cpus.push_back(std::make_unique<S7CpuNode>(
+        c, c.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(c.mpi_line)).params : nullptr));
+  for (const auto& m : m_plan.s7.stations)
+    m_mpi_clients.push_back(std::make_unique<MpiClientNode>(
+        m_sched, m, m_plan.lines.at(static_cast<std::size_t>(m.line)).params));
+  std::vector<S7CpuNode*> cpus;
+  for (auto& c : m_s7_cpus) cpus.push_back(c.get());
+  for (const auto& d : m_plan.s7.doors)
+    m_s7_doors.push_back(std::make_unique<S7DoorNode>(
+        m_sched, d, cpus,
+        d.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(d.mpi_line)).params : nullptr));
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
   for (auto& node : m_redundant) node->set_capture(m_opts.capture);
   std::string why;
@@ -138,6 +150,7 @@ bus::PacedRunner& Simulation::paced_runner(bus::Speed speed) {
     for (auto& s : ls->stations)
       if (s.pty) s.pty->attach_io(*m_runner);
   for (auto& g : m_gateways) g->open(*m_runner);
+  for (auto& d : m_s7_doors) d->open(*m_runner);
   return *m_runner;
 }
 
@@ -219,6 +232,14 @@ void Simulation::build_line(std::size_t li) {
           break;
         }
         st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
+        for (auto& cpu : m_s7_cpus) {
+          const auto& cp = cpu->plan();
+          if ((cp.x1_dp && cp.x1_dp->dp_master == mi) || (cp.x2_dp && cp.x2_dp->dp_master == mi)) {
+            S7CpuNode* node = cpu.get();
+            st.dp_master->set_cpu([node](dp::Master& m) { node->exchange(m); });
+            label = "CPU " + cp.name + " DP interface " + std::to_string(st.address);
+          }
+        }
         st.position = ls->line->attach(st.dp_master->station(), label);
         break;
       }
@@ -244,6 +265,26 @@ void Simulation::build_line(std::size_t li) {
         st.position = ls->line->attach(st.dp_slave->station(), label);
         break;
       }
+      case StationKind::S7CpuMpi: {
+        S7CpuNode& cpu = *m_s7_cpus.at(static_cast<std::size_t>(ps.source));
+        label = "CPU " + cpu.plan().name + " MPI " + std::to_string(st.address);
+        st.position = ls->line->attach(*cpu.mpi(), label);
+        break;
+      }
+      case StationKind::MpiStation: {
+        MpiClientNode& pg = *m_mpi_clients.at(static_cast<std::size_t>(ps.source));
+        label = std::string(pg.plan().op ? "OP " : "PG ") + std::to_string(st.address);
+        st.position = ls->line->attach(pg.station(), label);
+        break;
+      }
+      case StationKind::S7DoorMpi: {
+        S7DoorNode& door = *m_s7_doors.at(static_cast<std::size_t>(ps.source));
+        label = "S7 door " + door.plan().name + " MPI " + std::to_string(st.address);
+        st.position = ls->line->attach(*door.mpi(), label);
+        break;
+      }
+      case StationKind::HCpuMpi:
+        throw std::runtime_error("not yet");
       case StationKind::SerialMonitor:
       case StationKind::SerialStation: {
         const auto& sp = m_plan.proto.serial(ps.source);
@@ -335,6 +376,7 @@ void Simulation::start() {
   }
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
+  for (auto& pg : m_mpi_clients) pg->start(m_sched.now());
   build_gateways();
   schedule_faults();
 }

@@ -624,6 +624,78 @@ Report Simulation::report(double wall_seconds) const {
   for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
   for (const auto& h : m_h) r.h_systems.push_back(h->report());
   for (const auto& g : m_gateways) r.gateways.push_back(g->report());
+  r.s7 = s7_report();
+  return r;
+}
+
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+
+S7Report Simulation::s7_report() const {
+  S7Report r;
+  for (const auto& c : m_s7_cpus) {
+    S7CpuReport cr;
+    cr.name = c->plan().name;
+    if (const auto* m = c->mpi()) {
+      cr.mpi_address = m->address();
+      cr.accepted = m->stats().connects_accepted;
+      cr.refused = m->stats().connects_refused;
+      cr.open = m->server_connections();
+      cr.pdus_received = m->stats().pdus_received;
+      cr.pdus_sent = m->stats().pdus_sent;
+    }
+    cr.dp_exchanges = c->dp_exchanges();
+    cr.unmapped_bytes = c->unmapped_bytes();
+    r.cpus.push_back(std::move(cr));
+  }
+  for (const auto& pg : m_mpi_clients) {
+    MpiStationReport sr;
+    sr.op = pg->plan().op;
+    sr.line = m_plan.lines.at(static_cast<std::size_t>(pg->plan().line)).name;
+    sr.address = pg->plan().address;
+    sr.connects = pg->connects();
+    sr.breaks = pg->breaks();
+    const auto& broken = pg->station().stats().broken;
+    for (std::size_t k = 0; k < broken.size(); ++k)
+      if (broken[k] != 0)
+        sr.broken[std::string(mpi_station::to_string(static_cast<mpi_station::EndReason>(k)))] = broken[k];
+    for (std::size_t k = 0; k < pg->reads().size(); ++k) {
+      const auto& st = pg->reads()[k];
+      const auto& rp = pg->plan().reads[k];
+      S7ReadReport rr;
+      rr.cpu = rp.cpu;
+      rr.item = rp.item.str();
+      rr.requests = st.requests;
+      rr.ok = st.ok;
+      rr.errors = st.errors;
+      rr.last_code = st.last_code;
+      rr.last_value = st.last_value;
+      rr.last_latency = st.last_latency;
+      rr.max_latency = st.max_latency;
+      sr.reads.push_back(std::move(rr));
+    }
+    r.stations.push_back(std::move(sr));
+  }
+  for (const auto& d : m_s7_doors) {
+    S7DoorReport dr;
+    dr.name = d->plan().name;
+    dr.listen = d->plan().listen.str();
+    dr.port = d->port();
+    if (const auto* s = d->stats()) {
+      dr.clients = s->clients_accepted;
+      dr.connects = s->connects;
+      dr.connects_refused = s->connects_refused;
+      dr.routes_closed = s->routes_closed;
+      dr.jobs = s->jobs;
+      dr.answers = s->answers;
+      dr.closed_garbage = s->closed_garbage;
+      dr.closed_stalled = s->closed_stalled;
+      dr.closed_idle = s->closed_idle;
+      dr.closed_queue_full = s->closed_queue_full;
+    }
+    r.doors.push_back(std::move(dr));
+  }
   return r;
 }
 

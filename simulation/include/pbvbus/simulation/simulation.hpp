@@ -149,6 +149,8 @@ class Simulation {
 
   /// The report as of now. `wall_seconds` is how long the run took (for the speed figure).
   Report report(double wall_seconds) const;
+  /// The S7 part of the report as of now.
+  S7Report s7_report() const;
 
  private:
   struct Station;

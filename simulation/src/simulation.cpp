@@ -125,9 +125,14 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
       ls.line->add_tap(ls.stats);
     }
   }
-  if (m_opts.capture != nullptr)
-    for (std::size_t li = 0; li < m_lines.size(); ++li)
+  if (m_opts.capture != nullptr) {
+    for (std::size_t li = 0; li < m_lines.size(); ++li) {
+      // An MPI line's interfaces say so, for the dissector and the timeline (captures/README.md).
+      if (m_plan.lines[li].mpi) m_opts.capture->mark_mpi(*m_lines[li]->line);
       attach_capture(*m_opts.capture, *m_lines[li]->line, li, *probes);
+    }
+    for (auto& d : m_s7_doors) attach_s7_capture(*d);
+  }
 }
 
 Simulation::~Simulation() {
@@ -697,6 +702,27 @@ S7Report Simulation::s7_report() const {
     r.doors.push_back(std::move(dr));
   }
   return r;
+}
+
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+
+void Simulation::attach_s7_capture(S7DoorNode& door) {
+  captures::PcapngWriter& w = *m_opts.capture;
+  const auto& p = door.plan();
+  const std::uint32_t iface =
+      w.add_s7_interface("s7door:" + p.name, "S7 PDUs of the ISO-on-TCP door \"" + p.name + "\" at " +
+                                                 p.listen.str());
+  door.set_capture([&w, iface, this](const iso_on_tcp::PduRecord& r) {
+    captures::S7PduInfo info;
+    info.direction = r.direction == iso_on_tcp::PduDirection::FromClient
+                         ? captures::S7PduInfo::Direction::Inbound
+                         : captures::S7PduInfo::Direction::Outbound;
+    const std::string comment = "door connection " + std::to_string(r.connection_id);
+    info.comment = comment;
+    w.write_s7_pdu(iface, m_sched.now(), r.pdu, info);
+  });
 }
 
 }  // namespace pbvbus::tools

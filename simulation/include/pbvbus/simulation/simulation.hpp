@@ -158,6 +158,7 @@ class Simulation {
   void build_line(std::size_t li);
   void schedule_faults();
   void build_gateways();
+  void attach_s7_capture(S7DoorNode& door);
   void apply_fault(const PlanFault& f, bool on);
   void apply_slave_fault(const PlanFault& f, bool on);
   void make_link(const std::string& target, const std::string& link);

@@ -206,7 +206,8 @@ void MpiClientNode::on_station_event(const mpi_station::StationEvent& e) {
         }
         st.last_latency = e.at - p->sent_at;
         st.max_latency = std::max(st.max_latency, st.last_latency);
-        m_due[r] = e.at + m_plan.reads[r].period;
+        // A fixed grid of periods from the first read; a late answer moves it to the answer.
+        m_due[r] = std::max(m_due[r] + m_plan.reads[r].period, e.at);
         p->outstanding = -1;
       }
       pump(*p, e.at);

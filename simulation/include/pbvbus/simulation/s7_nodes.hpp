@@ -88,9 +88,11 @@ struct S7ReadStats {
 /// Communication (PDU 240) once connected, then each item's Read Var every period.
 ///
 /// Decisions:
-/// - One job outstanding per connection (AmQ 1, as the CPUs offer): a read that comes due while
-///   the previous one is still open waits for it (its next period starts from the answer), so
-///   a slow ring shows as latency and fewer reads, not as a queue.
+/// - One job outstanding per connection (AmQ 1, as the CPUs offer). Each read is due on a fixed
+///   grid of its period from the first read (the first once the connection is set up); one that
+///   comes due while another job is open waits for it, and an answer later than the next due
+///   time moves the grid to the answer, so a slow ring shows as latency and fewer reads, not as
+///   a queue.
 /// - A connection that breaks or is refused is opened again 1 s later (an HMI's retry); every
 ///   break is counted per reason.
 class MpiClientNode final : public bus::EventTarget {

@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "pbvbus/reports/json_text.hpp"
+#include "pbvbus/reports/s7_report.hpp"
 
 namespace pbvbus::tools {
 namespace {
@@ -116,6 +117,7 @@ void write_text(const Report& r, std::ostream& os) {
   write_redundancy_text(r.redundancy, os);
   write_h_text(r.h_systems, os);
   write_gateways_text(r.gateways, os);
+  write_s7_text(r.s7, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -225,6 +227,7 @@ void write_json(const Report& r, std::ostream& os) {
   write_redundancy_json(r.redundancy, os);
   write_h_json(r.h_systems, os);
   write_gateways_json(r.gateways, os);
+  write_s7_json(r.s7, os);
   os << "}\n";
 }
 

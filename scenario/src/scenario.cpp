@@ -1,5 +1,7 @@
 #include "pbvbus/scenario/scenario.hpp"
 
+#include "pbvbus/mpi_station/mpi_bus_params.hpp"
+
 #include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
@@ -34,6 +36,10 @@ std::string_view to_string(StationKind k) {
     case StationKind::DpMaster: return "dp_master";
     case StationKind::DpSlave: return "dp_slave";
     case StationKind::SwitchedInterface: return "switched_station";
+    case StationKind::S7CpuMpi: return "s7_cpu";
+    case StationKind::HCpuMpi: return "h_system CPU";
+    case StationKind::MpiStation: return "mpi_station";
+    case StationKind::S7DoorMpi: return "s7_door";
   }
   return "?";
 }
@@ -136,6 +142,11 @@ struct StationEntry {
   Where where;
   std::string line;
   std::optional<std::uint32_t> address;
+  // Where the line and address fields are, for entries whose message is not one of the plain
+  // station kinds (the MPI interfaces): the message holding them and the fields' names.
+  const pb::Descriptor* desc = nullptr;
+  const char* line_field = "line";
+  const char* address_field = "address";
 };
 
 class Planner {
@@ -204,6 +215,22 @@ class Planner {
     };
     plan_gateways(plan, glocate, m_errors);
     plan_stations(plan);
+    const S7Locator slocate = [this](const char* rep, int index,
+                                     const std::vector<std::pair<const char*, int>>& path) {
+      Where w = nested(m_root, scenario::Scenario::descriptor(), rep, index);
+      const pb::Descriptor* d = scenario::Scenario::descriptor()->FindFieldByName(rep)->message_type();
+      for (std::size_t k = 0; k < path.size() && d != nullptr; ++k) {
+        const pb::FieldDescriptor* f = field_of(d, path[k].first);
+        if (k + 1 == path.size() && f->message_type() == nullptr) {
+          w = at_field(w, d, path[k].first, path[k].second);
+        } else {
+          w = nested(w, d, path[k].first, path[k].second);
+          d = f->message_type();
+        }
+      }
+      return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
+    };
+    plan_s7(plan, slocate, m_errors);
     plan_captures(plan);
     plan_faults(plan);
     if (!m_errors.empty()) return std::nullopt;
@@ -279,7 +306,10 @@ class Planner {
                                                  baud_list() + ")");
         }
       }
-      pl.params = fdl::BusParams::defaults(pl.baud);
+      pl.mpi = l.kind() == scenario::Line::MPI;
+      // An MPI subnet: 187.5 kbit/s unless named, HSA 31 (s7_plan.hpp).
+      if (pl.mpi && l.speed_case() == scenario::Line::SPEED_NOT_SET) pl.baud = bus::Baud::k187_5;
+      pl.params = pl.mpi ? mpi_station::mpi_bus_params(pl.baud) : fdl::BusParams::defaults(pl.baud);
       if (l.has_bus_params()) {
         const Where bw = nested(w, ld, "bus_params");
         apply(bw, l.bus_params(), pl.params);
@@ -296,14 +326,14 @@ class Planner {
 
   /// Index of the line named by field `name` of the message at `w`, or -1 (error reported).
   int line_ref(const Where& w, const pb::Descriptor* d, const std::string& name,
-               std::string_view what) {
+               std::string_view what, const char* field = "line") {
     if (name.empty()) {
       error(w, std::string(what) + " needs a line");
       return -1;
     }
     auto it = m_line_index.find(name);
     if (it == m_line_index.end()) {
-      error(at_field(w, d, "line"), "unknown line " + in_quotes(name));
+      error(at_field(w, d, field), "unknown line " + in_quotes(name));
       return -1;
     }
     return it->second;
@@ -347,6 +377,7 @@ class Planner {
                            nested(m_root, sd, "switched_station", swp.source),
                            plan.lines[static_cast<std::size_t>(rp.line[side])].name, swp.address});
     }
+    add_mpi_entries(plan, entries);
     // Cable order = order of appearance in the text. Without text, the order above.
     if (m_root.tree != nullptr) {
       std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
@@ -356,7 +387,8 @@ class Planner {
 
     std::map<std::pair<int, std::uint32_t>, Where> used;  // (line, address) -> first user
     for (const auto& e : entries) {
-      const pb::Descriptor* d = e.kind == StationKind::Master    ? scenario::Master::descriptor()
+      const pb::Descriptor* d = e.desc != nullptr ? e.desc
+                                : e.kind == StationKind::Master    ? scenario::Master::descriptor()
                                 : e.kind == StationKind::Passive ? scenario::PassiveStation::descriptor()
                                 : e.kind == StationKind::DpMaster ? scenario::DpMaster::descriptor()
                                 : e.kind == StationKind::DpSlave  ? scenario::DpSlave::descriptor()
@@ -364,8 +396,8 @@ class Planner {
                                     ? scenario::SwitchedStation::descriptor()
                                     : scenario::Serial::descriptor();
       const std::string what(to_string(e.kind));
-      const int li = line_ref(e.where, d, e.line, what);
-      const Where aw = at_field(e.where, d, "address");
+      const int li = line_ref(e.where, d, e.line, what, e.line_field);
+      const Where aw = at_field(e.where, d, e.address_field);
       bool addr_ok = false;
       if (!e.address) {
         if (e.kind != StationKind::SerialMonitor && e.kind != StationKind::SerialStation)
@@ -400,7 +432,85 @@ class Planner {
       }
       if (e.kind == StationKind::Master) check_master(e, line, ps);
       if (e.kind == StationKind::Passive) check_passive(e, line);
+      check_mpi_line(e, line, ps, d);
       line.stations.push_back(ps);
+    }
+  }
+
+  /// The MPI interfaces of s7_cpu (X1 in MPI mode), h_system CPUs, PGs/OPs and S7 doors as
+  /// station entries, with their default addresses (s7_plan.hpp).
+  void add_mpi_entries(const ScenarioPlan& plan, std::vector<StationEntry>& entries) {
+    const auto* sd = scenario::Scenario::descriptor();
+    for (int i = 0; i < m_proto.s7_cpu_size(); ++i) {
+      const auto& c = m_proto.s7_cpu(i);
+      if (!c.has_mpi_dp() || c.mpi_dp().mode() != scenario::CpuInterface::MPI) continue;
+      const Where w = nested(nested(m_root, sd, "s7_cpu", i), scenario::S7Cpu::descriptor(), "mpi_dp");
+      entries.push_back({StationKind::S7CpuMpi, i, w, c.mpi_dp().line(),
+                         c.mpi_dp().has_address() ? c.mpi_dp().address() : 2u,
+                         scenario::CpuInterface::descriptor()});
+    }
+    for (int i = 0; i < m_proto.h_system_size(); ++i) {
+      const auto& h = m_proto.h_system(i);
+      if (!h.has_cpu() || !h.cpu().has_mpi()) continue;
+      const auto& m = h.cpu().mpi();
+      const Where w = nested(nested(nested(m_root, sd, "h_system", i), scenario::HSystem::descriptor(),
+                                    "cpu"),
+                             scenario::HCpuPair::descriptor(), "mpi");
+      entries.push_back({StationKind::HCpuMpi, 2 * i, w, m.line(),
+                         m.has_address_cpu0() ? m.address_cpu0() : 2u, scenario::HMpi::descriptor(),
+                         "line", "address_cpu0"});
+      entries.push_back({StationKind::HCpuMpi, 2 * i + 1, w, m.line(),
+                         m.has_address_cpu1() ? m.address_cpu1() : 3u, scenario::HMpi::descriptor(),
+                         "line", "address_cpu1"});
+    }
+    for (int i = 0; i < m_proto.mpi_station_size(); ++i) {
+      const auto& s = m_proto.mpi_station(i);
+      const bool op = s.role() == scenario::MpiStation::OP;
+      entries.push_back({StationKind::MpiStation, i, nested(m_root, sd, "mpi_station", i), s.line(),
+                         s.has_address() ? s.address() : (op ? 1u : 0u),
+                         scenario::MpiStation::descriptor()});
+    }
+    for (int i = 0; i < m_proto.s7_door_size(); ++i) {
+      const auto& d = m_proto.s7_door(i);
+      if (d.mpi_line().empty()) continue;
+      std::optional<std::uint32_t> a;
+      if (d.has_mpi_address()) {
+        a = d.mpi_address();
+      } else {  // the lowest address nobody else names on that line
+        for (std::uint32_t c = 0; c <= kMaxAddress && !a; ++c) {
+          bool used = false;
+          for (const auto& e : entries) used |= e.line == d.mpi_line() && e.address == c;
+          if (!used) a = c;
+        }
+      }
+      entries.push_back({StationKind::S7DoorMpi, i, nested(m_root, sd, "s7_door", i), d.mpi_line(),
+                         a, scenario::S7Door::descriptor(), "mpi_line", "mpi_address"});
+    }
+    (void)plan;
+  }
+
+  /// MPI lines carry MPI stations and plain FDL stations, no DP; MPI stations sit on MPI lines
+  /// at addresses the GAP reaches (s7_plan.hpp).
+  void check_mpi_line(const StationEntry& e, const PlanLine& line, const PlanStation& ps,
+                      const pb::Descriptor* d) {
+    const bool mpi_kind = e.kind == StationKind::S7CpuMpi || e.kind == StationKind::HCpuMpi ||
+                          e.kind == StationKind::MpiStation || e.kind == StationKind::S7DoorMpi;
+    const bool dp_kind = e.kind == StationKind::DpMaster || e.kind == StationKind::DpSlave ||
+                         e.kind == StationKind::SwitchedInterface;
+    if (mpi_kind && !line.mpi) {
+      error(at_field(e.where, d, e.line_field),
+            std::string(to_string(e.kind)) + " on line " + in_quotes(line.name) +
+                ": an MPI station needs a line of kind MPI");
+    } else if (dp_kind && line.mpi) {
+      error(at_field(e.where, d, e.line_field),
+            std::string(to_string(e.kind)) + " on MPI line " + in_quotes(line.name) +
+                ": an MPI line carries no DP (put DP stations on a CPU's DP interface line)");
+    }
+    if (mpi_kind && ps.address && *ps.address > ps.params.hsa) {
+      error(at_field(e.where, d, e.address_field),
+            "MPI address " + std::to_string(*ps.address) + " is above HSA " +
+                std::to_string(ps.params.hsa) + " of line " + in_quotes(line.name) +
+                ": no GAP poll would let the station into the token ring");
     }
   }
 

@@ -41,6 +41,11 @@ bool DpMasterNode::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request
 
 void DpMasterNode::on_token(bus::Ticks now, bus::Ticks trr) {
   ++m_tokens;
+  if (m_cpu) {  // a CPU's DP interface: its process image
+    m_cpu(m_master);
+    m_master.on_token(now, trr);
+    return;
+  }
   // Served by a gateway: its clients own the outputs (scenario.proto, DpMaster.outputs).
   if (m_program_off) {
     m_master.on_token(now, trr);

@@ -91,6 +91,18 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
                                       m_plan.lines.at(static_cast<std::size_t>(rp.line[1])).params};
     m_redundant.push_back(std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params));
   }
+  for (const auto& c : m_plan.s7.cpus)
+    m_s7_cpus.push_back(std::make_unique<S7CpuNode>(
+        c, c.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(c.mpi_line)).params : nullptr));
+  for (const auto& m : m_plan.s7.stations)
+    m_mpi_clients.push_back(std::make_unique<MpiClientNode>(
+        m_sched, m, m_plan.lines.at(static_cast<std::size_t>(m.line)).params));
+  std::vector<S7CpuNode*> cpus;
+  for (auto& c : m_s7_cpus) cpus.push_back(c.get());
+  for (const auto& d : m_plan.s7.doors)
+    m_s7_doors.push_back(std::make_unique<S7DoorNode>(
+        m_sched, d, cpus,
+        d.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(d.mpi_line)).params : nullptr));
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
   for (auto& node : m_redundant) node->set_capture(m_opts.capture);
   std::string why;
@@ -113,9 +125,14 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
       ls.line->add_tap(ls.stats);
     }
   }
-  if (m_opts.capture != nullptr)
-    for (std::size_t li = 0; li < m_lines.size(); ++li)
+  if (m_opts.capture != nullptr) {
+    for (std::size_t li = 0; li < m_lines.size(); ++li) {
+      // An MPI line's interfaces say so, for the dissector and the timeline (captures/README.md).
+      if (m_plan.lines[li].mpi) m_opts.capture->mark_mpi(*m_lines[li]->line);
       attach_capture(*m_opts.capture, *m_lines[li]->line, li, *probes);
+    }
+    for (auto& d : m_s7_doors) attach_s7_capture(*d);
+  }
 }
 
 Simulation::~Simulation() {
@@ -138,6 +155,7 @@ bus::PacedRunner& Simulation::paced_runner(bus::Speed speed) {
     for (auto& s : ls->stations)
       if (s.pty) s.pty->attach_io(*m_runner);
   for (auto& g : m_gateways) g->open(*m_runner);
+  for (auto& d : m_s7_doors) d->open(*m_runner);
   return *m_runner;
 }
 
@@ -219,6 +237,14 @@ void Simulation::build_line(std::size_t li) {
           break;
         }
         st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
+        for (auto& cpu : m_s7_cpus) {
+          const auto& cp = cpu->plan();
+          if ((cp.x1_dp && cp.x1_dp->dp_master == mi) || (cp.x2_dp && cp.x2_dp->dp_master == mi)) {
+            S7CpuNode* node = cpu.get();
+            st.dp_master->set_cpu([node](dp::Master& m) { node->exchange(m); });
+            label = "CPU " + cp.name + " DP interface " + std::to_string(st.address);
+          }
+        }
         st.position = ls->line->attach(st.dp_master->station(), label);
         break;
       }
@@ -244,6 +270,26 @@ void Simulation::build_line(std::size_t li) {
         st.position = ls->line->attach(st.dp_slave->station(), label);
         break;
       }
+      case StationKind::S7CpuMpi: {
+        S7CpuNode& cpu = *m_s7_cpus.at(static_cast<std::size_t>(ps.source));
+        label = "CPU " + cpu.plan().name + " MPI " + std::to_string(st.address);
+        st.position = ls->line->attach(*cpu.mpi(), label);
+        break;
+      }
+      case StationKind::MpiStation: {
+        MpiClientNode& pg = *m_mpi_clients.at(static_cast<std::size_t>(ps.source));
+        label = std::string(pg.plan().op ? "OP " : "PG ") + std::to_string(st.address);
+        st.position = ls->line->attach(pg.station(), label);
+        break;
+      }
+      case StationKind::S7DoorMpi: {
+        S7DoorNode& door = *m_s7_doors.at(static_cast<std::size_t>(ps.source));
+        label = "S7 door " + door.plan().name + " MPI " + std::to_string(st.address);
+        st.position = ls->line->attach(*door.mpi(), label);
+        break;
+      }
+      case StationKind::HCpuMpi:
+        throw std::runtime_error("not yet");
       case StationKind::SerialMonitor:
       case StationKind::SerialStation: {
         const auto& sp = m_plan.proto.serial(ps.source);
@@ -335,6 +381,7 @@ void Simulation::start() {
   }
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
+  for (auto& pg : m_mpi_clients) pg->start(m_sched.now());
   build_gateways();
   schedule_faults();
 }
@@ -582,7 +629,100 @@ Report Simulation::report(double wall_seconds) const {
   for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
   for (const auto& h : m_h) r.h_systems.push_back(h->report());
   for (const auto& g : m_gateways) r.gateways.push_back(g->report());
+  r.s7 = s7_report();
   return r;
+}
+
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+
+S7Report Simulation::s7_report() const {
+  S7Report r;
+  for (const auto& c : m_s7_cpus) {
+    S7CpuReport cr;
+    cr.name = c->plan().name;
+    if (const auto* m = c->mpi()) {
+      cr.mpi_address = m->address();
+      cr.accepted = m->stats().connects_accepted;
+      cr.refused = m->stats().connects_refused;
+      cr.open = m->server_connections();
+      cr.pdus_received = m->stats().pdus_received;
+      cr.pdus_sent = m->stats().pdus_sent;
+    }
+    cr.dp_exchanges = c->dp_exchanges();
+    cr.unmapped_bytes = c->unmapped_bytes();
+    r.cpus.push_back(std::move(cr));
+  }
+  for (const auto& pg : m_mpi_clients) {
+    MpiStationReport sr;
+    sr.op = pg->plan().op;
+    sr.line = m_plan.lines.at(static_cast<std::size_t>(pg->plan().line)).name;
+    sr.address = pg->plan().address;
+    sr.connects = pg->connects();
+    sr.breaks = pg->breaks();
+    const auto& broken = pg->station().stats().broken;
+    for (std::size_t k = 0; k < broken.size(); ++k)
+      if (broken[k] != 0)
+        sr.broken[std::string(mpi_station::to_string(static_cast<mpi_station::EndReason>(k)))] = broken[k];
+    for (std::size_t k = 0; k < pg->reads().size(); ++k) {
+      const auto& st = pg->reads()[k];
+      const auto& rp = pg->plan().reads[k];
+      S7ReadReport rr;
+      rr.cpu = rp.cpu;
+      rr.item = rp.item.str();
+      rr.requests = st.requests;
+      rr.ok = st.ok;
+      rr.errors = st.errors;
+      rr.last_code = st.last_code;
+      rr.last_value = st.last_value;
+      rr.last_latency = st.last_latency;
+      rr.max_latency = st.max_latency;
+      sr.reads.push_back(std::move(rr));
+    }
+    r.stations.push_back(std::move(sr));
+  }
+  for (const auto& d : m_s7_doors) {
+    S7DoorReport dr;
+    dr.name = d->plan().name;
+    dr.listen = d->plan().listen.str();
+    dr.port = d->port();
+    if (const auto* s = d->stats()) {
+      dr.clients = s->clients_accepted;
+      dr.connects = s->connects;
+      dr.connects_refused = s->connects_refused;
+      dr.routes_closed = s->routes_closed;
+      dr.jobs = s->jobs;
+      dr.answers = s->answers;
+      dr.closed_garbage = s->closed_garbage;
+      dr.closed_stalled = s->closed_stalled;
+      dr.closed_idle = s->closed_idle;
+      dr.closed_queue_full = s->closed_queue_full;
+    }
+    r.doors.push_back(std::move(dr));
+  }
+  return r;
+}
+
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+
+void Simulation::attach_s7_capture(S7DoorNode& door) {
+  captures::PcapngWriter& w = *m_opts.capture;
+  const auto& p = door.plan();
+  const std::uint32_t iface =
+      w.add_s7_interface("s7door:" + p.name, "S7 PDUs of the ISO-on-TCP door \"" + p.name + "\" at " +
+                                                 p.listen.str());
+  door.set_capture([&w, iface, this](const iso_on_tcp::PduRecord& r) {
+    captures::S7PduInfo info;
+    info.direction = r.direction == iso_on_tcp::PduDirection::FromClient
+                         ? captures::S7PduInfo::Direction::Inbound
+                         : captures::S7PduInfo::Direction::Outbound;
+    const std::string comment = "door connection " + std::to_string(r.connection_id);
+    info.comment = comment;
+    w.write_s7_pdu(iface, m_sched.now(), r.pdu, info);
+  });
 }
 
 }  // namespace pbvbus::tools

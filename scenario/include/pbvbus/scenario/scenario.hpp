@@ -42,6 +42,7 @@
 #include "pbvbus/scenario/dp_plan.hpp"
 #include "pbvbus/scenario/gateway_plan.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
+#include "pbvbus/scenario/s7_plan.hpp"
 #include "scenario.pb.h"
 
 namespace pbvbus::tools {
@@ -64,6 +65,11 @@ enum class StationKind : std::uint8_t {
   DpMaster,
   DpSlave,
   SwitchedInterface,  ///< one interface of a switched_station (source = its index)
+  // MPI stations (s7_plan.hpp): active stations on a line of kind MPI.
+  S7CpuMpi,    ///< an s7_cpu's MPI interface (source = its index)
+  HCpuMpi,     ///< an h_system CPU's MPI interface (source = h_system index * 2 + rack)
+  MpiStation,  ///< a PG or an OP (source = its mpi_station index)
+  S7DoorMpi,   ///< an s7_door's own station on its mpi_line (source = its index)
 };
 std::string_view to_string(StationKind k);
 
@@ -83,6 +89,7 @@ struct PlanProbe {
 
 struct PlanLine {
   std::string name;
+  bool mpi = false;  ///< kind MPI (s7_plan.hpp)
   bus::Baud baud = bus::Baud::k1_5M;
   fdl::BusParams params;
   std::vector<PlanStation> stations;  ///< cable order = attachment order
@@ -192,6 +199,7 @@ struct ScenarioPlan {
   std::vector<SwitchedPlan> switched;             ///< in file order, valid ones only
   std::vector<HSystemPlan> h_systems;  ///< h_system entries (update timing; runtime if simulated)
   std::vector<GatewayPlan> gateways;   ///< gateway entries, in file order (gateway_plan.hpp)
+  S7Plan s7;  ///< s7_cpu, mpi_station, s7_door entries and the H CPUs' MPI interfaces
 };
 
 struct LoadResult {

@@ -49,6 +49,9 @@ class DpMasterNode final : public fdl::InitiatorUser {
   dp::Master& master() { return m_master; }
   const dp::Master& master() const { return m_master; }
   std::uint64_t global_controls() const { return m_global_controls; }
+  /// The master is a CPU's DP interface (s7_nodes.hpp): at every token receipt `cpu` exchanges
+  /// the CPU's process image with the slaves instead of the master-side test program.
+  void set_cpu(std::function<void(dp::Master&)> cpu) { m_cpu = std::move(cpu); }
 
   void on_power_on(bus::Ticks now) override;
   bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override;
@@ -62,6 +65,7 @@ class DpMasterNode final : public fdl::InitiatorUser {
   dp::Master m_master;
   scenario::DpMaster::Outputs m_program;
   bool m_program_off = false;  ///< a gateway's clients own the outputs
+  std::function<void(dp::Master&)> m_cpu;  ///< a CPU owns the outputs
   std::unique_ptr<fdl::ActiveStation> m_station;
   std::uint64_t m_tokens = 0;
   std::uint64_t m_global_controls = 0;

@@ -39,6 +39,8 @@
 #include "pbvbus/simulation/gateway_node.hpp"
 #include "pbvbus/simulation/h_system_node.hpp"
 #include "pbvbus/simulation/redundancy_system.hpp"
+#include "pbvbus/simulation/s7_door_node.hpp"
+#include "pbvbus/simulation/s7_nodes.hpp"
 #include "pbvbus/simulation/report.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 
@@ -109,12 +111,26 @@ class Simulation {
 
   /// Whether something outside the process is attached (a pty, a gateway): then the run must
   /// be paced.
-  bool has_external_attachments() const { return !m_serial.empty() || !m_plan.gateways.empty(); }
+  bool has_external_attachments() const {
+    return !m_serial.empty() || !m_plan.gateways.empty() || !m_plan.s7.doors.empty();
+  }
   /// The gateways, in file order; built by start(), their doors opened by paced_runner().
   std::size_t gateway_count() const { return m_gateways.size(); }
   GatewayNode& gateway(std::size_t i) { return *m_gateways.at(i); }
   const GatewayNode& gateway(std::size_t i) const { return *m_gateways.at(i); }
   const std::vector<SerialReport>& serial_ports() const { return m_serial; }
+  /// The s7_cpu entries, in file order.
+  std::size_t s7_cpu_count() const { return m_s7_cpus.size(); }
+  S7CpuNode& s7_cpu(std::size_t i) { return *m_s7_cpus.at(i); }
+  const S7CpuNode& s7_cpu(std::size_t i) const { return *m_s7_cpus.at(i); }
+  /// The s7_door entries, in file order; their doors opened by paced_runner().
+  std::size_t s7_door_count() const { return m_s7_doors.size(); }
+  S7DoorNode& s7_door(std::size_t i) { return *m_s7_doors.at(i); }
+  const S7DoorNode& s7_door(std::size_t i) const { return *m_s7_doors.at(i); }
+  /// The mpi_station entries (PGs, OPs), in file order.
+  std::size_t mpi_client_count() const { return m_mpi_clients.size(); }
+  MpiClientNode& mpi_client(std::size_t i) { return *m_mpi_clients.at(i); }
+  const MpiClientNode& mpi_client(std::size_t i) const { return *m_mpi_clients.at(i); }
 
   /// Paced driver: creates the simulation's PacedRunner (once) and registers every pty
   /// attachment's I/O on its io_context. The Simulation owns the runner so that the order of
@@ -133,6 +149,8 @@ class Simulation {
 
   /// The report as of now. `wall_seconds` is how long the run took (for the speed figure).
   Report report(double wall_seconds) const;
+  /// The S7 part of the report as of now.
+  S7Report s7_report() const;
 
  private:
   struct Station;
@@ -140,6 +158,7 @@ class Simulation {
   void build_line(std::size_t li);
   void schedule_faults();
   void build_gateways();
+  void attach_s7_capture(S7DoorNode& door);
   void apply_fault(const PlanFault& f, bool on);
   void apply_slave_fault(const PlanFault& f, bool on);
   void make_link(const std::string& target, const std::string& link);
@@ -155,6 +174,10 @@ class Simulation {
   // Redundant master systems own devices on several lines: built before the lines, destroyed
   // after them.
   std::vector<std::unique_ptr<RedundantSystemNode>> m_redundant;
+  // CPUs and PGs/OPs own MPI stations the lines hold: built before the lines, destroyed after.
+  std::vector<std::unique_ptr<S7CpuNode>> m_s7_cpus;
+  std::vector<std::unique_ptr<MpiClientNode>> m_mpi_clients;
+  std::vector<std::unique_ptr<S7DoorNode>> m_s7_doors;
   std::vector<std::unique_ptr<LineState>> m_lines;
   // H-systems drive the redundant systems' models and schedule on m_sched: destroyed first.
   std::vector<std::unique_ptr<HSystemNode>> m_h;

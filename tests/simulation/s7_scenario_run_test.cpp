@@ -1,0 +1,157 @@
+// S7 communication in a running scenario (simulation/s7_nodes.hpp): a PG on an MPI line
+// connects to a single CPU with the §H.3 trace's frames and reads a DB whose answer carries the
+// bytes the CPU holds; the CPU's DP interface maps its slaves into I and Q; an OP reads
+// periodically and its report says so.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+
+#include "frame_recorder.hpp"
+#include "pbvbus/scenario/scenario.hpp"
+#include "pbvbus/simulation/simulation.hpp"
+
+namespace pbvbus::tools {
+namespace {
+
+const std::string kFile = std::string(PBVBUS_SOURCE_DIR) + "/examples/s7-run.textproto";
+
+std::optional<ScenarioPlan> plan_of(const std::string& text) {
+  auto r = parse_scenario(text, kFile);
+  EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].str());
+  return r.plan;
+}
+
+bool contains(const std::vector<std::uint8_t>& hay, const std::vector<std::uint8_t>& needle) {
+  return std::search(hay.begin(), hay.end(), needle.begin(), needle.end()) != hay.end();
+}
+
+TEST(S7ScenarioRun, APgConnectsWithTheTraceFramesAndReadsWhatTheCpuHolds) {
+  const auto plan = plan_of(R"(name: "pg" duration: "1s"
+line { name: "MPI" kind: MPI }
+s7_cpu { name: "C" mpi_dp { line: "MPI" } db { number: 1 size: 16 } }
+mpi_station { line: "MPI" read { cpu: 2 item: "DB1.DBB0,10" period: "100ms" } }
+)");
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  test::FrameRecorder rec;
+  sim.line(0).add_tap(rec);
+  auto db1 = sim.s7_cpu(0).memory().db(1);
+  ASSERT_TRUE(db1);
+  for (std::size_t i = 0; i < 10; ++i) (*db1)[i] = static_cast<std::uint8_t>(0xA0 + i);
+  sim.start();
+  sim.run_until(*sim.duration());
+
+  const auto hex = rec.hex_all();
+  // protocol-facts.md §H.3: PG 0 -> PLC 2 connect request, and the PLC's confirm from SAP 0x14.
+  const std::string request = "68 11 11 68 82 80 6D 00 14 E0 04 00 80 00 02 00 02 01 00 01 00 ED 16";
+  const std::string confirm = "68 11 11 68 80 82 6C 14 14 D0 04 00 80 00 02 00 02 01 00 01 00 F0 16";
+  const auto req = std::find(hex.begin(), hex.end(), request);
+  const auto conf = std::find(hex.begin(), hex.end(), confirm);
+  ASSERT_NE(req, hex.end());
+  ASSERT_NE(conf, hex.end());
+  EXPECT_LT(req, conf);
+  // The CPU's FDL answers the request with SC at once.
+  EXPECT_EQ(*(req + 1), "E5");
+
+  // The Read Var answer (§H.4: ack-data, 2 octets of parameters 04 01, 14 of data: FF 04,
+  // 80 bits, the ten octets) inside a data message F1 nr from CPU 2 (SA 82) to PG 0 (DA 80).
+  // Its PDU reference is 2: the PG's Setup Communication was 1.
+  const std::vector<std::uint8_t> answer = {0x32, 0x03, 0x00, 0x00, 0x00, 0x02, 0x00, 0x02,
+                                            0x00, 0x0E, 0x00, 0x00, 0x04, 0x01, 0xFF, 0x04,
+                                            0x00, 0x50, 0xA0, 0xA1, 0xA2, 0xA3, 0xA4, 0xA5,
+                                            0xA6, 0xA7, 0xA8, 0xA9};
+  bool seen = false;
+  for (const auto& f : rec.frames())
+    if (f.bytes.size() > 12 && f.bytes[4] == 0x80 && f.bytes[5] == 0x82 && f.bytes[9] == 0xF1 &&
+        contains(f.bytes, answer))
+      seen = true;
+  EXPECT_TRUE(seen) << "no Read Var answer with DB1's bytes from the CPU";
+
+  const auto r = sim.s7_report();
+  ASSERT_EQ(r.stations.size(), 1u);
+  const auto& rd = r.stations[0].reads.at(0);
+  // Once connected, one read per 100 ms in a 1 s run: the first within the first rotations.
+  EXPECT_GE(rd.ok, 9u);
+  EXPECT_LE(rd.ok, 10u);
+  EXPECT_EQ(rd.errors, 0u);
+  EXPECT_EQ(rd.last_value, std::vector<std::uint8_t>(answer.end() - 10, answer.end()));
+  EXPECT_EQ(r.stations[0].breaks, 0u);
+  ASSERT_EQ(r.cpus.size(), 1u);
+  EXPECT_EQ(r.cpus[0].accepted, 1u);
+  EXPECT_EQ(r.cpus[0].open, 1u);
+}
+
+TEST(S7ScenarioRun, TheCpusDpInterfaceMapsItsSlavesIntoIAndQ) {
+  // Slaves 3 and 4 (PBVB0A01: one module 2 octets in, 2 out): slave 3 at IB0..1 / QB0..1,
+  // slave 4 at IB2..3 / QB2..3 (ascending addresses, no addresses configured).
+  const std::string text = R"(name: "dp" duration: "200ms"
+line { name: "DP" }
+dp_master { address: 2 line: "DP" }
+dp_slave { address: 4 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 inputs: ZERO }
+dp_slave { address: 3 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 inputs: COUNTER }
+s7_cpu { name: "C" mpi_dp { mode: DP line: "DP" address: 2 } }
+)";
+  const auto plan = plan_of(text);
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  auto q = sim.s7_cpu(0).memory().area(s7cpu::Area::Outputs);
+  q[0] = 0x12;
+  q[1] = 0x34;
+  q[2] = 0x56;
+  q[3] = 0x78;
+  sim.start();
+  sim.run_until(*sim.duration());
+  const auto rep = sim.report(1.0);
+  const DpSlaveView* s3 = nullptr;
+  const DpSlaveView* s4 = nullptr;
+  for (const auto& v : rep.dp_slaves) (v.address == 3 ? s3 : s4) = &v;
+  ASSERT_TRUE(s3 && s4);
+  EXPECT_EQ(s3->outputs, (std::vector<std::uint8_t>{0x12, 0x34}));
+  EXPECT_EQ(s4->outputs, (std::vector<std::uint8_t>{0x56, 0x78}));
+  // I holds what the slaves sent in the last exchange: slave 3 counts, slave 4 sends zeros.
+  const auto in = sim.s7_cpu(0).memory().area(s7cpu::Area::Inputs);
+  EXPECT_NE(in[0] | in[1], 0);
+  EXPECT_EQ(in[2] | in[3], 0);
+  EXPECT_GT(sim.s7_cpu(0).dp_exchanges(), 100u);
+  EXPECT_EQ(sim.s7_cpu(0).unmapped_bytes(), 0u);
+}
+
+TEST(S7ScenarioRun, ACpuInStopWritesZeroOutputs) {
+  const auto plan = plan_of(R"(name: "stop" duration: "100ms"
+line { name: "DP" }
+dp_master { address: 2 line: "DP" }
+dp_slave { address: 3 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 }
+s7_cpu { name: "C" mode: STOP dp { line: "DP" address: 2 } }
+)");
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  auto q = sim.s7_cpu(0).memory().area(s7cpu::Area::Outputs);
+  q[0] = 0xFF;
+  q[1] = 0xFF;
+  sim.start();
+  sim.run_until(*sim.duration());
+  const auto rep = sim.report(1.0);
+  ASSERT_EQ(rep.dp_slaves.size(), 1u);
+  EXPECT_EQ(rep.dp_slaves[0].outputs, (std::vector<std::uint8_t>{0, 0}));
+}
+
+TEST(S7ScenarioRun, AReadOfAMissingDbIsCountedWithItsReturnCode) {
+  const auto plan = plan_of(R"(name: "nodb" duration: "300ms"
+line { name: "MPI" kind: MPI }
+s7_cpu { name: "C" mpi_dp { line: "MPI" } }
+mpi_station { role: OP line: "MPI" read { cpu: 2 item: "DB9.DBW0" } }
+)");
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const auto r = sim.s7_report();
+  const auto& rd = r.stations.at(0).reads.at(0);
+  EXPECT_EQ(rd.ok, 0u);
+  EXPECT_GE(rd.errors, 2u);
+  EXPECT_EQ(rd.last_code, 0x0A);  // §H.4: object does not exist
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

@@ -343,6 +343,45 @@ TEST(HS7, HListsOverReadSzl) {
                    'A', 'B', '0', ' '}));
 }
 
+// Without a ProgramSpec (the fixture's hook program): M and the DBs live in the model's own
+// storage per CPU, I and Q are the model's one PII/PIQ; a write during the link-up reaches the
+// standby through the update's copy at t4, a write in Redundant reaches both at once; counters
+// and timers are copied at t4 too.
+TEST(HS7, HookProgramMemoryFollowsTheSameRules) {
+  HSys s;
+  HS7MemoryConfig m;
+  m.dbs = {{1, 4}};
+  s.h->set_s7_memory(m);
+  s.at(kT0);
+  s.h->power_on_both();
+  s.at(500 * kMs);
+  HS7Session c = s.h->open_s7_adhoc(0);  // before the link-up (R8)
+  ASSERT_TRUE(c.handle(kSetup) == kSetupAnswer);
+  s.at(2000 * kMs);
+  EXPECT_EQ(c.handle(kWriteDbw0), kWriteOk);
+  // Write Var C 3 = 00 2A (area 1C, transport 1C, count 1, address 3; data transport 09),
+  // pdu-ref 6.
+  EXPECT_EQ(c.handle(hex("32 01 00 00 00 06 00 0E 00 06 | 05 01 12 0A 10 1C 00 01 00 00 1C 00 00 03"
+                         "| 00 09 00 02 00 2A")),
+            hex("32 03 00 00 00 06 00 02 00 01 00 00 | 05 01 | FF"));
+  EXPECT_EQ(*s7cpu::get_word(*s.h->s7_cpu_memory(1).db(1), 0), 0x0000);
+  EXPECT_EQ(s.h->s7_cpu_memory(1).counters()[3], 0);
+  s.at(kRedundant + 100 * kMs);
+  EXPECT_EQ(*s7cpu::get_word(*s.h->s7_cpu_memory(1).db(1), 0), 0x1234);
+  EXPECT_EQ(s.h->s7_cpu_memory(1).counters()[3], 0x2A);
+  // In Redundant: DB1.DBW2 (pdu-ref 3 again) reaches both at once.
+  Bytes w = kWriteDbw0;
+  w[23] = 0x10;  // the address's low octet: 2 x 8 = 16 = 0x10
+  EXPECT_EQ(c.handle(w), kWriteOk);
+  EXPECT_EQ(*s7cpu::get_word(*s.h->s7_cpu_memory(1).db(1), 2), 0x1234);
+  // QW 0 is the hook's counter in the model's PIQ, the same for both CPUs.
+  HS7Session d = s.h->open_s7_adhoc(1);
+  ASSERT_TRUE(d.handle(kSetup) == kSetupAnswer);
+  const Bytes q = d.handle(hex("32 01 00 00 00 09 00 0E 00 00 | 04 01 12 0A 10 02 00 02 00 00 82 00 00 00"));
+  ASSERT_EQ(q.size(), 20u);
+  EXPECT_EQ(Bytes(q.begin() + 18, q.end()), Bytes(s.h->piq().begin(), s.h->piq().begin() + 2));
+}
+
 // Garbage ends a session (ProtocolError); a destroyed handle gives the resource back.
 TEST(HS7, ProtocolErrorAndRelease) {
   S7Sys s;

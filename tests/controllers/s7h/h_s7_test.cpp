@@ -308,6 +308,8 @@ TEST(HS7, RoutingConnectionIsDroppedAtTheSwitchover) {
   EXPECT_EQ(r.close_reason(), S7CloseReason::Switchover);
   EXPECT_TRUE(s.ask(r, kReadDbw0).empty());
   EXPECT_EQ(asked, 2);
+  // At the switchover itself the IM has no active channel yet: refused.
+  EXPECT_THAT(s.h->open_s7_routing(0, kFast, ep).close_text(), HasSubstr("no active channel"));
   // The user re-establishes it once the IM's new active channel runs.
   s.at(4500 * kMs);
   HS7Session again = s.h->open_s7_routing(0, kFast, ep);

@@ -1076,6 +1076,7 @@ bool HCpuPair::connect(int r, bus::Ticks now) {
   check_rack(r);
   run_due(now);
   if (!accepts_connections(r)) return false;
+  if (m_p.max_connections > 0 && m_cpu[r].connections >= m_p.max_connections) return false;
   ++m_cpu[r].connections;
   return true;
 }

@@ -240,10 +240,13 @@ HS7Session HSystemModel::open_s7_adhoc(int rack) {
   if (!ok) {
     s->reason = S7CloseReason::Refused;
     const CpuState st = m_pair.state(rack);
-    s->text = st == CpuState::Off || st == CpuState::ErrorSearch || st == CpuState::Defective
-                  ? "CPU " + std::to_string(rack) + " is " + std::string(to_string(st))
-                  : "no new connections from the start of a link-up to the end of the update "
-                    "(R8)";
+    if (st == CpuState::Off || st == CpuState::ErrorSearch || st == CpuState::Defective)
+      s->text = "CPU " + std::to_string(rack) + " is " + std::string(to_string(st));
+    else if (m_pair.accepts_connections(rack))
+      s->text = "all " + std::to_string(m_pair.params().max_connections) +
+                " connection resources of CPU " + std::to_string(rack) + " are in use";
+    else
+      s->text = "no new connections from the start of a link-up to the end of the update (R8)";
     return s7_open(std::move(s));
   }
   s->epoch = m_pair.connection_epoch(rack);

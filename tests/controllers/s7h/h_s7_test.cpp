@@ -384,6 +384,24 @@ TEST(HS7, HookProgramMemoryFollowsTheSameRules) {
   EXPECT_EQ(Bytes(q.begin() + 18, q.end()), Bytes(s.h->piq().begin(), s.h->piq().begin() + 2));
 }
 
+// The MPI connection resources (HCpuPairParams::max_connections): a clear refusal beyond them,
+// and a closed session gives its resource back.
+TEST(HS7, ConnectionResourcesAreCounted) {
+  HCpuPairParams p;
+  p.max_connections = 2;
+  HSys s(p);
+  s.bring_up();
+  HS7Session a = s.h->open_s7_adhoc(0);
+  HS7Session b = s.h->open_s7_adhoc(0);
+  ASSERT_TRUE(a.alive() && b.alive());
+  HS7Session c = s.h->open_s7_adhoc(0);
+  EXPECT_EQ(c.close_reason(), S7CloseReason::Refused);
+  EXPECT_EQ(c.close_text(), "all 2 connection resources of CPU 0 are in use");
+  EXPECT_TRUE(s.h->open_s7_adhoc(1).alive());  // per CPU
+  a.close();
+  EXPECT_TRUE(s.h->open_s7_adhoc(0).alive());
+}
+
 // Garbage ends a session (ProtocolError); a destroyed handle gives the resource back.
 TEST(HS7, ProtocolErrorAndRelease) {
   S7Sys s;

@@ -205,8 +205,7 @@ HS7Session HSystemModel::s7_open(S7SessionPtr s) {
 void HSystemModel::s7_finish(S7SessionState& s, S7CloseReason why, std::string text) {
   if (s.reason != S7CloseReason::None) return;
   // An ad-hoc connection the pair still counts gives its resource back.
-  if (s.route == S7Route::AdHoc && s.reason != S7CloseReason::Refused &&
-      m_pair.connection_epoch(s.rack) == s.epoch)
+  if (s.route == S7Route::AdHoc && m_pair.connection_epoch(s.rack) == s.epoch)
     m_pair.disconnect(s.rack);
   s.reason = why;
   s.text = std::move(text);

@@ -519,7 +519,8 @@ class HSystemModel final : public bus::EventTarget {
   // Sessions are checked at every reconcile() and at every use.
  public:
   /// The CPUs' S7 memory. Before the first OB 1 (a set_program(ProgramSpec) before is rebuilt
-  /// with the new memory area). Throws std::invalid_argument("s7 memory: " + the first
+  /// with the new memory area). Until it is called: M = the program's memory exactly (no free
+  /// flags), no DBs, 256 counters and timers. Throws std::invalid_argument("s7 memory: " + the first
   /// problem) for a bad configuration or after the first OB 1; the model is then unchanged.
   void set_s7_memory(HS7MemoryConfig c);
   const HS7MemoryConfig& s7_memory() const { return m_s7_cfg; }
@@ -564,8 +565,16 @@ class HSystemModel final : public bus::EventTarget {
   void s7_finish(S7SessionState& s, S7CloseReason why, std::string text);
   std::vector<std::uint8_t> s7_handle(std::uint32_t id, std::span<const std::uint8_t> pdu);
   void s7_release(std::uint32_t id);
-  HS7MemoryConfig m_s7_cfg;
-  HS7Layout m_s7_layout = layout(HS7MemoryConfig{}, 0);
+  /// Until set_s7_memory(): no flags beyond the program's memory and no DBs, so a model whose
+  /// S7 memory is not configured keeps the images it had before S7 (the scenario's comparison
+  /// fault tells a program with state from one without by an empty memory area).
+  HS7MemoryConfig m_s7_cfg = unconfigured_s7_memory();
+  HS7Layout m_s7_layout = layout(unconfigured_s7_memory(), 0);
+  static HS7MemoryConfig unconfigured_s7_memory() {
+    HS7MemoryConfig c;
+    c.flags = 0;
+    return c;
+  }
   std::array<std::vector<std::uint8_t>, 2> m_s7_work;  ///< M + DBs without a ProgramSpec
   std::array<std::vector<std::uint16_t>, 2> m_s7_counters, m_s7_timers;
   std::array<s7cpu::CpuMemory, 2> m_s7_views;

@@ -9,11 +9,54 @@ CpuMemory::CpuMemory(const CpuMemorySizes& sizes)
       outputs_(sizes.outputs),
       flags_(sizes.flags),
       counters_(sizes.counters),
-      timers_(sizes.timers) {}
+      timers_(sizes.timers),
+      inputs_view_(inputs_),
+      outputs_view_(outputs_),
+      flags_view_(flags_),
+      counters_view_(counters_),
+      timers_view_(timers_) {}
 
 void CpuMemory::create_db(std::uint16_t number, std::size_t size) {
-  dbs_[number] = std::vector<std::uint8_t>(size);
+  Db& d = dbs_[number];
+  d.owned.assign(size, 0);
+  d.view = d.owned;
 }
+
+void CpuMemory::bind(Area a, std::span<std::uint8_t> storage) {
+  switch (a) {
+    case Area::Inputs:
+      inputs_view_ = storage;
+      sizes_.inputs = storage.size();
+      return;
+    case Area::Outputs:
+      outputs_view_ = storage;
+      sizes_.outputs = storage.size();
+      return;
+    case Area::Flags:
+      break;
+  }
+  flags_view_ = storage;
+  sizes_.flags = storage.size();
+}
+
+void CpuMemory::bind_counters(std::span<std::uint16_t> storage) {
+  counters_view_ = storage;
+  sizes_.counters = storage.size();
+}
+
+void CpuMemory::bind_timers(std::span<std::uint16_t> storage) {
+  timers_view_ = storage;
+  sizes_.timers = storage.size();
+}
+
+void CpuMemory::bind_db(std::uint16_t number, std::span<std::uint8_t> storage) {
+  Db& d = dbs_[number];
+  d.owned.clear();
+  d.owned.shrink_to_fit();
+  d.view = storage;
+}
+
+void CpuMemory::clear_dbs() { dbs_.clear(); }
 
 bool CpuMemory::delete_db(std::uint16_t number) {
   return dbs_.erase(number) != 0;
@@ -26,25 +69,25 @@ bool CpuMemory::has_db(std::uint16_t number) const {
 std::optional<std::span<std::uint8_t>> CpuMemory::db(std::uint16_t number) {
   const auto it = dbs_.find(number);
   if (it == dbs_.end()) return std::nullopt;
-  return std::span<std::uint8_t>(it->second);
+  return it->second.view;
 }
 
 std::optional<std::span<const std::uint8_t>> CpuMemory::db(std::uint16_t number) const {
   const auto it = dbs_.find(number);
   if (it == dbs_.end()) return std::nullopt;
-  return std::span<const std::uint8_t>(it->second);
+  return std::span<const std::uint8_t>(it->second.view);
 }
 
 std::span<std::uint8_t> CpuMemory::area(Area a) {
   switch (a) {
     case Area::Inputs:
-      return inputs_;
+      return inputs_view_;
     case Area::Outputs:
-      return outputs_;
+      return outputs_view_;
     case Area::Flags:
       break;
   }
-  return flags_;
+  return flags_view_;
 }
 
 std::span<const std::uint8_t> CpuMemory::area(Area a) const {

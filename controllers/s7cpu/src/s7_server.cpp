@@ -10,6 +10,8 @@
 #include "pbvbus/s7/s7_read_var.hpp"
 #include "pbvbus/s7/s7_szl.hpp"
 #include "pbvbus/s7/s7_write_var.hpp"
+#include "pbvbus/s7cpu/szl_lists.hpp"
+#include "pbvbus/s7cpu/szl_source.hpp"
 
 namespace pbvbus::s7cpu {
 namespace {
@@ -21,16 +23,9 @@ namespace rc = s7::return_code;
 /// Read Var Ack-Data header (12) + parameters `04 <count>` (2).
 constexpr std::size_t kReadVarResponseOverhead = 12 + 2;
 
-/// SZL lists served (docs/s7cpu.md "Read SZL").
-constexpr std::uint16_t kSzlModuleIdentification = 0x0011;
-constexpr std::uint16_t kSzlCpuState = 0x0424;
-/// W#16#0011 record: index u16, MLFB (order number) 20 characters, BGTyp u16, Ausbg u16,
-/// Ausbe u16 (snap7's SZL_ID_0011 layout).
-constexpr std::size_t kSzl0011RecordLength = 28;
-constexpr std::size_t kMlfbLength = 20;
-/// W#16#0424 record: ereig u16, ae, bzu-id, then reserved and event info and a time stamp.
-constexpr std::size_t kSzl0424RecordLength = 20;
-constexpr std::size_t kSzl0424StateOctet = 3;
+/// Read SZL answer without records: Userdata header 10, parameters 12, data header 4, list
+/// header 8.
+constexpr std::size_t kSzlResponseOverhead = 10 + 12 + 4 + 8;
 
 /// Where one variable specification points in the CPU's memory.
 struct Target {
@@ -177,7 +172,8 @@ Encoded read_var(CpuMemory& memory, const s7::S7Pdu& pdu, std::size_t pdu_length
   return s7::encode_read_var_response(pdu.header.pdu_ref, results);
 }
 
-std::uint8_t write_item(CpuMemory& memory, const VarItem& v, const s7::DataItem& value) {
+std::uint8_t write_item(CpuMemory& memory, CpuMemory* mirror, const VarItem& v,
+                        const s7::DataItem& value) {
   const Target t = resolve(memory, v);
   if (t.return_code != rc::kSuccess) return t.return_code;
   // A BIT item must come as a BIT data item and the rest must not (s7_item.hpp).
@@ -191,25 +187,27 @@ std::uint8_t write_item(CpuMemory& memory, const VarItem& v, const s7::DataItem&
     return rc::kDataTypeInconsistent;
   }
   copy_in(t, value.data);
+  if (mirror != nullptr) {
+    // The partner's copy (s7_server.hpp set_mirror): the same octets or nothing.
+    const Target m = resolve(*mirror, v);
+    if (m.return_code == rc::kSuccess && m.octets == t.octets && m.is_bit == t.is_bit)
+      copy_in(m, value.data);
+  }
   return rc::kSuccess;
 }
 
-Encoded write_var(CpuMemory& memory, const s7::S7Pdu& pdu) {
+Encoded write_var(CpuMemory& memory, CpuMemory* mirror, const s7::S7Pdu& pdu) {
   const auto req = s7::decode_write_var_request(pdu);
   if (!req.ok()) return refuse(pdu.header.pdu_ref);
   std::vector<std::uint8_t> codes(req.value.items.size());
   for (std::size_t i = 0; i < codes.size(); ++i) {
-    codes[i] = write_item(memory, req.value.items[i], req.value.values[i]);
+    codes[i] = write_item(memory, mirror, req.value.items[i], req.value.values[i]);
   }
   return s7::encode_write_var_response(pdu.header.pdu_ref, codes);
 }
 
-void put_u16(std::vector<std::uint8_t>& out, std::uint16_t v) {
-  out.push_back(static_cast<std::uint8_t>(v >> 8));
-  out.push_back(static_cast<std::uint8_t>(v));
-}
-
-Encoded read_szl(const CpuInfo& info, const s7::S7Pdu& pdu) {
+Encoded read_szl(const CpuInfo& info, SzlSource* source, const s7::S7Pdu& pdu,
+                 std::size_t pdu_length) {
   const auto params = s7::decode_userdata_params(pdu);
   if (!params.ok() || params.value.method != s7::kUserdataMethodRequest ||
       params.value.group != s7::kUserdataGroupCpu ||
@@ -218,36 +216,33 @@ Encoded read_szl(const CpuInfo& info, const s7::S7Pdu& pdu) {
   }
   const auto req = s7::decode_szl_request(pdu);
   if (!req.ok()) return refuse(pdu.header.pdu_ref);
+  // The owner's lists first, then the standard ones (szl_source.hpp).
+  std::optional<SzlList> list;
+  if (source != nullptr) list = source->read_szl(req.value.id, req.value.index);
+  if (!list) list = standard_szl(info, req.value.id, req.value.index);
+  if (!list) list = SzlList{SzlStatus::UnknownId, 0, 0, {}};
   s7::SzlResponse r;
   r.sequence = req.value.sequence;
-  std::vector<std::uint8_t> records;
-  if (req.value.id == kSzlModuleIdentification) {
-    // One record, index 0001 (the module): the order number, space-padded; module type and
-    // versions 0 (docs/s7cpu.md).
-    put_u16(records, 0x0001);
-    for (std::size_t i = 0; i < kMlfbLength; ++i) {
-      records.push_back(i < info.order_number.size()
-                            ? static_cast<std::uint8_t>(info.order_number[i])
-                            : std::uint8_t{' '});
-    }
-    put_u16(records, 0x0000);
-    put_u16(records, 0x0000);
-    put_u16(records, 0x0000);
-    r.record_length = kSzl0011RecordLength;
-  } else if (req.value.id == kSzlCpuState) {
-    // One record, 20 octets; the state in octet 3 (bzu-id), where snap7's client reads it
-    // (opGetPlcStatus); event id and time stamp 0 (docs/s7cpu.md).
-    records.assign(kSzl0424RecordLength, 0);
-    records[kSzl0424StateOctet] = info.state;
-    r.record_length = kSzl0424RecordLength;
-  } else {
-    r.error_code = s7::kSzlNotAvailable;
+  const std::size_t whole = std::size_t{list->record_length} * list->record_count;
+  if (list->status != SzlStatus::Ok || list->records.size() != whole) {
+    // A source whose records do not add up is treated as having nothing now.
+    r.error_code = szl_error_code(list->status == SzlStatus::Ok ? SzlStatus::NotAvailableNow
+                                                                : list->status);
     return s7::encode_szl_response(pdu.header.pdu_ref, r);
+  }
+  // One data unit: the records that fit the negotiated PDU, N_DR counting those
+  // (docs/s7cpu.md "Read SZL").
+  std::uint16_t count = list->record_count;
+  if (list->record_length != 0 && kSzlResponseOverhead + whole > pdu_length) {
+    const std::size_t room = pdu_length > kSzlResponseOverhead ? pdu_length - kSzlResponseOverhead : 0;
+    count = static_cast<std::uint16_t>(room / list->record_length);
   }
   r.id = req.value.id;
   r.index = req.value.index;
-  r.record_count = 1;
-  r.records = records;
+  r.record_length = list->record_length;
+  r.record_count = count;
+  r.records = std::span<const std::uint8_t>(list->records)
+                  .first(std::size_t{count} * list->record_length);
   return s7::encode_szl_response(pdu.header.pdu_ref, r);
 }
 
@@ -274,13 +269,14 @@ Encoded S7Server::handle(std::span<const std::uint8_t> octets) {
   }
   // Anything before Setup Communication is refused (docs/s7cpu.md).
   if (!setup_done_) return refuse(ref);
-  if (pdu.header.type == s7::kS7Userdata) return read_szl(info_, pdu);
+  if (pdu.header.type == s7::kS7Userdata)
+    return read_szl(info_, szl_source_, pdu, negotiated_.pdu_length);
   if (pdu.params.empty()) return refuse(ref);
   switch (pdu.params[0]) {
     case s7::kFnReadVar:
       return read_var(memory_, pdu, negotiated_.pdu_length);
     case s7::kFnWriteVar:
-      return write_var(memory_, pdu);
+      return write_var(memory_, mirror_, pdu);
     default:
       return refuse(ref);
   }

@@ -433,6 +433,11 @@ void HCpuPair::set_state(int r, CpuState s, bus::Ticks now, std::string_view why
   e.from_state = c.state;
   e.to_state = s;
   c.state = s;
+  if (s == CpuState::Off || s == CpuState::ErrorSearch || s == CpuState::Defective) {
+    // A CPU that carries no connections breaks every one it had (h_connections.hpp).
+    c.connections = 0;
+    ++c.connection_epoch;
+  }
   e.role = c.role;
   emit(e);
   std::string t = std::string(to_string(e.from_state)) + " -> " + std::string(to_string(s));
@@ -650,6 +655,7 @@ void HCpuPair::begin_link_up(int s, bus::Ticks now, Pending after) {
       diag(s, now,
            "link-up: " + std::to_string(c.connections) + " connection(s) of this CPU broken");
     c.connections = 0;
+    ++c.connection_epoch;
     set_state(s, CpuState::LinkUp, now,
               after == Pending::Relink ? "re-link after error search"
               : after == Pending::Swap ? "master swap requested"
@@ -1070,8 +1076,13 @@ bool HCpuPair::connect(int r, bus::Ticks now) {
   check_rack(r);
   run_due(now);
   if (!accepts_connections(r)) return false;
+  if (m_p.max_connections > 0 && m_cpu[r].connections >= m_p.max_connections) return false;
   ++m_cpu[r].connections;
   return true;
+}
+
+void HCpuPair::disconnect(int r) {
+  if ((r == 0 || r == 1) && m_cpu[r].connections > 0) --m_cpu[r].connections;
 }
 
 bool HCpuPair::accepts_connections(int r) const {

@@ -131,7 +131,7 @@ ProcessImage Program::make_image() const { return ProcessImage(pii_bytes_, piq_b
 
 bool Program::fits(const ProcessImage& image) const {
   return image.pii().size() == pii_bytes_ && image.piq().size() == piq_bytes_ &&
-         image.memory().size() == memory_bytes_;
+         image.memory().size() >= memory_bytes_;
 }
 
 bool Program::scan(ProcessImage& image, bus::Ticks now, std::vector<ProgramEvent>& events) const {

@@ -10,9 +10,10 @@
 namespace pbvbus::devices {
 
 RedundantExecution::RedundantExecution(const ProgramSpec& spec, std::size_t pii_bytes,
-                                       std::size_t piq_bytes)
+                                       std::size_t piq_bytes, std::size_t memory_bytes)
     : program_(spec, pii_bytes, piq_bytes),
-      images_{program_.make_image(), program_.make_image()} {}
+      images_{ProcessImage(pii_bytes, piq_bytes, std::max(program_.memory_size(), memory_bytes)),
+              ProcessImage(pii_bytes, piq_bytes, std::max(program_.memory_size(), memory_bytes))} {}
 
 bool RedundantExecution::set_inputs(std::span<const std::uint8_t> pii_from_io) {
   if (pii_from_io.size() != program_.pii_size()) return false;
@@ -73,6 +74,11 @@ bool RedundantExecution::inject_divergence(int rack, Area area, std::uint32_t of
 }
 
 const ProcessImage& RedundantExecution::image(int rack) const {
+  if (!valid_rack(rack)) throw std::out_of_range("rack " + std::to_string(rack) + " (0 or 1)");
+  return images_[static_cast<std::size_t>(rack)];
+}
+
+ProcessImage& RedundantExecution::image(int rack) {
   if (!valid_rack(rack)) throw std::out_of_range("rack " + std::to_string(rack) + " (0 or 1)");
   return images_[static_cast<std::size_t>(rack)];
 }

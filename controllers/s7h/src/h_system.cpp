@@ -236,6 +236,8 @@ void HSystemModel::arm_scan(bus::Ticks at) {
 void HSystemModel::set_program(Program hook, bus::Ticks scan_time) {
   m_program = std::move(hook);
   m_exec.reset();  // one program: the hook (or none) replaces a spec
+  m_s7_spec.reset();
+  m_s7_layout = layout(m_s7_cfg, 0);  // M and the DBs in the model's own storage again
   m_scan_time = scan_time > 0 ? scan_time : bus::kTicksPerMs;
   if (has_program() && !m_scan_armed && program_runs()) arm_scan(m_sched.now());
 }

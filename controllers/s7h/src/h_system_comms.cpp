@@ -17,6 +17,7 @@ std::string HSystemModel::add_connection(const ConnectionConfig& c) {
 void HSystemModel::comms_update(bus::Ticks now) {
   m_comms.update(m_pair, now);
   comms_log(now);
+  s7_update(now);  // S7 sessions follow their connections (h_system_s7.cpp)
 }
 
 void HSystemModel::comms_log(bus::Ticks now) {
@@ -73,22 +74,6 @@ SslResult header(std::uint16_t lenthdr, std::uint16_t n_dr) {
   return r;
 }
 
-std::uint16_t bz_cpu(const HCpuPair& p, int r) {
-  switch (p.state(r)) {
-    case CpuState::Off: return 0x000F;                               // NO POWER
-    case CpuState::Stop: return p.reset_request(r) ? 0x0002 : 0x0004;  // reset memory / internal
-    case CpuState::Startup: return 0x0006;                           // warm restart (OB 100)
-    case CpuState::Run: return p.system_mode() == SystemMode::Redundant ? 0x0009 : 0x0008;
-    case CpuState::Hold: return 0x000A;
-    case CpuState::LinkUp: return 0x000B;
-    case CpuState::Update: return 0x000C;
-    case CpuState::Defective: return 0x000D;
-    case CpuState::ErrorSearch: return 0x000E;  // SELFTEST
-    case CpuState::SyncUp: return 0x000B;       // 1500: no code of its own (h_ssl.hpp)
-  }
-  return 0;
-}
-
 /// led_on, led_blink
 std::pair<std::uint8_t, std::uint8_t> led_bytes(Redf r) {
   switch (r) {
@@ -109,12 +94,40 @@ std::pair<std::uint8_t, std::uint8_t> led_bytes(bool on) {
 
 }  // namespace
 
+std::uint16_t bz_cpu(const HCpuPair& p, int r) {
+  switch (p.state(r)) {
+    case CpuState::Off: return 0x000F;                               // NO POWER
+    case CpuState::Stop: return p.reset_request(r) ? 0x0002 : 0x0004;  // reset memory / internal
+    case CpuState::Startup: return 0x0006;                           // warm restart (OB 100)
+    case CpuState::Run: return p.system_mode() == SystemMode::Redundant ? 0x0009 : 0x0008;
+    case CpuState::Hold: return 0x000A;
+    case CpuState::LinkUp: return 0x000B;
+    case CpuState::Update: return 0x000C;
+    case CpuState::Defective: return 0x000D;
+    case CpuState::ErrorSearch: return 0x000E;  // SELFTEST
+    case CpuState::SyncUp: return 0x000B;       // 1500: no code of its own (h_ssl.hpp)
+  }
+  return 0;
+}
+
 SslResult HSystemModel::read_ssl(std::uint16_t id, std::uint16_t index) {
   const bus::Ticks now = m_sched.now();
   if (const std::uint16_t busy = m_pair.record_job_result(51, now); busy != 0)
     return error(busy);  // W#16#8085 during the update
   const int cpu = m_pair.master();
   if (cpu < 0) return error(kRetSfc51Update);  // no CPU runs the SFC: not available
+  return ssl_from(cpu, id, index);
+}
+
+SslResult HSystemModel::read_ssl_on(int rack, std::uint16_t id, std::uint16_t index) {
+  const bus::Ticks now = m_sched.now();
+  if (const std::uint16_t busy = m_pair.record_job_result(51, now); busy != 0)
+    return error(busy);  // W#16#8085 during the update
+  if (!valid_rack(rack) || m_pair.state(rack) == CpuState::Off) return error(kRetSfc51Update);
+  return ssl_from(rack, id, index);
+}
+
+SslResult HSystemModel::ssl_from(int cpu, std::uint16_t id, std::uint16_t index) {
   switch (id) {
     case kSslHState:
       return index == 0 ? ssl_h_state(cpu) : error(kRetSslIndex);

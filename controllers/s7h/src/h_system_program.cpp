@@ -12,7 +12,13 @@ namespace pbvbus::devices {
 void HSystemModel::set_program(const ProgramSpec& spec) {
   const auto errors = validate(spec, m_map.pii_size(), m_map.piq_size());
   if (!errors.empty()) throw std::invalid_argument("program: " + errors.front());
-  m_exec = std::make_unique<RedundantExecution>(spec, m_map.pii_size(), m_map.piq_size());
+  // The memory area holds the program's state, the flags and the DBs (h_s7_memory.hpp).
+  const devices::Program probe(spec, m_map.pii_size(), m_map.piq_size());
+  HS7Layout lay = layout(m_s7_cfg, probe.memory_size());
+  m_exec = std::make_unique<RedundantExecution>(spec, m_map.pii_size(), m_map.piq_size(),
+                                                lay.total);
+  m_s7_layout = std::move(lay);
+  m_s7_spec = std::make_unique<ProgramSpec>(spec);
   m_program = nullptr;
   m_scan_time = spec.scan_time;  // > 0: validate() checked it
   m_direct = spec.copies;        // OB 122 checks those with `direct` (h_system_diag.cpp)

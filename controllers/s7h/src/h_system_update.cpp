@@ -30,6 +30,7 @@ void HSystemModel::track_update(bus::Ticks now) {
     m_update_copied = true;
     m.standby_operate_from = now;
     if (m_exec) m_exec->copy_state(1 - m.standby, m.standby);
+    s7_copy_update(1 - m.standby, m.standby);  // counters, timers (and M/DBs without a spec)
   }
   if (!running) m.done = true;
 }

@@ -372,14 +372,15 @@ TEST_F(S7ServerTest, ReadSzlCpuStateFollowsTheOwner) {
   EXPECT_EQ(r.value.records[3], cpu_state::kStop);
 }
 
-// Any other list: error code D4 02 and data 0A 00 00 00 (docs/s7.md "Read SZL").
-TEST_F(S7ServerTest, ReadSzlOtherListsAreNotAvailable) {
+// Any other list: error code D4 01 ("invalid SZL ID", szl_source.hpp) and data 0A 00 00 00
+// (docs/s7.md "Read SZL").
+TEST_F(S7ServerTest, ReadSzlOtherListsAreUnknown) {
   setup();
   Bytes keep;
-  for (const std::uint16_t id : std::vector<std::uint16_t>{0x0000, 0x0111, 0x0131, 0x0C91}) {
+  for (const std::uint16_t id : std::vector<std::uint16_t>{0x0000, 0x0131, 0x0C91, 0x0071}) {
     const auto r = szl(server, id, 0x0001, keep);
     ASSERT_TRUE(r.ok());
-    EXPECT_EQ(r.value.error_code, s7::kSzlNotAvailable);
+    EXPECT_EQ(r.value.error_code, 0xD401);
     EXPECT_EQ(Bytes(keep.end() - 4, keep.end()), hex("0A 00 00 00"));
   }
 }

@@ -11,6 +11,12 @@
 // (one snapshot, never torn), one Write Var item is copied in in that call, and the owner sees it
 // on its next cycle. Nothing here locks.
 //
+// Storage: by default the memory owns every area (sizes from CpuMemorySizes, DBs from
+// create_db). An owner that keeps the bytes elsewhere (an H CPU's process images and work
+// memory, controllers/s7h) binds areas, counters, timers and DBs to its own storage instead
+// (bind, bind_counters, bind_timers, bind_db): the memory is then a view, and the owner keeps
+// the storage alive and rebinds after it reallocates. Binding changes sizes() accordingly.
+//
 // Byte order: the CPU's, big-endian (S7 words and double words are stored high octet first).
 // Counters and timers are 16-bit cells; a client reads or writes each as 2 octets, big-endian.
 #include <cstddef>
@@ -37,6 +43,11 @@ enum class Area : std::uint8_t { Inputs, Outputs, Flags };
 class CpuMemory {
  public:
   explicit CpuMemory(const CpuMemorySizes& sizes = {});
+  // The views point into the owned vectors: no copies (a move keeps the vectors' buffers).
+  CpuMemory(const CpuMemory&) = delete;
+  CpuMemory& operator=(const CpuMemory&) = delete;
+  CpuMemory(CpuMemory&&) = default;
+  CpuMemory& operator=(CpuMemory&&) = default;
 
   const CpuMemorySizes& sizes() const { return sizes_; }
 
@@ -54,19 +65,38 @@ class CpuMemory {
 
   std::span<std::uint8_t> area(Area a);
   std::span<const std::uint8_t> area(Area a) const;
-  std::span<std::uint16_t> counters() { return counters_; }
-  std::span<const std::uint16_t> counters() const { return counters_; }
-  std::span<std::uint16_t> timers() { return timers_; }
-  std::span<const std::uint16_t> timers() const { return timers_; }
+  std::span<std::uint16_t> counters() { return counters_view_; }
+  std::span<const std::uint16_t> counters() const { return counters_view_; }
+  std::span<std::uint16_t> timers() { return timers_view_; }
+  std::span<const std::uint16_t> timers() const { return timers_view_; }
+
+  // ---- views of the owner's storage (the header comment) ----
+  /// The area is `storage` from now on (its own octets are no longer used).
+  void bind(Area a, std::span<std::uint8_t> storage);
+  void bind_counters(std::span<std::uint16_t> storage);
+  void bind_timers(std::span<std::uint16_t> storage);
+  /// DB `number` is `storage` (replaces an owned or bound DB of that number).
+  void bind_db(std::uint16_t number, std::span<std::uint8_t> storage);
+  /// Removes every DB, owned and bound.
+  void clear_dbs();
 
  private:
+  struct Db {
+    std::vector<std::uint8_t> owned;
+    std::span<std::uint8_t> view;  ///< owned, or the owner's storage
+  };
   CpuMemorySizes sizes_;
   std::vector<std::uint8_t> inputs_;
   std::vector<std::uint8_t> outputs_;
   std::vector<std::uint8_t> flags_;
   std::vector<std::uint16_t> counters_;
   std::vector<std::uint16_t> timers_;
-  std::map<std::uint16_t, std::vector<std::uint8_t>> dbs_;
+  std::span<std::uint8_t> inputs_view_;
+  std::span<std::uint8_t> outputs_view_;
+  std::span<std::uint8_t> flags_view_;
+  std::span<std::uint16_t> counters_view_;
+  std::span<std::uint16_t> timers_view_;
+  std::map<std::uint16_t, Db> dbs_;
 };
 
 // Byte and bit access for the owner's user program, on any area or DB span. Readers give

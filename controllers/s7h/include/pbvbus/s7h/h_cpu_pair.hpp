@@ -219,6 +219,10 @@ struct HCpuPairParams {
   ComparisonReaction comparison_reaction = ComparisonReaction::ErrorSearch;
   std::array<bool, 2> switch_run{true, true};  ///< mode switch positions at construction
   std::size_t diag_capacity = 120;             ///< entries per CPU, oldest dropped
+  /// Ad-hoc connections per CPU (connect()): the MPI interface's connection resources (digest
+  /// §9 "MPI 32/44" for the 414/417; the 417's here). The reservation of one for a PG and one
+  /// for an OP is not modelled. 0 = no limit.
+  int max_connections = 44;
 };
 
 /// 75 ms + 0.7 ms per KB (exact in ticks: 0.7 ms = 2 545 200 ticks).
@@ -295,8 +299,18 @@ class HCpuPair {
   /// stays in STOP; a switch_to_run() starts it. false if not possible.
   bool memory_reset(int rack, bus::Ticks now);
   /// R8: open an S7 connection to `rack`; false on a CPU that is off, in ERROR-SEARCH or
-  /// DEFECTIVE, and on both CPUs from the start of a link-up to the end of the update (400H).
+  /// DEFECTIVE, and on both CPUs from the start of a link-up to the end of the update (400H);
+  /// false too when its max_connections are all in use.
   bool connect(int rack, bus::Ticks now);
+  /// The client closes an ad-hoc connection opened with connect(): one less on `rack` (never
+  /// below 0; a connection the pair already broke was not counted any more).
+  void disconnect(int rack);
+  /// Changes whenever the pair breaks every ad-hoc connection of `rack` (R8 link-up of the
+  /// standby; the CPU off, in ERROR-SEARCH or DEFECTIVE): a connection opened at an earlier
+  /// epoch is gone (controllers/s7h h_s7_session.hpp). 0 for a bad rack.
+  std::uint64_t connection_epoch(int rack) const {
+    return rack == 0 || rack == 1 ? m_cpu[rack].connection_epoch : 0;
+  }
   /// R8's admission rule, the one truth for connect() and HConnections (h_connections.hpp): a
   /// new S7 connection to `rack` is accepted now (powered, not ERROR-SEARCH/DEFECTIVE, and no
   /// CPU in LINK-UP or UPDATE). Does not run deadlines: call after on_time()/an operation.
@@ -376,6 +390,7 @@ class HCpuPair {
     bus::Ticks link_up_start = bus::kNever;
     bus::Ticks retry_at = bus::kNever;  ///< F19: the standby's own link-up retry
     int connections = 0;                ///< R8: open S7 connections
+    std::uint64_t connection_epoch = 0;  ///< bumped when all of them are broken
     std::deque<DiagEntry> diag;
   };
 

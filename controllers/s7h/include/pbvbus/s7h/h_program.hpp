@@ -96,7 +96,8 @@ class Program {
 
   /// A zeroed image of the right sizes (the state of a CPU whose program has not run yet).
   ProcessImage make_image() const;
-  /// The image has exactly this program's sizes.
+  /// The image has this program's PII and PIQ sizes and at least its memory (the rest of the
+  /// memory area belongs to the CPU's S7 memory, h_s7_memory.hpp).
   bool fits(const ProcessImage& image) const;
 
   /// Executes one OB 1 at virtual time `now`: copies, counters, monitors. Appends the events

@@ -62,8 +62,12 @@ struct ScanResult {
 
 class RedundantExecution {
  public:
-  /// Throws std::invalid_argument with the first validate() message.
-  RedundantExecution(const ProgramSpec& spec, std::size_t pii_bytes, std::size_t piq_bytes);
+  /// Throws std::invalid_argument with the first validate() message. `memory_bytes`: the
+  /// memory area of each image is max(the program's memory_size(), memory_bytes) — the CPU's
+  /// S7 memory (flags and DBs, h_s7_memory.hpp) lives there too, so the comparison and the
+  /// update's copy cover it.
+  RedundantExecution(const ProgramSpec& spec, std::size_t pii_bytes, std::size_t piq_bytes,
+                     std::size_t memory_bytes = 0);
 
   const Program& program() const { return program_; }
 
@@ -84,6 +88,8 @@ class RedundantExecution {
 
   /// Throws std::out_of_range for a rack other than 0 or 1.
   const ProcessImage& image(int rack) const;
+  /// The same, writable: the CPU's S7 server reads and writes it (h_s7_session.hpp).
+  ProcessImage& image(int rack);
   /// OB 1 runs on that rack (0 for a bad rack).
   std::uint64_t scans(int rack) const;
   /// Every event reported so far, in order.

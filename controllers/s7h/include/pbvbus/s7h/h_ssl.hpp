@@ -51,6 +51,12 @@
 
 namespace pbvbus::devices {
 
+class HCpuPair;
+
+/// bz_cpu of CPU `rack` (the codes above: 0004 STOP, 0008 RUN, 0009 RUN-R, 000B LINK-UP ...);
+/// SZL W#16#0424 over S7 reports its low octet as the CPU's state (h_s7_session.hpp).
+std::uint16_t bz_cpu(const HCpuPair& pair, int rack);
+
 inline constexpr std::uint16_t kRetSslIdUnknown = 0x8082;  ///< W#16#8082: SSL_ID wrong/unknown
 inline constexpr std::uint16_t kRetSslIndex = 0x8083;      ///< W#16#8083: INDEX wrong
 

@@ -101,7 +101,10 @@
 #include "pbvbus/s7h/h_expansion_rack.hpp"
 #include "pbvbus/s7h/h_io_map.hpp"
 #include "pbvbus/s7h/h_program_spec.hpp"
+#include "pbvbus/s7cpu/cpu_memory.hpp"
 #include "pbvbus/s7h/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_s7_memory.hpp"
+#include "pbvbus/s7h/h_s7_session.hpp"
 #include "pbvbus/s7h/h_ssl.hpp"
 #include "pbvbus/s7h/h_system_records.hpp"
 #include "pbvbus/s7h/h_update_measure.hpp"
@@ -159,6 +162,7 @@ class HSystemModel final : public bus::EventTarget {
                std::vector<RedundantMasterSystemModel*> systems);
   HSystemModel(const HSystemModel&) = delete;
   HSystemModel& operator=(const HSystemModel&) = delete;
+  ~HSystemModel();
 
   // ---- the program ----
   /// scan_time <= 0 is replaced by 1 ms. An empty hook stops the scans.
@@ -505,6 +509,79 @@ class HSystemModel final : public bus::EventTarget {
   std::uint64_t m_reparams = 0;
   void reparameterise(int system, std::uint8_t station, std::size_t module);
   // ---- end F3/F15/OB 122 ----
+
+  // ---- S7 communication ---- (h_system_s7.cpp; h_s7_memory.hpp, h_s7_session.hpp;
+  // docs/h-system.md "S7 communication"). Every CPU serves S7 on its own memory: I = its PII,
+  // Q = its PIQ, M and the DBs in its image's memory area (the program's state from MB 0),
+  // counters and timers. A Write Var reaches both CPUs while the standby's copy is live
+  // (Redundant, or after the update's copy at t4), so the comparison stays quiet; otherwise the
+  // answering CPU only (a standby in LINK-UP/UPDATE before t4 gets it from the update's copy).
+  // Sessions are checked at every reconcile() and at every use.
+ public:
+  /// The CPUs' S7 memory. Before the first OB 1 (a set_program(ProgramSpec) before is rebuilt
+  /// with the new memory area). Until it is called: M = the program's memory exactly (no free
+  /// flags), no DBs, 256 counters and timers. Throws std::invalid_argument("s7 memory: " + the first
+  /// problem) for a bad configuration or after the first OB 1; the model is then unchanged.
+  void set_s7_memory(HS7MemoryConfig c);
+  const HS7MemoryConfig& s7_memory() const { return m_s7_cfg; }
+  /// Where M and the DBs lie in each CPU's memory area now.
+  const HS7Layout& s7_layout() const { return m_s7_layout; }
+  /// The order number SZL 0011 reports (the configuration's, else the profile's).
+  std::string s7_order_number() const;
+  /// CPU `rack`'s memory as S7 sees it (a view bound to its storage now; the owner's user
+  /// program and tests read and write it). Throws std::out_of_range for a bad rack.
+  s7cpu::CpuMemory& s7_cpu_memory(int rack);
+
+  /// (a) an ad-hoc S7 connection to CPU `rack` through its MPI interface (HCpuPair::connect).
+  HS7Session open_s7_adhoc(int rack);
+  /// (b)/(c) the configured connection `name` (standard or fault-tolerant; it must be
+  /// established and not in use by another session).
+  HS7Session open_s7_connection(std::string_view name);
+  /// (d) S7 routing through the master to `device`, behind switched station `station` of
+  /// master system `system`.
+  HS7Session open_s7_routing(std::size_t system, std::uint8_t station, S7Endpoint device);
+  /// Sessions not closed yet.
+  std::size_t s7_sessions_alive() const;
+  /// SFC 51 / Read SZL answered by CPU `rack` (powered) instead of the master: as read_ssl.
+  SslResult read_ssl_on(int rack, std::uint16_t id, std::uint16_t index);
+
+ private:
+  friend class HS7Session;
+  struct S7SessionState;
+  struct S7SessionDeleter {
+    void operator()(S7SessionState* s) const;
+  };
+  using S7SessionPtr = std::unique_ptr<S7SessionState, S7SessionDeleter>;
+  SslResult ssl_from(int cpu, std::uint16_t id, std::uint16_t index);
+  void s7_prepare();  ///< storage of the right sizes for the layout
+  void s7_bind(s7cpu::CpuMemory& mem, int rack);
+  bool s7_mirror_live() const;
+  void s7_update(bus::Ticks now);           ///< every session's check (comms_update)
+  void s7_copy_update(int from, int to);    ///< the update's copy at t4
+  void s7_check(S7SessionState& s);
+  int s7_answering(const S7SessionState& s) const;
+  S7SessionState* s7_find(std::uint32_t id) const;
+  HS7Session s7_open(S7SessionPtr s);
+  void s7_finish(S7SessionState& s, S7CloseReason why, std::string text);
+  std::vector<std::uint8_t> s7_handle(std::uint32_t id, std::span<const std::uint8_t> pdu);
+  void s7_release(std::uint32_t id);
+  /// Until set_s7_memory(): no flags beyond the program's memory and no DBs, so a model whose
+  /// S7 memory is not configured keeps the images it had before S7 (the scenario's comparison
+  /// fault tells a program with state from one without by an empty memory area).
+  HS7MemoryConfig m_s7_cfg = unconfigured_s7_memory();
+  HS7Layout m_s7_layout = layout(unconfigured_s7_memory(), 0);
+  static HS7MemoryConfig unconfigured_s7_memory() {
+    HS7MemoryConfig c;
+    c.flags = 0;
+    return c;
+  }
+  std::array<std::vector<std::uint8_t>, 2> m_s7_work;  ///< M + DBs without a ProgramSpec
+  std::array<std::vector<std::uint16_t>, 2> m_s7_counters, m_s7_timers;
+  std::array<s7cpu::CpuMemory, 2> m_s7_views;
+  std::unique_ptr<ProgramSpec> m_s7_spec;  ///< the spec set_program() got (rebuilt on a change)
+  std::vector<std::pair<std::uint32_t, S7SessionPtr>> m_s7_sessions;
+  std::uint32_t m_s7_next = 1;
+  // ---- end S7 communication ----
 };
 
 }  // namespace pbvbus::devices

@@ -1,0 +1,283 @@
+#!/usr/bin/python3
+"""An MPI PG outside pbvbus: joins an MPI line's token ring through a serial port (a pbvbus pty),
+connects to a CPU, reads DB bytes over S7 communication, disconnects, prints a JSON summary.
+
+It is written from protocol-facts.md §B, §C (FDL frames, token ring, GAP, FCB) and §H (MPI
+connection layer, S7 PDUs) and docs/mpi.md (the byte tables), without pbvbus's C++ code, so that
+it checks pbvbus's MPI stations from the outside, as a real PG behind an interface would.
+
+Files (this folder; Debian's python3 and python3-serial only):
+  fdl_frames.py   FDL telegrams: encode (SD1/SD2/SD3 by §B.1), tokens, decode, Deframer
+  fdl_station.py  the FDL active station in wall time: ring entry, token, GAP, FCB, responder
+  mpi_pdus.py     MPI connection-layer PDUs (§H.3)
+  s7_pdus.py      S7 Setup Communication and Read Var (§H.4)
+  pg_session.py   the PG's connection: connect, setup, read, disconnect (the station's user)
+  outside_pg.py   this program: the serial link, options, the summary
+  test_outside_pg.py  unit tests (hand-worked frames, a fake line playing the CPU)
+
+Running it against pbvbus
+-------------------------
+A scenario with an MPI line, a CPU at MPI address 2 and a serial STATION attachment at the PG's
+address (the scenario names the pty's link path), e.g. examples/mpi.textproto with
+
+    serial { line: "MPI" mode: STATION address: 0 timing: INTERFACE link: "/tmp/pbvbus-pg" }
+
+    ./pbvbus run examples/mpi.textproto --speed 1/100 &
+    /usr/bin/python3 tests/integration/outside_pg/outside_pg.py --port /tmp/pbvbus-pg \\
+        --address 0 --cpu 2 --db 1 --start 0 --length 10 --speed 1/100
+
+`timing: INTERFACE` makes the attachment hold the program's requests and tokens until the line
+has been idle TSYN and the previous reply (or slot time) is over, so the program keeps no bus
+timing. What it cannot escape is the other stations' timing: the CPU awaits the PG's SC within
+its slot time TSL and claims the token after TTO = (6 + 2n) TSL of silence (§C.2), which at
+187.5 kbit/s are fractions of a millisecond and a few milliseconds: far less than a Python
+program behind a pty needs. So the run must be paced slowly (pbvbus `--speed 1/100` or slower,
+and the same --speed here, which scales the default timeouts), or the line slow.
+
+Exit status: 0 = connected, the PDU size negotiated, every byte read (and disconnected);
+1 = a protocol failure (the summary's "error" says which); 2 = bad options or no port.
+The JSON summary on stdout: connected, pdu_size, cpu_sap, data (hex), bytes_read, the FDL
+figures (frames sent and received, retries, token visits, ...), the MPI figures, ps, ns, live,
+elapsed_s, error.
+
+Decisions where the sources are silent (also in the docstrings of the modules):
+  - Ring entry without listening. A pbvbus pty in STATION mode forwards only the frames for its
+    address and the first frame after each of the program's telegrams, so the program cannot
+    build its LAS from the tokens of the others (§C.4 Listen_Token). It answers every FDL
+    Status poll "ready to enter the ring" (0x20), the way pbvbus's ActiveStation answers a
+    master of its LAS (docs/fdl-stations.md), takes the token from whoever passes it (that one
+    is PS) and finds NS by polling the addresses after its own up to PS (first "ready" or "in
+    ring" answer; none: PS). Its other SD1 replies carry "in ring" (0x30) once it has held the
+    token.
+  - One request cycle per token visit (--per-visit), then one GAP poll when due, then the
+    token. The program cannot measure the virtual token rotation time, so it keeps no TTR.
+  - Timeouts are wall time. --timeout (reply and token-pass check) defaults to the time of the
+    longest frame plus the slot time at --baud, scaled by --speed, and at least 0.2 s.
+  - The PG asks for PDU size 240 (the largest S7 PDU that fits one MPI data message with
+    headroom, §B.1: 242); a read longer than the negotiated PDU allows is split into several
+    Read Var jobs.
+"""
+
+import argparse
+import json
+import os
+import select
+import sys
+import time
+from fractions import Fraction
+
+import fdl_frames as F
+import mpi_pdus as M
+import s7_pdus as S
+from fdl_station import ActiveStation
+from pg_session import PgSession
+
+LONGEST_FRAME_BITS = 255 * 11
+DEFAULT_TSL_BITS = 415  # assumed slot time for the default timeout; the scenario's may differ
+
+
+class SerialLink:
+    """A serial port (a pty) opened 8E1 raw; telegrams split from the byte stream."""
+
+    def __init__(self, port, baud):
+        import serial  # Debian python3-serial; imported here so the unit tests need none
+        self.ser = serial.Serial(port, baudrate=baud, bytesize=8, parity=serial.PARITY_EVEN,
+                                 stopbits=1, timeout=0)
+        self.deframer = F.Deframer()
+        self.ser.reset_input_buffer()  # whatever was queued before we opened the port
+
+    @property
+    def garbage(self):
+        return self.deframer.garbage
+
+    def now(self):
+        return time.monotonic()
+
+    def send(self, frame):
+        self.ser.write(frame)
+        self.ser.flush()
+
+    def read(self, deadline):
+        while True:
+            t = self.deframer.next()
+            if t is not None:
+                return t
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return None
+            # select() instead of the port's own timeout: changing that reconfigures the port.
+            ready, _, _ = select.select([self.ser.fileno()], [], [], left)
+            if ready:
+                self.deframer.feed(self.ser.read(max(1, self.ser.in_waiting)))
+
+    def close(self):
+        self.ser.close()
+
+
+def parse_speed(text):
+    try:
+        v = Fraction(text)
+    except (ValueError, ZeroDivisionError):
+        raise argparse.ArgumentTypeError("speed must be N or N/M, e.g. 1/100")
+    if v <= 0:
+        raise argparse.ArgumentTypeError("speed must be positive")
+    return v
+
+
+def parse_baud(text):
+    t = text.strip().lower()
+    scale = 1
+    if t.endswith("k"):
+        t, scale = t[:-1], 1000
+    elif t.endswith("m"):
+        t, scale = t[:-1], 1000000
+    try:
+        v = float(t) * scale
+    except ValueError:
+        raise argparse.ArgumentTypeError("baud must be a number like 187500 or 187.5k")
+    if v <= 0:
+        raise argparse.ArgumentTypeError("baud must be positive")
+    return int(v)
+
+
+def default_timeout(baud, speed):
+    """The longest frame plus the slot time at baud, as wall time at speed; at least 0.2 s."""
+    virtual = (LONGEST_FRAME_BITS + 33 + DEFAULT_TSL_BITS) / baud
+    return max(0.2, float(virtual / speed))
+
+
+def address(text):
+    v = int(text, 0)
+    if not 0 <= v <= 126:
+        raise argparse.ArgumentTypeError("an address is 0..126")
+    return v
+
+
+def options(argv):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--port", required=True, help="the serial port or the pty's link path")
+    ap.add_argument("--address", type=address, default=0, help="the PG's MPI address (0)")
+    ap.add_argument("--cpu", type=address, default=2, help="the CPU's MPI address (2)")
+    ap.add_argument("--sap", type=lambda s: int(s, 0), default=M.DEFAULT_PG_SAP,
+                    help="the PG's SAP (0x14)")
+    ap.add_argument("--db", type=int, default=1, help="the DB to read (1)")
+    ap.add_argument("--start", type=int, default=0, help="first byte (DBB) to read (0)")
+    ap.add_argument("--length", type=int, default=10, help="bytes to read (10)")
+    ap.add_argument("--pdu-size", type=int, default=S.PG_PDU_SIZE,
+                    help="PDU size asked for in Setup Communication (240)")
+    ap.add_argument("--baud", type=parse_baud, default=187500,
+                    help="the line's baud rate (187.5k; a pty ignores it; sets the timeouts)")
+    ap.add_argument("--speed", type=parse_speed, default=Fraction(1),
+                    help="virtual / wall time of a paced pbvbus run (pbvbus --speed), for the "
+                         "default timeouts")
+    ap.add_argument("--hsa", type=int, default=31, help="highest station address (31, §H.1)")
+    ap.add_argument("--timeout", type=float, default=None,
+                    help="wall seconds to await a reply or the token taker's first frame")
+    ap.add_argument("--retries", type=int, default=1, help="FDL retries per request (1)")
+    ap.add_argument("--per-visit", type=int, default=1, help="request cycles per token visit")
+    ap.add_argument("--gap-factor", type=int, default=10, help="G: visits between GAP scans")
+    ap.add_argument("--step-timeout", type=float, default=None,
+                    help="wall seconds any step of the connection may take (default: 40 x "
+                         "--timeout, at least 5 s)")
+    ap.add_argument("--max-time", type=float, default=60.0, help="give up after this (60 s)")
+    ap.add_argument("--wait-port", type=float, default=10.0,
+                    help="wait this long for the port to appear (10 s)")
+    ap.add_argument("--no-disconnect", action="store_true", help="leave the connection open")
+    ap.add_argument("-v", "--verbose", action="store_true", help="log to stderr")
+    a = ap.parse_args(argv)
+    if not 0 <= a.sap <= 63:
+        ap.error("--sap must be 0..63")
+    if a.address == a.cpu:
+        ap.error("--address and --cpu must differ")
+    if not 0 <= a.db <= 65535 or not 0 <= a.start <= 0xFFFF or not 0 <= a.length <= 65535:
+        ap.error("--db, --start, --length must be 0..65535")
+    if not 19 <= a.pdu_size <= S.PG_PDU_SIZE:
+        ap.error("--pdu-size must be 19..%d (one MPI data message)" % S.PG_PDU_SIZE)
+    if not a.address <= a.hsa <= 126:
+        ap.error("--hsa must be 0..126 and not below --address")
+    if a.timeout is None:
+        a.timeout = default_timeout(a.baud, a.speed)
+    if a.step_timeout is None:
+        a.step_timeout = max(5.0, 40 * a.timeout)
+    if a.timeout <= 0 or a.max_time <= 0 or a.per_visit < 1 or a.retries < 0:
+        ap.error("--timeout and --max-time must be positive, --per-visit >= 1, --retries >= 0")
+    return a
+
+
+def run(link, a, log):
+    """Runs the PG on a link; returns (exit status, summary)."""
+    t0 = link.now()
+    session = PgSession(a.cpu, a.db, a.start, a.length, link.now, pg_sap=a.sap,
+                        pdu_size=a.pdu_size, step_timeout=a.step_timeout,
+                        disconnect=not a.no_disconnect, log=log)
+    station = ActiveStation(link, a.address, session, hsa=a.hsa, reply_timeout=a.timeout,
+                            retries=a.retries, gap_factor=a.gap_factor, per_visit=a.per_visit,
+                            log=log)
+    finished = station.run_until(session.finished, t0 + a.max_time, on_idle=session.check)
+    if not finished:
+        session.fail("--max-time %.1f s reached while waiting for %s" % (a.max_time,
+                                                                          session.waiting_for))
+    complete = len(session.data) == a.length and session.pdu_size is not None
+    ok = session.error is None and complete and (session.disconnected or a.no_disconnect)
+    summary = {
+        "ok": ok,
+        "address": a.address,
+        "cpu": a.cpu,
+        "connected": session.connected or session.disconnected,
+        "disconnected": session.disconnected,
+        "pg_sap": a.sap,
+        "cpu_sap": session.cpu_sap,
+        "pdu_size": session.pdu_size,
+        "db": a.db,
+        "start": a.start,
+        "length": a.length,
+        "bytes_read": len(session.data),
+        "data": bytes(session.data).hex(" ").upper(),
+        "ps": station.ps,
+        "ns": station.ns,
+        "live": {str(k): v for k, v in sorted(station.live.items())},
+        "elapsed_s": round(link.now() - t0, 3),
+        "error": session.error,
+    }
+    summary.update(station.count)
+    summary.update(session.count)
+    return (0 if ok else 1), summary
+
+
+def main(argv=None):
+    a = options(sys.argv[1:] if argv is None else argv)
+
+    def log(msg):
+        if a.verbose:
+            sys.stderr.write("outside_pg: %s\n" % msg)
+
+    until = time.monotonic() + a.wait_port
+    while not os.path.exists(a.port) and time.monotonic() < until:
+        time.sleep(0.05)
+    if not os.path.exists(a.port):
+        sys.stderr.write("outside_pg: %s does not exist (waited %.1f s for it)\n"
+                         % (a.port, a.wait_port))
+        return 2
+    try:
+        link = SerialLink(a.port, a.baud)
+    except ImportError:
+        sys.stderr.write("outside_pg: no serial module (Debian: apt-get install python3-serial; "
+                         "run with /usr/bin/python3)\n")
+        return 2
+    except Exception as e:  # serial.SerialException, OSError
+        sys.stderr.write("outside_pg: cannot open %s: %s\n" % (a.port, e))
+        return 2
+    try:
+        rc, summary = run(link, a, log)
+    finally:
+        link.close()
+    summary["garbage_octets"] = link.garbage
+    json.dump(summary, sys.stdout)
+    sys.stdout.write("\n")
+    if summary["error"]:
+        sys.stderr.write("outside_pg: %s\n" % summary["error"])
+    return rc
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -21,7 +21,7 @@ What it does:
   - Per token visit at most `per_visit` request cycles (SRD high, FCB/FCV per responder: first
     frame FCV=0 FCB=1, then FCV=1 with FCB toggled after every valid reply; a retry repeats the
     frame unchanged; after the retries the responder is non-operational and the next frame is a
-    first frame again, §C.6), then the token pass `DC NS TS`. Any frame within the reply
+    first frame again, §C.6), then the token pass `DC NS TS`. Any frame within the token
     timeout after the token counts as NS's activity (the attachment forwards the first frame
     after the program's telegram within the slot time); three attempts in total (§C.4), then NS
     is dropped and found again at the next token.
@@ -50,12 +50,13 @@ class Request:
 
 
 class ActiveStation:
-    def __init__(self, link, address, user, hsa=31, reply_timeout=0.5, retries=1,
-                 token_attempts=3, gap_factor=10, per_visit=1, log=None):
+    def __init__(self, link, address, user, hsa=31, reply_timeout=0.5, token_timeout=None,
+                 retries=1, token_attempts=3, gap_factor=10, per_visit=1, log=None):
         if not 0 <= address <= 126:
             raise ValueError("station address %d is not 0..126" % address)
         self.link, self.ts, self.user = link, address, user
         self.hsa, self.reply_timeout, self.retries = hsa, reply_timeout, retries
+        self.token_timeout = reply_timeout if token_timeout is None else token_timeout
         self.token_attempts, self.gap_factor, self.per_visit = token_attempts, gap_factor, per_visit
         self.log = log or (lambda msg: None)
         self.in_ring = False
@@ -271,7 +272,7 @@ class ActiveStation:
             if attempt:
                 self.count["token_pass_retries"] += 1
             self.send(F.encode_token(self.ns, self.ts))
-            t = self.next_frame(self.link.now() + self.reply_timeout)
+            t = self.next_frame(self.link.now() + self.token_timeout)
             if t is not None:
                 self.count["tokens_passed"] += 1
                 self.pending.appendleft(t.raw)

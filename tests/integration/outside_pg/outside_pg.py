@@ -51,8 +51,15 @@ Decisions where the sources are silent (also in the docstrings of the modules):
     token.
   - One request cycle per token visit (--per-visit), then one GAP poll when due, then the
     token. The program cannot measure the virtual token rotation time, so it keeps no TTR.
-  - Timeouts are wall time. --timeout (reply and token-pass check) defaults to the time of the
-    longest frame plus the slot time at --baud, scaled by --speed, and at least 0.2 s.
+  - Timeouts are wall time, worked out from the line's figures (--tsl, --baud) scaled by
+    --speed, plus 10 ms for the pty. A reply (SC or SD1) must start within TSL: --timeout is
+    TSL + 66 + 33 bit times. It must stay short, because while the PG waits for an empty address
+    the line is silent, and the other stations claim the token after TTO = (6 + 2n) TSL (§C.2).
+    The token taker's first frame may be the longest one, forwarded when it has ended:
+    --token-timeout is TSL + 2805 + 33 bit times. At 187.5 kbit/s and TSL 415 (pbvbus's MPI
+    bus parameters): 2.7 ms and 17.5 ms virtual, 0.28 s and 1.76 s of wall time at 1/100.
+  - The first token is awaited until --max-time (the CPU's GAP walk reaches the PG's address
+    only every few dozen token visits); every later step of the connection has --step-timeout.
   - The PG asks for PDU size 240 (the largest S7 PDU that fits one MPI data message with
     headroom, §B.1: 242); a read longer than the negotiated PDU allows is split into several
     Read Var jobs.
@@ -73,7 +80,9 @@ from fdl_station import ActiveStation
 from pg_session import PgSession
 
 LONGEST_FRAME_BITS = 255 * 11
-DEFAULT_TSL_BITS = 415  # assumed slot time for the default timeout; the scenario's may differ
+SD1_BITS = 6 * 11
+TSYN_BITS = 33
+PTY_ALLOWANCE_S = 0.01  # wall time the pty and the scheduler may add to a reply
 
 
 class SerialLink:
@@ -140,10 +149,18 @@ def parse_baud(text):
     return int(v)
 
 
-def default_timeout(baud, speed):
-    """The longest frame plus the slot time at baud, as wall time at speed; at least 0.2 s."""
-    virtual = (LONGEST_FRAME_BITS + 33 + DEFAULT_TSL_BITS) / baud
-    return max(0.2, float(virtual / speed))
+def default_timeout(tsl, baud, speed):
+    """Awaiting a reply: it starts within TSL and is at most an SD1 (the CPU's SC or status
+    reply, an FDL Status reply), plus TSYN of margin; as wall time at speed, plus the pty's
+    allowance. Short on purpose: while the PG waits for an empty address the line is silent, and
+    the other stations claim the token after TTO = (6 + 2n) TSL of silence (§C.2)."""
+    return float(Fraction(tsl + SD1_BITS + TSYN_BITS, baud) / speed) + PTY_ALLOWANCE_S
+
+
+def default_token_timeout(tsl, baud, speed):
+    """Awaiting the token taker's first frame: it starts within TSL and may be the longest
+    frame; the attachment forwards it when it has ended."""
+    return float(Fraction(tsl + LONGEST_FRAME_BITS + TSYN_BITS, baud) / speed) + PTY_ALLOWANCE_S
 
 
 def address(text):
@@ -171,8 +188,14 @@ def options(argv):
                     help="virtual / wall time of a paced pbvbus run (pbvbus --speed), for the "
                          "default timeouts")
     ap.add_argument("--hsa", type=int, default=31, help="highest station address (31, §H.1)")
+    ap.add_argument("--tsl", type=int, default=415,
+                    help="the line's slot time in bit times, for the default timeouts (415: "
+                         "pbvbus's MPI bus parameters at 187.5 kbit/s)")
     ap.add_argument("--timeout", type=float, default=None,
-                    help="wall seconds to await a reply or the token taker's first frame")
+                    help="wall seconds to await a reply (default from --tsl, --baud, --speed)")
+    ap.add_argument("--token-timeout", type=float, default=None,
+                    help="wall seconds to await the token taker's first frame (default from "
+                         "--tsl, --baud, --speed)")
     ap.add_argument("--retries", type=int, default=1, help="FDL retries per request (1)")
     ap.add_argument("--per-visit", type=int, default=1, help="request cycles per token visit")
     ap.add_argument("--gap-factor", type=int, default=10, help="G: visits between GAP scans")
@@ -195,11 +218,15 @@ def options(argv):
         ap.error("--pdu-size must be 19..%d (one MPI data message)" % S.PG_PDU_SIZE)
     if not a.address <= a.hsa <= 126:
         ap.error("--hsa must be 0..126 and not below --address")
+    if a.tsl <= 0:
+        ap.error("--tsl must be positive")
     if a.timeout is None:
-        a.timeout = default_timeout(a.baud, a.speed)
+        a.timeout = default_timeout(a.tsl, a.baud, a.speed)
+    if a.token_timeout is None:
+        a.token_timeout = max(a.timeout, default_token_timeout(a.tsl, a.baud, a.speed))
     if a.step_timeout is None:
-        a.step_timeout = max(5.0, 40 * a.timeout)
-    if a.timeout <= 0 or a.max_time <= 0 or a.per_visit < 1 or a.retries < 0:
+        a.step_timeout = max(5.0, 40 * a.token_timeout)
+    if a.timeout <= 0 or a.token_timeout <= 0 or a.max_time <= 0 or a.per_visit < 1 or a.retries < 0:
         ap.error("--timeout and --max-time must be positive, --per-visit >= 1, --retries >= 0")
     return a
 
@@ -211,6 +238,7 @@ def run(link, a, log):
                         pdu_size=a.pdu_size, step_timeout=a.step_timeout,
                         disconnect=not a.no_disconnect, log=log)
     station = ActiveStation(link, a.address, session, hsa=a.hsa, reply_timeout=a.timeout,
+                            token_timeout=a.token_timeout,
                             retries=a.retries, gap_factor=a.gap_factor, per_visit=a.per_visit,
                             log=log)
     finished = station.run_until(session.finished, t0 + a.max_time, on_idle=session.check)

@@ -53,7 +53,7 @@ class PgSession:
         self.ref = 0
         self.count = {"data_sent": 0, "data_received": 0, "acks_sent": 0, "acks_received": 0,
                       "repeats_received": 0, "ignored_pdus": 0, "reads": 0}
-        self.deadline = clock() + step_timeout
+        self.deadline = float("inf")  # the first token: only --max-time bounds the wait
         self.waiting_for = "the first token (a GAP poll and the token from a master)"
         self.queue(M.connect_request(), dsap=M.CONNECT_SAP, tag="connect")
 

@@ -331,7 +331,8 @@ class FakeLine:
 
 def run_pg(cpu, *args):
     line = FakeLine(cpu)
-    a = outside_pg.options(["--port", "fake", "--timeout", "0.05", "--max-time", "30"] +
+    a = outside_pg.options(["--port", "fake", "--timeout", "0.05", "--token-timeout", "0.05",
+                            "--max-time", "30"] +
                            list(args))
     rc, summary = outside_pg.run(line, a, lambda msg: None)
     return rc, summary, line
@@ -553,11 +554,15 @@ class Options(unittest.TestCase):
         self.assertIn("--pdu-size", self.parse_error("--pdu-size", "480"))
         self.assertIn("speed", self.parse_error("--speed", "0"))
 
-    def test_default_timeout_scales_with_speed(self):
-        a = outside_pg.options(["--port", "x", "--baud", "187.5k", "--speed", "1/1000"])
-        # (2805 + 33 + 415) bits at 187500 bit/s = 17.35 ms virtual = 17.35 s wall at 1/1000
-        self.assertAlmostEqual(a.timeout, 3253 / 187500 * 1000, places=6)
-        self.assertEqual(outside_pg.options(["--port", "x"]).timeout, 0.2)
+    def test_default_timeouts_scale_with_speed(self):
+        a = outside_pg.options(["--port", "x", "--baud", "187.5k", "--speed", "1/100"])
+        # reply: (415 + 66 + 33) = 514 bits at 187500 bit/s = 2.7413 ms virtual, x 100, + 10 ms
+        self.assertAlmostEqual(a.timeout, 0.27413 + 0.01, places=5)
+        # token: (415 + 2805 + 33) = 3253 bits = 17.349 ms virtual, x 100, + 10 ms
+        self.assertAlmostEqual(a.token_timeout, 1.73493 + 0.01, places=5)
+        b = outside_pg.options(["--port", "x", "--baud", "45.45k", "--tsl", "100"])
+        # 199 bits at 45450 bit/s = 4.378 ms, + 10 ms
+        self.assertAlmostEqual(b.timeout, 0.004378 + 0.01, places=6)
 
     def test_missing_port(self):
         with redirect_stderr(io.StringIO()) as err:
@@ -627,7 +632,8 @@ class OverAPty(unittest.TestCase):
         try:
             out = io.StringIO()
             with redirect_stdout(out):
-                rc = outside_pg.main(["--port", path, "--timeout", "0.3", "--max-time", "20"])
+                rc = outside_pg.main(["--port", path, "--timeout", "0.3", "--token-timeout", "0.3",
+                                      "--max-time", "20"])
         finally:
             stop.set()
             t.join(2)

@@ -30,7 +30,8 @@ What it does:
     SA's previous frame) gets the stored reply again and does not reach the user (§C.6).
     SDN is given to the user without a reply. Ident and LSAP status are refused (RS).
   - A foreign request or token heard while it holds the token means the token is lost (a second
-    token on the line, §C.4): the visit ends at once, the frame is handled as usual.
+    token on the line, §C.4): the visit ends at once, the frame is handled as usual. A request
+    whose reply was awaited then goes again, the same frame (same FCB), at the next token.
 """
 
 from collections import deque
@@ -51,7 +52,7 @@ class Request:
 
 class ActiveStation:
     def __init__(self, link, address, user, hsa=31, reply_timeout=0.5, token_timeout=None,
-                 retries=1, token_attempts=3, gap_factor=10, per_visit=1, log=None):
+                 retries=1, token_attempts=3, gap_factor=10, per_visit=1, log=None, trace=None):
         if not 0 <= address <= 126:
             raise ValueError("station address %d is not 0..126" % address)
         self.link, self.ts, self.user = link, address, user
@@ -59,6 +60,7 @@ class ActiveStation:
         self.token_timeout = reply_timeout if token_timeout is None else token_timeout
         self.token_attempts, self.gap_factor, self.per_visit = token_attempts, gap_factor, per_visit
         self.log = log or (lambda msg: None)
+        self.trace = trace  # called with every telegram in ("<") and out (">")
         self.in_ring = False
         self.ps = None
         self.ns = None
@@ -66,6 +68,7 @@ class ActiveStation:
         self.fcb = {}             # responder -> FCB of our last frame that got a valid reply
         self.memory = {}          # initiator SA -> (its last FCB, our reply octets)
         self.pending = deque()    # telegrams read while waiting, to be handled by the main loop
+        self.interrupted = None   # (request, frame, FCB, next attempt) cut short by a lost token
         self.gap_next = None
         self.gap_wait = 0
         self.stop_after_pass = False
@@ -79,14 +82,19 @@ class ActiveStation:
 
     def send(self, frame):
         self.count["frames_sent"] += 1
+        if self.trace:
+            self.trace("> " + frame.hex(" ").upper())
         self.link.send(frame)
 
     def next_frame(self, deadline):
         """A telegram from the pending queue or the link, decoded; None at the deadline."""
         while True:
-            raw = self.pending.popleft() if self.pending else self.link.read(deadline)
+            again = bool(self.pending)
+            raw = self.pending.popleft() if again else self.link.read(deadline)
             if raw is None:
                 return None
+            if self.trace and not again:
+                self.trace("< " + raw.hex(" ").upper())
             t = F.decode(raw)
             if t is None:
                 self.count["invalid_frames"] += 1
@@ -171,18 +179,31 @@ class ActiveStation:
                 raise TokenLost()
 
     def transaction(self, req):
-        """One request cycle with retries: ("delivered"|"refused", reply) or ("no_answer", None)."""
+        """One request cycle with retries: ("delivered"|"refused", reply) or ("no_answer", None).
+
+        A request cut short by a lost token is kept with its frame (self.interrupted) and sent
+        again, unchanged, as the first thing at the next token: the responder may have taken
+        it, and only the same FCB lets it tell a repeat from a new frame (§C.6)."""
         uses_fcb = req.fn in F.USES_FCB
-        last = self.fcb.get(req.da)
-        fcv, fcb = (False, True) if last is None else (True, not last)
-        fc = F.request_fc(req.fn, fcv, fcb) if uses_fcb else F.request_fc(req.fn)
-        frame = F.encode(req.da, self.ts, fc, req.dsap, req.ssap, req.du)
-        self.count["requests_sent"] += 1
-        for attempt in range(1 + self.retries):
+        if self.interrupted is not None and self.interrupted[0] is req:
+            _, frame, fcb, first_attempt = self.interrupted
+            self.interrupted = None
+        else:
+            last = self.fcb.get(req.da)
+            fcv, fcb = (False, True) if last is None else (True, not last)
+            fc = F.request_fc(req.fn, fcv, fcb) if uses_fcb else F.request_fc(req.fn)
+            frame = F.encode(req.da, self.ts, fc, req.dsap, req.ssap, req.du)
+            self.count["requests_sent"] += 1
+            first_attempt = 0
+        for attempt in range(first_attempt, 1 + self.retries):
             if attempt:
                 self.count["retries"] += 1
             self.send(frame)
-            r = self.await_reply(req.da)
+            try:
+                r = self.await_reply(req.da)
+            except TokenLost:
+                self.interrupted = (req, frame, fcb, min(attempt + 1, self.retries))
+                raise
             if r is None:
                 continue
             if uses_fcb:
@@ -254,7 +275,7 @@ class ActiveStation:
                 self.gap_next = self.after(self.ts)
                 self.gap_wait = self.gap_factor
             for _ in range(self.per_visit):
-                req = self.user.next_request()
+                req = self.interrupted[0] if self.interrupted else self.user.next_request()
                 if req is None:
                     break
                 result, reply = self.transaction(req)

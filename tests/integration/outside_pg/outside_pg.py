@@ -207,6 +207,8 @@ def options(argv):
                     help="wait this long for the port to appear (10 s)")
     ap.add_argument("--no-disconnect", action="store_true", help="leave the connection open")
     ap.add_argument("-v", "--verbose", action="store_true", help="log to stderr")
+    ap.add_argument("--trace", action="store_true",
+                    help="every telegram in (<) and out (>) to stderr, with wall time")
     a = ap.parse_args(argv)
     if not 0 <= a.sap <= 63:
         ap.error("--sap must be 0..63")
@@ -231,7 +233,7 @@ def options(argv):
     return a
 
 
-def run(link, a, log):
+def run(link, a, log, trace=None):
     """Runs the PG on a link; returns (exit status, summary)."""
     t0 = link.now()
     session = PgSession(a.cpu, a.db, a.start, a.length, link.now, pg_sap=a.sap,
@@ -240,7 +242,7 @@ def run(link, a, log):
     station = ActiveStation(link, a.address, session, hsa=a.hsa, reply_timeout=a.timeout,
                             token_timeout=a.token_timeout,
                             retries=a.retries, gap_factor=a.gap_factor, per_visit=a.per_visit,
-                            log=log)
+                            log=log, trace=trace)
     finished = station.run_until(session.finished, t0 + a.max_time, on_idle=session.check)
     if not finished:
         session.fail("--max-time %.1f s reached while waiting for %s" % (a.max_time,
@@ -279,6 +281,11 @@ def main(argv=None):
         if a.verbose:
             sys.stderr.write("outside_pg: %s\n" % msg)
 
+    t0 = time.monotonic()
+
+    def trace(msg):
+        sys.stderr.write("%10.6f %s\n" % (time.monotonic() - t0, msg))
+
     until = time.monotonic() + a.wait_port
     while not os.path.exists(a.port) and time.monotonic() < until:
         time.sleep(0.05)
@@ -296,7 +303,7 @@ def main(argv=None):
         sys.stderr.write("outside_pg: cannot open %s: %s\n" % (a.port, e))
         return 2
     try:
-        rc, summary = run(link, a, log)
+        rc, summary = run(link, a, log, trace if a.trace else None)
     finally:
         link.close()
     summary["garbage_octets"] = link.garbage

@@ -173,7 +173,8 @@ class FakeCpu:
     low frames with FCB (first 6C, then 5C/7C), one per PG E5, then passes the token back."""
 
     def __init__(self, sap=0x14, pdu_size=240, dbs=None, refuse_connect=False,
-                 drop_first=(), repeat_answer=False, ignore_tokens=0, per_visit=2, silent=False):
+                 drop_first=(), repeat_answer=False, ignore_tokens=0, per_visit=2, silent=False,
+                 token_before_e5=()):
         self.sap, self.pdu_size = sap, pdu_size
         self.dbs = {1: bytes(range(10))} if dbs is None else dbs
         self.refuse_connect, self.drop_first = refuse_connect, set(drop_first)
@@ -193,6 +194,7 @@ class FakeCpu:
         self.tokens_seen = 0
         self.polls_seen = []
         self.silent = silent
+        self.token_before_e5 = set(token_before_e5)
         self.admitted = False
 
     def start(self):
@@ -296,6 +298,11 @@ class FakeCpu:
         if du[0] == 0xE0 and self.refuse_connect:
             self.line.to_pg.append(RR_FROM_CPU)
             return
+        if key in self.token_before_e5:
+            # Our token retry was already on its way (the PG answered our token too late for
+            # us): the PG hears DC 00 02 while it awaits the reply to its request.
+            self.token_before_e5.discard(key)
+            self.line.to_pg.append(TOKEN_TO_PG)
         self.line.to_pg.append(h("E5"))
         if not repeat:
             assert dsap == (0x00 if du[0] == 0xE0 else self.sap), f.hex()
@@ -396,6 +403,17 @@ class WholeExchange(unittest.TestCase):
         self.assertEqual(s["repeats_answered"], 1)
         self.assertEqual(s["data_received"], 2)  # setup answer and read answer, once each
         self.assertEqual(s["repeats_received"], 0)
+
+    def test_request_cut_by_a_lost_token_goes_again_with_the_same_fcb(self):
+        cpu = FakeCpu(token_before_e5={"05"})
+        rc, s, line = run_pg(cpu)
+        self.assertEqual(rc, 0, s)
+        self.assertEqual(s["token_losses"], 1)
+        # 05 01 went twice with FCB 0 (5D): the CPU saw a repeat, not a new frame, and took it
+        # once; the next new frame toggles (7D).
+        self.assertEqual(cpu.pg_fcs[:4], [0x6D, 0x5D, 0x5D, 0x7D])
+        self.assertEqual(line.sent.count(CONN_ACK_PG), 2)
+        self.assertEqual([p[:1].hex() for p in cpu.pg_pdus], ["e0", "05", "f1", "b0", "f1", "b0", "80"])
 
     def test_cpu_sap_is_taken_from_the_confirm(self):
         cpu = FakeCpu(sap=0x15)

@@ -13,11 +13,12 @@ What it does:
     "master ready to enter the ring" (`10 SA TS 20 FCS 16`): the poller is about to make it its
     NS, as pbvbus's ActiveStation does when polled by a master of its LAS. A token `DC TS x`
     is accepted from anyone (x becomes PS).
-  - Its NS: on the first token it asks the addresses after its own, up to PS (cyclic, wrapping
-    after HSA to 0, HSA itself polled), with Request FDL Status; the first that answers "ready"
-    (0x20) or "in the ring" (0x30) is NS, none: PS. Later, one GAP address (between TS and NS)
-    per token visit, a full scan every `gap_factor` visits; a "ready" answer is admitted (new
-    NS, the token goes to it right away).
+  - Its NS: at the first token the only station it knows to be in the ring is PS, so NS = PS,
+    and it scans its GAP (the addresses after its own up to NS, cyclic, wrapping after HSA to 0,
+    HSA itself polled) with Request FDL Status, `scan_per_visit` addresses per visit; the first
+    that answers "ready" (0x20) or "in the ring" (0x30) becomes NS (and gets the token at the
+    end of this visit). Later scans: one address per visit, a new scan `gap_factor` visits
+    after the last (§C.5).
   - Per token visit at most `per_visit` request cycles (SRD high, FCB/FCV per responder: first
     frame FCV=0 FCB=1, then FCV=1 with FCB toggled after every valid reply; a retry repeats the
     frame unchanged; after the retries the responder is non-operational and the next frame is a
@@ -52,7 +53,8 @@ class Request:
 
 class ActiveStation:
     def __init__(self, link, address, user, hsa=31, reply_timeout=0.5, token_timeout=None,
-                 retries=1, token_attempts=3, gap_factor=10, per_visit=1, log=None, trace=None):
+                 retries=1, token_attempts=3, gap_factor=10, per_visit=1, scan_per_visit=4,
+                 log=None, trace=None):
         if not 0 <= address <= 126:
             raise ValueError("station address %d is not 0..126" % address)
         self.link, self.ts, self.user = link, address, user
@@ -71,7 +73,8 @@ class ActiveStation:
         self.interrupted = None   # (request, frame, FCB, next attempt) cut short by a lost token
         self.gap_next = None
         self.gap_wait = 0
-        self.stop_after_pass = False
+        self.scanning = False
+        self.scan_per_visit = scan_per_visit
         self.count = {"frames_sent": 0, "frames_received": 0, "invalid_frames": 0,
                       "requests_sent": 0, "retries": 0, "no_answer": 0, "refused": 0,
                       "token_visits": 0, "tokens_passed": 0, "token_pass_retries": 0,
@@ -237,33 +240,28 @@ class ActiveStation:
             return False
         return (a - self.ts) % 128 < (self.ns - self.ts) % 128
 
-    def find_ns(self):
-        a = self.after(self.ts)
-        for _ in range(self.hsa + 1):
-            if a in (self.ps, self.ts):
-                break
-            if self.fdl_status(a) in (F.TYPE_READY, F.TYPE_IN_RING):
-                self.log("NS %d answered the scan" % a)
-                return a
-            a = self.after(a)
-        return self.ps
-
     def gap_poll(self):
-        """One GAP address per visit (§C.5); a "ready" station becomes NS."""
+        """GAP polls (§C.5): the first scan after entering the ring (NS unknown, PS taken for it)
+        asks up to scan_per_visit addresses per visit, later scans one per visit, a new scan
+        gap_factor visits after the last. A station answering "ready" (0x20) or "in the ring"
+        (0x30) lies between us and NS in the ring: it becomes NS."""
         if self.gap_wait > 0:
             self.gap_wait -= 1
             return
-        if self.gap_next is None:
-            self.gap_next = self.after(self.ts)
-        if not self.in_gap(self.gap_next):
-            self.gap_wait = self.gap_factor
-            self.gap_next = self.after(self.ts)
-            return
-        a = self.gap_next
-        self.gap_next = self.after(a)
-        if self.fdl_status(a) == F.TYPE_READY:
-            self.log("admitting station %d" % a)
-            self.ns = a
+        for _ in range(self.scan_per_visit if self.scanning else 1):
+            if self.gap_next is None:
+                self.gap_next = self.after(self.ts)
+            if not self.in_gap(self.gap_next):
+                self.scanning = False
+                self.gap_wait = self.gap_factor
+                self.gap_next = self.after(self.ts)
+                return
+            a = self.gap_next
+            self.gap_next = self.after(a)
+            if self.fdl_status(a) in (F.TYPE_READY, F.TYPE_IN_RING):
+                self.log("station %d answered the GAP poll: it is NS now" % a)
+                self.ns = a
+                return
 
     def use_token(self, sender):
         self.count["token_visits"] += 1
@@ -271,9 +269,12 @@ class ActiveStation:
         self.in_ring = True
         try:
             if self.ns is None:
-                self.ns = self.find_ns()
+                # The only station known to be in the ring is PS; the scan finds what lies
+                # between us and it.
+                self.ns = sender
                 self.gap_next = self.after(self.ts)
-                self.gap_wait = self.gap_factor
+                self.gap_wait = 0
+                self.scanning = True
             for _ in range(self.per_visit):
                 req = self.interrupted[0] if self.interrupted else self.user.next_request()
                 if req is None:

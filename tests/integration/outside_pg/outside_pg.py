@@ -29,10 +29,16 @@ address (the scenario names the pty's link path), e.g. examples/mpi.textproto wi
 `timing: INTERFACE` makes the attachment hold the program's requests and tokens until the line
 has been idle TSYN and the previous reply (or slot time) is over, so the program keeps no bus
 timing. What it cannot escape is the other stations' timing: the CPU awaits the PG's SC within
-its slot time TSL and claims the token after TTO = (6 + 2n) TSL of silence (§C.2), which at
-187.5 kbit/s are fractions of a millisecond and a few milliseconds: far less than a Python
-program behind a pty needs. So the run must be paced slowly (pbvbus `--speed 1/100` or slower,
-and the same --speed here, which scales the default timeouts), or the line slow.
+its slot time TSL (415 bit times = 2.2 ms at 187.5 kbit/s) and retries once, and the stations
+claim the token after TTO = (6 + 2n) TSL of silence (§C.2). A Python program behind a pty
+usually answers within a millisecond, but not always. So pace the run (pbvbus `--speed 1/10`
+or slower) and give the program the same --speed (it scales the default timeouts). Tried
+against pbvbus's MPI CPU (devices/mpi_station: a CPU at 2 and the pty at 0 on one line at
+187.5 kbit/s, TSL 415; a harness outside the repository): at --speed 1, 4 runs of 25 failed (the
+PG's SC came after the CPU's slot time twice, the CPU's FDL gave up on the PG and dropped the
+connection, and the PG's next frame was refused RS); at 1/10 and 1/100 every run succeeded.
+With the CPU's GAP walk (HSA 31, one address per token visit) the PG waits up to about 30 token
+visits for its first poll: about 0.1 s at speed 1, 11 s at 1/100.
 
 Exit status: 0 = connected, the PDU size negotiated, every byte read (and disconnected);
 1 = a protocol failure (the summary's "error" says which); 2 = bad options or no port.
@@ -45,12 +51,23 @@ Decisions where the sources are silent (also in the docstrings of the modules):
     address and the first frame after each of the program's telegrams, so the program cannot
     build its LAS from the tokens of the others (§C.4 Listen_Token). It answers every FDL
     Status poll "ready to enter the ring" (0x20), the way pbvbus's ActiveStation answers a
-    master of its LAS (docs/fdl-stations.md), takes the token from whoever passes it (that one
-    is PS) and finds NS by polling the addresses after its own up to PS (first "ready" or "in
-    ring" answer; none: PS). Its other SD1 replies carry "in ring" (0x30) once it has held the
-    token.
-  - One request cycle per token visit (--per-visit), then one GAP poll when due, then the
+    master of its LAS (docs/fdl-stations.md), and takes the token from whoever passes it (that
+    one is PS). NS starts as PS, the only station known to be in the ring; the GAP scan that
+    follows (--scan-per-visit addresses per visit, then one per visit every --gap-factor
+    visits) makes the first station between that answers "ready" or "in ring" NS. A ring
+    member skipped meanwhile is re-admitted by that scan (pbvbus's masters answer "ready" to a
+    master of their LAS). With the defaults PG 0, OP 1, CPU 2 the scan is one address. Its
+    other SD1 replies carry "in ring" (0x30) once it has held the token.
+  - One request cycle per token visit (--per-visit), then the GAP poll(s) when due, then the
     token. The program cannot measure the virtual token rotation time, so it keeps no TTR.
+  - A token or request heard while the PG awaits a reply means its token is gone (the CPU
+    retried its token pass because the PG's first frame came late, or claimed the token): the
+    visit ends and the frame is handled. The request in flight goes again at the next token as
+    the same frame with the same FCB, so the CPU answers a repeat with its stored reply
+    instead of taking it twice (§C.6); a new frame with an unchanged FCB would be taken for a
+    repeat and silently dropped.
+  - FDL retries: --retries (1, the §C.1 default); the token pass: 3 attempts (§C.4, S2), then NS
+    is forgotten and found again at the next token.
   - Timeouts are wall time, worked out from the line's figures (--tsl, --baud) scaled by
     --speed, plus 10 ms for the pty. A reply (SC or SD1) must start within TSL: --timeout is
     TSL + 66 + 33 bit times. It must stay short, because while the PG waits for an empty address
@@ -199,6 +216,8 @@ def options(argv):
     ap.add_argument("--retries", type=int, default=1, help="FDL retries per request (1)")
     ap.add_argument("--per-visit", type=int, default=1, help="request cycles per token visit")
     ap.add_argument("--gap-factor", type=int, default=10, help="G: visits between GAP scans")
+    ap.add_argument("--scan-per-visit", type=int, default=4,
+                    help="GAP polls per token visit in the first scan after entering the ring")
     ap.add_argument("--step-timeout", type=float, default=None,
                     help="wall seconds any step of the connection may take (default: 40 x "
                          "--timeout, at least 5 s)")
@@ -228,8 +247,10 @@ def options(argv):
         a.token_timeout = max(a.timeout, default_token_timeout(a.tsl, a.baud, a.speed))
     if a.step_timeout is None:
         a.step_timeout = max(5.0, 40 * a.token_timeout)
-    if a.timeout <= 0 or a.token_timeout <= 0 or a.max_time <= 0 or a.per_visit < 1 or a.retries < 0:
-        ap.error("--timeout and --max-time must be positive, --per-visit >= 1, --retries >= 0")
+    if min(a.timeout, a.token_timeout, a.max_time) <= 0 or a.per_visit < 1 or a.retries < 0 \
+            or a.scan_per_visit < 1 or a.gap_factor < 0:
+        ap.error("timeouts and --max-time must be positive, --per-visit and --scan-per-visit "
+                 ">= 1, --retries and --gap-factor >= 0")
     return a
 
 
@@ -242,6 +263,7 @@ def run(link, a, log, trace=None):
     station = ActiveStation(link, a.address, session, hsa=a.hsa, reply_timeout=a.timeout,
                             token_timeout=a.token_timeout,
                             retries=a.retries, gap_factor=a.gap_factor, per_visit=a.per_visit,
+                            scan_per_visit=a.scan_per_visit,
                             log=log, trace=trace)
     finished = station.run_until(session.finished, t0 + a.max_time, on_idle=session.check)
     if not finished:

@@ -363,8 +363,8 @@ class WholeExchange(unittest.TestCase):
         self.assertTrue(cpu.disconnected)
         # The PG's frames, in order, as the fake line saw them.
         self.assertEqual(line.sent[0], READY_REPLY)
-        self.assertEqual(line.sent[1], POLL_1)          # NS scan: address 1, no answer
-        self.assertEqual(line.sent[2], CONNECT_REQUEST)  # the §H.3 trace frame
+        self.assertEqual(line.sent[1], CONNECT_REQUEST)  # the §H.3 trace frame
+        self.assertEqual(line.sent[2], POLL_1)          # GAP scan: address 1, no answer
         self.assertEqual(line.sent[3], TOKEN_TO_CPU)
         self.assertEqual(line.sent[4], h("E5"))          # for the connect confirm
         self.assertIn(CONN_ACK_PG, line.sent)
@@ -548,9 +548,32 @@ class StationDetails(unittest.TestCase):
         link.send = Ring().send
         st.run_until(lambda: st.count["token_visits"] >= 8, 10.0)
         polls = [i for i, f in enumerate(link.sent) if f == POLL_1]
-        # The scan at the first visit, then one poll every G + 1 visits (G visits waiting).
-        self.assertGreaterEqual(len(polls), 3)
+        # Visit 1: the first scan (address 1 only, then complete); G = 2 visits waiting (2, 3);
+        # visit 4: poll 1; visit 5 finds the scan complete; 6, 7 wait; visit 8: poll 1.
+        self.assertEqual(len(polls), 3)
         self.assertEqual(st.ns, 2)
+
+    def test_first_scan_spreads_over_visits_and_finds_ns(self):
+        # PG at 3, CPU at 2 (PS), HSA 6, a master at 0 that answers "in ring"; 2 polls a visit.
+        link = ScriptedLink([], {})
+        st = ActiveStation(link, 3, NoUser(), hsa=6, reply_timeout=0.05, scan_per_visit=2)
+        token_from_2 = h("DC 03 02")
+        link.to_pg.append(token_from_2)
+
+        def send(f):
+            link.sent.append(bytes(f))
+            if f[0] == 0xDC:
+                link.to_pg.append(token_from_2 if f[1] == 2 else h("DC 02 00"))
+            elif f == h("10 00 03 49 4C 16"):          # 00+03+49 = 4C: poll to 0
+                link.to_pg.append(h("10 03 00 30 33 16"))  # 03+00+30 = 33: in the ring
+        link.send = send
+        st.run_until(lambda: st.count["token_visits"] >= 2 and link.sent[-1][0] == 0xDC, 5.0)
+        polls = [f[1] for f in link.sent if f[0] == 0x10]
+        tokens = [f for f in link.sent if f[0] == 0xDC]
+        self.assertEqual(polls, [4, 5, 6, 0])  # 4, 5 in visit 1; 6, 0 in visit 2
+        self.assertEqual(tokens, [h("DC 02 03"), h("DC 00 03")])
+        self.assertEqual(st.ns, 0)
+        self.assertEqual(st.live, {0: 0x30})
 
     def test_request_fc_bits(self):
         self.assertEqual(F.request_fc(F.FN_SRD_HIGH, fcv=False, fcb=True), 0x6D)

@@ -103,13 +103,17 @@ PTY_ALLOWANCE_S = 0.01  # wall time the pty and the scheduler may add to a reply
 
 
 class SerialLink:
-    """A serial port (a pty) opened 8E1 raw; telegrams split from the byte stream."""
+    """A serial port (a pty) opened 8E1 raw; telegrams split from the byte stream. An incomplete
+    telegram that gets no further octet for `resync` seconds is dropped (counted as garbage), so
+    one lost octet does not swallow the telegrams after it."""
 
-    def __init__(self, port, baud):
+    def __init__(self, port, baud, resync=0.05):
         import serial  # Debian python3-serial; imported here so the unit tests need none
         self.ser = serial.Serial(port, baudrate=baud, bytesize=8, parity=serial.PARITY_EVEN,
                                  stopbits=1, timeout=0)
         self.deframer = F.Deframer()
+        self.resync = resync
+        self.last_octet = 0.0
         self.ser.reset_input_buffer()  # whatever was queued before we opened the port
 
     @property
@@ -132,9 +136,17 @@ class SerialLink:
             if left <= 0:
                 return None
             # select() instead of the port's own timeout: changing that reconfigures the port.
-            ready, _, _ = select.select([self.ser.fileno()], [], [], left)
+            if self.deframer.buf:
+                stale_at = self.last_octet + self.resync
+                if time.monotonic() >= stale_at:
+                    self.deframer.garbage += len(self.deframer.buf)
+                    self.deframer.clear()
+                    continue
+                left = min(left, stale_at - time.monotonic())
+            ready, _, _ = select.select([self.ser.fileno()], [], [], max(0.0, left))
             if ready:
                 self.deframer.feed(self.ser.read(max(1, self.ser.in_waiting)))
+                self.last_octet = time.monotonic()
 
     def close(self):
         self.ser.close()

@@ -621,6 +621,28 @@ def have_serial():
 
 
 @unittest.skipUnless(have_serial(), "needs python3-serial (run with /usr/bin/python3)")
+class SerialLinkOnAPty(unittest.TestCase):
+    def test_garbage_and_an_incomplete_telegram_are_dropped(self):
+        import pty
+        master, slave = pty.openpty()
+        try:
+            link = outside_pg.SerialLink(os.ttyname(slave), 187500, resync=0.05)
+            # Garbage, then a connect confirm that loses its last 3 octets, then a token.
+            os.write(master, h("00 FF") + CONNECT_CONFIRM[:-3])
+            self.assertIsNone(link.read(link.now() + 0.2))  # incomplete: dropped after 50 ms
+            os.write(master, TOKEN_TO_PG + CONN_ACK_PLC)
+            self.assertEqual(link.read(link.now() + 1.0), TOKEN_TO_PG)
+            self.assertEqual(link.read(link.now() + 1.0), CONN_ACK_PLC)
+            self.assertEqual(link.garbage, 2 + len(CONNECT_CONFIRM) - 3)
+            link.send(TOKEN_TO_CPU)
+            self.assertEqual(os.read(master, 16), TOKEN_TO_CPU)
+            link.close()
+        finally:
+            os.close(master)
+            os.close(slave)
+
+
+@unittest.skipUnless(have_serial(), "needs python3-serial (run with /usr/bin/python3)")
 class OverAPty(unittest.TestCase):
     """The whole program, main() included, on a real pty with the fake CPU on its other side."""
 
@@ -682,6 +704,7 @@ class OverAPty(unittest.TestCase):
             os.close(slave)
         s = json.loads(out.getvalue())
         self.assertEqual(rc, 0, s)
+        self.assertGreaterEqual(s["garbage_octets"], 0)
         self.assertEqual(s["data"], "00 01 02 03 04 05 06 07 08 09")
         self.assertEqual(s["pdu_size"], 240)
         self.assertTrue(s["disconnected"])

@@ -77,6 +77,7 @@ Decisions where the sources are silent (also in the docstrings of the modules):
     bus parameters): 2.7 ms and 17.5 ms virtual, 0.28 s and 1.76 s of wall time at 1/100.
   - The first token is awaited until --max-time (the CPU's GAP walk reaches the PG's address
     only every few dozen token visits); every later step of the connection has --step-timeout.
+    Both defaults grow as --speed slows down (--max-time 60 s, at 1/1000 600 s).
   - The PG asks for PDU size 240 (the largest S7 PDU that fits one MPI data message with
     headroom, §B.1: 242); a read longer than the negotiated PDU allows is split into several
     Read Var jobs.
@@ -233,7 +234,8 @@ def options(argv):
     ap.add_argument("--step-timeout", type=float, default=None,
                     help="wall seconds any step of the connection may take (default: 40 x "
                          "--timeout, at least 5 s)")
-    ap.add_argument("--max-time", type=float, default=60.0, help="give up after this (60 s)")
+    ap.add_argument("--max-time", type=float, default=None,
+                    help="give up after this many wall seconds (60, or 0.6 / --speed if longer)")
     ap.add_argument("--wait-port", type=float, default=10.0,
                     help="wait this long for the port to appear (10 s)")
     ap.add_argument("--no-disconnect", action="store_true", help="leave the connection open")
@@ -251,6 +253,8 @@ def options(argv):
         ap.error("--pdu-size must be 19..%d (one MPI data message)" % S.PG_PDU_SIZE)
     if not a.address <= a.hsa <= 126:
         ap.error("--hsa must be 0..126 and not below --address")
+    if a.max_time is None:
+        a.max_time = max(60.0, float(Fraction(6, 10) / a.speed))
     if a.tsl <= 0:
         ap.error("--tsl must be positive")
     if a.timeout is None:

@@ -467,6 +467,28 @@ class WholeExchange(unittest.TestCase):
         self.assertIn("waiting for the connect confirm (D0) from CPU 2", s["error"])
 
 
+class NoAnswerCpu(FakeCpu):
+    """Acknowledges data messages (B0) but never answers the S7 job."""
+
+    def take_pdu(self, du):
+        if du[0] == 0xF1:
+            self.pg_pdus.append(du)
+            self.queue_pdu(h("B0 01") + du[1:2])
+            return
+        super().take_pdu(du)
+
+
+class StepTimeoutWhileConnected(unittest.TestCase):
+    def test_no_s7_answer_ends_with_a_disconnect(self):
+        cpu = NoAnswerCpu()
+        rc, s, _ = run_pg(cpu, "--step-timeout", "2")
+        self.assertEqual(rc, 1)
+        self.assertIn("waiting for the answer to Setup Communication", s["error"])
+        self.assertTrue(s["disconnected"])
+        self.assertTrue(cpu.disconnected)
+        self.assertEqual(s["acks_received"], 1)
+
+
 class ScriptedLink:
     """A link that plays a fixed script: after each frame the PG sends, the replies queued for
     it (by the frame's octets) are delivered."""
@@ -601,6 +623,8 @@ class Options(unittest.TestCase):
         self.assertAlmostEqual(a.timeout, 0.27413 + 0.01, places=5)
         # token: (415 + 2805 + 33) = 3253 bits = 17.349 ms virtual, x 100, + 10 ms
         self.assertAlmostEqual(a.token_timeout, 1.73493 + 0.01, places=5)
+        self.assertEqual(a.max_time, 60.0)
+        self.assertEqual(outside_pg.options(["--port", "x", "--speed", "1/1000"]).max_time, 600.0)
         b = outside_pg.options(["--port", "x", "--baud", "45.45k", "--tsl", "100"])
         # 199 bits at 45450 bit/s = 4.378 ms, + 10 ms
         self.assertAlmostEqual(b.timeout, 0.004378 + 0.01, places=6)

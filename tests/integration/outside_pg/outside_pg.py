@@ -34,9 +34,10 @@ claim the token after TTO = (6 + 2n) TSL of silence (§C.2). A Python program be
 usually answers within a millisecond, but not always. So pace the run (pbvbus `--speed 1/10`
 or slower) and give the program the same --speed (it scales the default timeouts). Tried
 against pbvbus's MPI CPU (devices/mpi_station: a CPU at 2 and the pty at 0 on one line at
-187.5 kbit/s, TSL 415; a harness outside the repository): at --speed 1, 4 runs of 25 failed (the
+187.5 kbit/s, TSL 415; a harness outside the repository): at --speed 1, 6 runs of 45 failed (the
 PG's SC came after the CPU's slot time twice, the CPU's FDL gave up on the PG and dropped the
-connection, and the PG's next frame was refused RS); at 1/10 and 1/100 every run succeeded.
+connection, and the PG's next frame was refused RS); at 1/10 (20 runs, with and without an OP
+at 1 or 5) and at 1/100 every run succeeded.
 With the CPU's GAP walk (HSA 31, one address per token visit) the PG waits up to about 30 token
 visits for its first poll: about 0.1 s at speed 1, 11 s at 1/100.
 

@@ -236,8 +236,47 @@ class S7Planner {
     m_plan.s7.cpus.push_back(std::move(p));
   }
 
+  void plan_h_memory(int i) {
+    const auto& h = m_proto.h_system(i);
+    if (!h.has_cpu()) return;
+    HS7Plan p;
+    for (std::size_t k = 0; k < m_plan.h_systems.size(); ++k)
+      if (m_plan.h_systems[k].source == i) p.h_system = static_cast<int>(k);
+    const auto& m = h.cpu().s7_memory();
+    if (m.has_flag_bytes()) {
+      if (m.flag_bytes() > kMaxArea)
+        error("h_system", i, {{"cpu", -1}, {"s7_memory", -1}, {"flag_bytes", -1}},
+              "flag_bytes " + std::to_string(m.flag_bytes()) + " is over 16384");
+      else
+        p.memory.flags = m.flag_bytes();
+    }
+    std::set<std::uint32_t> numbers;
+    for (int k = 0; k < m.db_size(); ++k) {
+      const auto& db = m.db(k);
+      const Path at{{"cpu", -1}, {"s7_memory", -1}, {"db", k}};
+      if (!db.has_number() || db.number() < 1 || db.number() > 65535 || !numbers.insert(db.number()).second) {
+        Path f = at;
+        f.push_back({"number", -1});
+        error("h_system", i, f,
+              db.has_number() && db.number() >= 1 && db.number() <= 65535
+                  ? "DB " + std::to_string(db.number()) + " is defined twice"
+                  : "a DB needs a number 1..65535");
+        continue;
+      }
+      if (!db.has_size() || db.size() < 1 || db.size() > 65534) {
+        Path f = at;
+        f.push_back({"size", -1});
+        error("h_system", i, f, "DB " + std::to_string(db.number()) + " needs a size 1..65534 bytes");
+        continue;
+      }
+      p.memory.dbs.push_back({static_cast<std::uint16_t>(db.number()), db.size()});
+    }
+    m_plan.s7.h_memory.push_back(std::move(p));
+  }
+
   void plan_h_mpi(int i) {
     const auto& h = m_proto.h_system(i);
+    plan_h_memory(i);
     if (!h.has_cpu() || !h.cpu().has_mpi()) return;
     const auto& m = h.cpu().mpi();
     const Path at{{"cpu", -1}, {"mpi", -1}};
@@ -259,6 +298,10 @@ class S7Planner {
         p.max_connections = m.max_connections();
     }
     (void)at;
+    // The pair counts its ad-hoc connections against this (HCpuPair::connect).
+    if (p.h_system >= 0 && m_plan.h_systems[static_cast<std::size_t>(p.h_system)].runtime)
+      m_plan.h_systems[static_cast<std::size_t>(p.h_system)].runtime->pair.max_connections =
+          static_cast<int>(p.max_connections);
     m_plan.s7.h_mpi.push_back(p);
   }
 

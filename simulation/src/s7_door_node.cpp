@@ -74,9 +74,36 @@ class S7DoorNode::MpiChannel final : public iso_on_tcp::S7Channel {
   Closed m_closed;
 };
 
+/// A client connection to an H-system over one of the model's S7 sessions.
+class S7DoorNode::HChannel final : public iso_on_tcp::S7Channel {
+ public:
+  explicit HChannel(devices::HS7Session s) : m_s(std::move(s)) {}
+  void request(std::vector<std::uint8_t> pdu, Reply reply) override {
+    if (m_s.alive()) {
+      auto answer = m_s.handle(pdu);
+      if (m_s.alive() || !answer.empty()) {
+        reply(std::move(answer));
+        return;
+      }
+    }
+    // The connection ended with its CPU (or CP, or at a link-up): the client gets a DR.
+    if (m_closed) {
+      auto c = std::move(m_closed);
+      m_closed = nullptr;
+      c(m_s.close_text());
+    }
+  }
+  void on_closed(Closed closed) override { m_closed = std::move(closed); }
+
+ private:
+  devices::HS7Session m_s;
+  Closed m_closed;
+};
+
 S7DoorNode::S7DoorNode(bus::Scheduler& sched, const S7DoorPlan& plan, std::vector<S7CpuNode*> cpus,
-                       const fdl::BusParams* mpi_params)
-    : m_sched(sched), m_plan(plan), m_cpus(std::move(cpus)) {
+                       const fdl::BusParams* mpi_params,
+                       std::function<devices::HSystemModel*(int)> h_model)
+    : m_sched(sched), m_plan(plan), m_cpus(std::move(cpus)), m_h_model(std::move(h_model)) {
   if (plan.mpi_line >= 0 && mpi_params != nullptr) {
     mpi_station::MpiStationConfig c;
     c.address = plan.mpi_address;
@@ -140,8 +167,22 @@ iso_on_tcp::RouteResult S7DoorNode::open(const iso_on_tcp::RouteRequest& request
       r.channel = std::move(ch);
       return r;
     }
-    case S7RoutePlan::Kind::HSystem:
-      break;
+    case S7RoutePlan::Kind::HSystem: {
+      devices::HSystemModel* m = m_h_model ? m_h_model(it->target) : nullptr;
+      if (m == nullptr) return iso_on_tcp::RouteResult::refuse(1, "the H-system is not running");
+      devices::HS7Session session;
+      if (it->connection >= 0) {
+        session = m->open_s7_connection(m->comms().connections().at(
+            static_cast<std::size_t>(it->connection)).config.name);
+      } else {
+        const int master = m->pair().master();
+        if (master < 0) return iso_on_tcp::RouteResult::refuse(1, "the H-system has no master CPU");
+        session = m->open_s7_adhoc(master);
+      }
+      if (!session.alive()) return iso_on_tcp::RouteResult::refuse(1, session.close_text());
+      r.channel = std::make_unique<HChannel>(std::move(session));
+      return r;
+    }
   }
   return iso_on_tcp::RouteResult::refuse(3, "route kind not served");
 }

@@ -96,6 +96,52 @@ void S7CpuNode::exchange(dp::Master& master) {
   }
 }
 
+// --- HCpuMpiNode ---------------------------------------------------------------------------------
+
+namespace {
+
+/// One MPI connection's S7 session on an H CPU: answers while the model's session lives.
+class HSession final : public mpi_station::S7Session {
+ public:
+  explicit HSession(devices::HS7Session s) : m_s(std::move(s)) {}
+  std::vector<std::uint8_t> handle(std::span<const std::uint8_t> pdu) override { return m_s.handle(pdu); }
+
+ private:
+  devices::HS7Session m_s;
+};
+
+}  // namespace
+
+class HCpuMpiNode::Factory final : public mpi_station::S7SessionFactory {
+ public:
+  Factory(int rack, std::function<devices::HSystemModel*()> model)
+      : m_rack(rack), m_model(std::move(model)) {}
+  std::unique_ptr<mpi_station::S7Session> open(std::uint8_t) override {
+    devices::HSystemModel* m = m_model();
+    if (m == nullptr) return nullptr;
+    devices::HS7Session s = m->open_s7_adhoc(m_rack);
+    if (!s.alive()) return nullptr;  // no resources, R8, CPU not carrying: refused
+    return std::make_unique<HSession>(std::move(s));
+  }
+
+ private:
+  int m_rack;
+  std::function<devices::HSystemModel*()> m_model;
+};
+
+HCpuMpiNode::HCpuMpiNode(const HMpiPlan& plan, int rack, const fdl::BusParams& params,
+                         std::function<devices::HSystemModel*()> model)
+    : m_plan(plan), m_rack(rack), m_factory(std::make_unique<Factory>(rack, std::move(model))) {
+  mpi_station::MpiStationConfig c;
+  c.address = plan.address[rack];
+  c.bus = params;
+  // The model counts the CPU's connections (HCpuPair::connect); the pool is no tighter.
+  c.pool.max_connections = plan.max_connections;
+  m_station = std::make_unique<mpi_station::MpiStation>(c, m_factory.get());
+}
+
+HCpuMpiNode::~HCpuMpiNode() = default;
+
 // --- MpiClientNode ------------------------------------------------------------------------------
 
 namespace {

@@ -97,12 +97,20 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
   for (const auto& m : m_plan.s7.stations)
     m_mpi_clients.push_back(std::make_unique<MpiClientNode>(
         m_sched, m, m_plan.lines.at(static_cast<std::size_t>(m.line)).params));
+  for (const auto& hm : m_plan.s7.h_mpi)
+    for (int rack = 0; rack < 2; ++rack) {
+      const int hi = hm.h_system;
+      m_h_mpi.push_back(std::make_unique<HCpuMpiNode>(
+          hm, rack, m_plan.lines.at(static_cast<std::size_t>(hm.line)).params,
+          [this, hi] { return h_model(hi); }));
+    }
   std::vector<S7CpuNode*> cpus;
   for (auto& c : m_s7_cpus) cpus.push_back(c.get());
   for (const auto& d : m_plan.s7.doors)
     m_s7_doors.push_back(std::make_unique<S7DoorNode>(
         m_sched, d, cpus,
-        d.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(d.mpi_line)).params : nullptr));
+        d.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(d.mpi_line)).params : nullptr,
+        [this](int h) { return h_model(h); }));
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
   for (auto& node : m_redundant) node->set_capture(m_opts.capture);
   std::string why;
@@ -288,8 +296,19 @@ void Simulation::build_line(std::size_t li) {
         st.position = ls->line->attach(*door.mpi(), label);
         break;
       }
-      case StationKind::HCpuMpi:
-        throw std::runtime_error("not yet");
+      case StationKind::HCpuMpi: {
+        // source = h_system entry * 2 + rack (scenario.hpp); the nodes are in h_mpi order.
+        const int entry = ps.source / 2, rack = ps.source % 2;
+        for (auto& n : m_h_mpi) {
+          if (m_plan.h_systems.at(static_cast<std::size_t>(n->plan().h_system)).source != entry ||
+              n->rack() != rack)
+            continue;
+          label = m_plan.h_systems.at(static_cast<std::size_t>(n->plan().h_system)).name + " CPU " +
+                  std::to_string(rack) + " MPI " + std::to_string(st.address);
+          st.position = ls->line->attach(n->station(), label);
+        }
+        break;
+      }
       case StationKind::SerialMonitor:
       case StationKind::SerialStation: {
         const auto& sp = m_plan.proto.serial(ps.source);
@@ -377,7 +396,20 @@ void Simulation::start() {
     if (!m_plan.h_systems[k].runtime) continue;
     m_h.push_back(std::make_unique<HSystemNode>(m_plan, static_cast<int>(k), m_sched, systems));
     m_h.back()->set_capture(m_opts.capture);
+    for (const auto& hm : m_plan.s7.h_memory)
+      if (hm.h_system == static_cast<int>(k)) m_h.back()->model().set_s7_memory(hm.memory);
     m_h.back()->start();
+    // The CPUs' MPI interfaces are powered with their CPUs.
+    const auto& on = m_plan.h_systems[k].runtime->power_on;
+    for (int r = 0; r < 2; ++r) {
+      const auto when = on[static_cast<std::size_t>(r)];
+      if (when && *when <= m_sched.now()) continue;
+      set_h_mpi_power(static_cast<int>(k), r, false);
+      if (when) {
+        const int hk = static_cast<int>(k);
+        m_sched.schedule(*when, [this, hk, r] { set_h_mpi_power(hk, r, true); });
+      }
+    }
   }
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
@@ -427,6 +459,7 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
+  if (f.kind == PlanFault::Kind::CpuFailure) set_h_mpi_power(f.h_system, f.rack, !on);
   if (is_h_fault(f.kind)) {
     for (auto& h : m_h)
       if (h->plan().source == m_plan.h_systems.at(static_cast<std::size_t>(f.h_system)).source)
@@ -723,6 +756,28 @@ void Simulation::attach_s7_capture(S7DoorNode& door) {
     info.comment = comment;
     w.write_s7_pdu(iface, m_sched.now(), r.pdu, info);
   });
+}
+
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+
+devices::HSystemModel* Simulation::h_model(int plan_index) {
+  if (plan_index < 0) return nullptr;
+  const int source = m_plan.h_systems.at(static_cast<std::size_t>(plan_index)).source;
+  for (auto& h : m_h)
+    if (h->plan().source == source) return &h->model();
+  return nullptr;
+}
+
+void Simulation::set_h_mpi_power(int plan_index, int rack, bool on) {
+  for (auto& n : m_h_mpi) {
+    if (n->plan().h_system != plan_index || n->rack() != rack) continue;
+    auto& line = *m_lines.at(static_cast<std::size_t>(n->plan().line))->line;
+    for (const auto& st : m_lines.at(static_cast<std::size_t>(n->plan().line))->stations)
+      if (st.kind == StationKind::HCpuMpi && st.address == n->plan().address[rack])
+        line.set_power(st.position, on);
+  }
 }
 
 }  // namespace pbvbus::tools

@@ -249,7 +249,10 @@ s7_door { name: "D" listen: "127.0.0.1:0" route { rack: 0 slot: 3 h_system: "H" 
   EXPECT_EQ(p.s7.h_mpi[0].h_system, 0);
   EXPECT_EQ(p.s7.h_mpi[0].address[0], 2);
   EXPECT_EQ(p.s7.h_mpi[0].address[1], 3);
-  EXPECT_EQ(p.s7.h_mpi[0].max_connections, 32u);
+  EXPECT_EQ(p.s7.h_mpi[0].max_connections, 44u);
+  EXPECT_EQ(p.h_systems[0].runtime->pair.max_connections, 44);
+  ASSERT_EQ(p.s7.h_memory.size(), 1u);
+  EXPECT_EQ(p.s7.h_memory[0].memory.flags, 256u);
   const auto& st = p.lines[0].stations;
   ASSERT_EQ(st.size(), 3u);
   EXPECT_EQ(st[0].kind, StationKind::HCpuMpi);

@@ -19,8 +19,9 @@
 //    PROFIBUS-DP line. At least one interface. DB numbers 1..65535 unique, sizes 1..65534;
 //    I, Q, M sizes up to 16 384 (the largest S7-400 process image); max_connections 1..64
 //    (default 12: an S7-300 CPU's S7 connection resources).
-//  - An H pair's MPI addresses differ (the only thing in which CPU 1 may differ from CPU 0,
-//    seeds-digest.md §3.2); max_connections 1..64, default 32 (a 414-4H's MPI resources).
+//  - Every h_system with a `cpu` part serves S7 (its memory: cpu.s7_memory, flags default 256,
+//    DBs as a single CPU's); an H pair's MPI addresses differ (the only thing in which CPU 1 may differ from CPU 0,
+//    seeds-digest.md §3.2); max_connections 1..64, default 44 (a 417-4H's MPI resources, the profile's CPU).
 //  - A PG/OP read names the MPI address of a CPU on the station's own line, an item in S7
 //    syntax (s7_item below) and a period > 0 (default 100 ms).
 //  - S7 doors: names unique, "HOST:PORT" as the gateways' (numeric host; a port other than 0
@@ -37,6 +38,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/s7h/h_s7_memory.hpp"
 #include "pbvbus/scenario/gateway_plan.hpp"
 
 namespace pbvbus::tools {
@@ -84,12 +86,18 @@ struct S7CpuPlan {
   bool run = true;
 };
 
+/// What S7 clients see of an h_system's CPUs (set whenever the h_system has a `cpu` part).
+struct HS7Plan {
+  int h_system = -1;  ///< index into ScenarioPlan::h_systems
+  devices::HS7MemoryConfig memory;
+};
+
 /// The MPI interfaces of an h_system's CPUs.
 struct HMpiPlan {
   int h_system = -1;  ///< index into ScenarioPlan::h_systems
   int line = -1;
   std::uint8_t address[2] = {2, 3};
-  std::uint32_t max_connections = 32;
+  std::uint32_t max_connections = 44;
 };
 
 struct S7PollPlan {
@@ -130,6 +138,7 @@ struct S7DoorPlan {
 struct S7Plan {
   std::vector<S7CpuPlan> cpus;
   std::vector<HMpiPlan> h_mpi;
+  std::vector<HS7Plan> h_memory;
   std::vector<MpiStationPlan> stations;
   std::vector<S7DoorPlan> doors;
   /// The S7 CPUs on MPI line `line`: (address, "CPU name" or "h_system rack r").

@@ -14,6 +14,11 @@
 //   connect confirm) and jobs wait until the MPI connection is up. If it is refused or breaks,
 //   the client gets a COTP DR (the route closed). The CPU answers Setup Communication with at
 //   most 240 (the MPI data message's limit), which the client then keeps to.
+// - To an H-system: a route with `connection` rides on that configured connection
+//   (HSystemModel::open_s7_connection: standard ends with its CPU or CP, fault-tolerant survives
+//   the master's loss); without, an ad-hoc connection to the master CPU at the client's CR
+//   (open_s7_adhoc, ends with that CPU). The session is checked at every job: once the model has
+//   closed it, the job goes unanswered and the client gets a COTP DR with the model's reason.
 // - The S7 PDUs the door carries go to the capture as upper-PDU records when a capture runs.
 #include <cstdint>
 #include <functional>
@@ -35,7 +40,8 @@ class S7DoorNode final : public iso_on_tcp::S7Router, public bus::EventTarget {
   /// `cpus`: the run's single CPUs (index = S7Plan::cpus); `mpi_params`: the door's MPI line's
   /// bus parameters when it has one.
   S7DoorNode(bus::Scheduler& sched, const S7DoorPlan& plan, std::vector<S7CpuNode*> cpus,
-             const fdl::BusParams* mpi_params);
+             const fdl::BusParams* mpi_params,
+             std::function<devices::HSystemModel*(int h_system)> h_model = {});
   ~S7DoorNode() override;
 
   const S7DoorPlan& plan() const { return m_plan; }
@@ -56,11 +62,13 @@ class S7DoorNode final : public iso_on_tcp::S7Router, public bus::EventTarget {
  private:
   class CpuChannel;
   class MpiChannel;
+  class HChannel;
   void on_station_event(const mpi_station::StationEvent& e);
 
   bus::Scheduler& m_sched;
   S7DoorPlan m_plan;
   std::vector<S7CpuNode*> m_cpus;
+  std::function<devices::HSystemModel*(int)> m_h_model;
   std::unique_ptr<mpi_station::MpiStation> m_mpi;
   std::vector<MpiChannel*> m_mpi_channels;  ///< open channels over MPI (owned by the door)
   std::vector<mpi_station::StationEvent> m_pending;

@@ -4,6 +4,7 @@
 // from CPUs over MPI. docs/s7cpu.md "A single CPU in a scenario" and docs/mpi.md "PGs and OPs in
 // a scenario" have the decisions.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -15,6 +16,7 @@
 #include "pbvbus/mpi_station/s7cpu_sessions.hpp"
 #include "pbvbus/s7cpu/cpu_memory.hpp"
 #include "pbvbus/s7cpu/s7_server.hpp"
+#include "pbvbus/s7h/h_system.hpp"
 #include "pbvbus/scenario/s7_plan.hpp"
 
 namespace pbvbus::tools {
@@ -71,6 +73,30 @@ class S7CpuNode {
   std::uint32_t m_next_in = 0, m_next_out = 0, m_unmapped = 0;
   std::uint64_t m_exchanges = 0;
   std::vector<std::uint8_t> m_buf;
+};
+
+/// The MPI interface of one CPU of an h_system: an MPI station whose connections are ad-hoc S7
+/// connections of that CPU (HSystemModel::open_s7_adhoc: counted against its connection
+/// resources, refused during a link-up/update, R8). `model` gives the running model (nullptr
+/// before the H-system runs: connections are then refused). The line powers the station with its
+/// CPU (Simulation: the CPU's power-on time, cpu_failure faults), so a CPU that fails leaves the
+/// token ring and its connections break at the PGs (PeerLeftRing / PeerGone).
+class HCpuMpiNode {
+ public:
+  HCpuMpiNode(const HMpiPlan& plan, int rack, const fdl::BusParams& params,
+              std::function<devices::HSystemModel*()> model);
+  ~HCpuMpiNode();
+  mpi_station::MpiStation& station() { return *m_station; }
+  const mpi_station::MpiStation& station() const { return *m_station; }
+  const HMpiPlan& plan() const { return m_plan; }
+  int rack() const { return m_rack; }
+
+ private:
+  class Factory;
+  HMpiPlan m_plan;
+  int m_rack;
+  std::unique_ptr<Factory> m_factory;
+  std::unique_ptr<mpi_station::MpiStation> m_station;
 };
 
 /// What a PG/OP's read of one item did in the run.

@@ -159,6 +159,10 @@ class Simulation {
   void schedule_faults();
   void build_gateways();
   void attach_s7_capture(S7DoorNode& door);
+  /// The running model of h_systems[plan_index] (nullptr before start() or without a `cpu`).
+  devices::HSystemModel* h_model(int plan_index);
+  /// Powers the MPI stations of h_systems[plan_index]'s CPU `rack` with the CPU.
+  void set_h_mpi_power(int plan_index, int rack, bool on);
   void apply_fault(const PlanFault& f, bool on);
   void apply_slave_fault(const PlanFault& f, bool on);
   void make_link(const std::string& target, const std::string& link);
@@ -178,6 +182,7 @@ class Simulation {
   std::vector<std::unique_ptr<S7CpuNode>> m_s7_cpus;
   std::vector<std::unique_ptr<MpiClientNode>> m_mpi_clients;
   std::vector<std::unique_ptr<S7DoorNode>> m_s7_doors;
+  std::vector<std::unique_ptr<HCpuMpiNode>> m_h_mpi;  ///< the H CPUs' MPI interfaces
   std::vector<std::unique_ptr<LineState>> m_lines;
   // H-systems drive the redundant systems' models and schedule on m_sched: destroyed first.
   std::vector<std::unique_ptr<HSystemNode>> m_h;

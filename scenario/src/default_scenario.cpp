@@ -47,6 +47,9 @@ constexpr char kDefault[] = R"pb(# pbvbus scenario: an S7-400H-style H-system, t
 #            16.145 s Redundant, now with CPU 1 as master.
 #   Also: OB 85 (process-image transfer error, W#16#39B1 / 38B1) at the first OB 1 that finds
 #   a one-sided slave of the lost side gone (5.005 s, 12.005 s) and back (9.145 s, 16.145 s).
+#   MPI: the OP connects to CPU 0 (MPI 2) and reads every 200 ms; 12 s its connection breaks,
+#            16.145 s it is back. The S7 door at 127.0.0.1:10102 (rack 0, slot 3) answers
+#            from the master CPU (a paced run: `pbvbus run` paces a scenario with a door).
 #   18 s     end.
 name: "h-system"
 description: "An H-system CPU pair on a redundant DP master system: power-up to Redundant, F5, an IM failure, F1 and the return of the failed CPU."
@@ -55,6 +58,8 @@ duration: "18s"
 
 line { name: "DP_A" baud: "1.5M" }
 line { name: "DP_B" baud: "1.5M" }
+# The CPUs' MPI subnet (187.5 kbit/s, HSA 31): CPU 0 at MPI address 2, CPU 1 at 3, an OP at 1.
+line { name: "MPI" kind: MPI }
 
 dp_master { address: 1 line: "DP_A" watchdog: "100ms" }
 dp_master { address: 1 line: "DP_B" watchdog: "100ms" }
@@ -109,6 +114,8 @@ h_system {
     startup_time: "1s"
     link_up_time: "2s"
     comparison_reaction: ERROR_SEARCH
+    mpi { line: "MPI" }                      # CPU 0 at 2, CPU 1 at 3
+    s7_memory { db { number: 1 size: 64 } }  # M from MB 0 is the program's state
   }
   program {
     scan_time: "10ms"
@@ -118,6 +125,15 @@ h_system {
     copy { from_input: 0 to_output: 4 length: 2 }
   }
 }
+
+# An OP on the MPI line reads the program's counter (QW 0) and the program's state (its counter
+# value is MD 8, docs/h-system.md "S7 communication") from CPU 0 every 200 ms: at 12 s CPU 0
+# fails, the OP's connection breaks; it connects again once CPU 0 is back and its update is
+# over (no connections during link-up and update, seed R8).
+mpi_station { role: OP line: "MPI" read { cpu: 2 item: "QW0" period: "200ms" } read { cpu: 2 item: "MD8" period: "200ms" } }
+# S7 clients (nodes7, HMIs) reach the H-system at 127.0.0.1:10102, rack 0 slot 3, on an ad-hoc
+# connection to the master CPU (README "MPI and S7"). The door opens in paced runs (the default).
+s7_door { name: "S7" listen: "127.0.0.1:10102" route { rack: 0 slot: 3 h_system: "H-CPU" } }
 
 # F5 and its repair; then the standby's STOP -> RUN to link up again.
 fault { at: "5s" repair_at: "6s" fibre_cut { fibre: 0 } }

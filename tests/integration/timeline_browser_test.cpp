@@ -274,7 +274,7 @@ class TimelineBrowserH : public TimelineBrowser {
     if (!start()) GTEST_SKIP() << kNoChromium;
     const std::string capture = (m_dir / "h.pcapng").string();
     std::ostringstream out, err;
-    ASSERT_EQ(cmd_run({"--capture", capture, "--quiet"}, out, err), 0) << err.str();
+    ASSERT_EQ(cmd_run({"--fast", "--capture", capture, "--quiet"}, out, err), 0) << err.str();
     m_html = (m_dir / "h.html").string();
     ASSERT_EQ(cmd_timeline({capture, "-o", m_html}, out, err), 0) << err.str();
   }

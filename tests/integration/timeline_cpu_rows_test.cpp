@@ -72,7 +72,7 @@ const Files& files() {
       return r;
     }
     std::string out;
-    if (shell(quote(kBinary) + " run --capture " + quote(r.capture.string()) + " --quiet", out) != 0)
+    if (shell(quote(kBinary) + " run --fast --capture " + quote(r.capture.string()) + " --quiet", out) != 0)
       r.error = "pbvbus run: " + out;
     else if (shell(quote(kBinary) + " timeline " + quote(r.capture.string()) + " -o " +
                        quote(r.svg.string()),

@@ -18,6 +18,15 @@
 // it): at speed 1 a Python program behind a pty sometimes answers after the CPU's slot time
 // (outside_pg.py's docstring: 6 of 45 runs failed at speed 1, none at 1/10). Nothing here is
 // timed; the waits are guards that fail the test instead of hanging it.
+//
+// Decisions where the sources are silent:
+//  - DB1 is filled over the door (route `cpu:`, straight into the CPU's memory) before the PG
+//    starts, so the PG's read comes after the write whatever the timing; the door's port is a
+//    free ephemeral one picked by the test (bind to port 0, release), checked in the report.
+//  - The OP's reads are only checked for errors, not for the value: when its last read falls
+//    relative to the write depends on the wall-clock pacing.
+//  - The PG disconnects before the run ends, so the CPU has exactly the OP's connection open
+//    (the PG's disconnect was taken: the FDL acknowledged the frame before the PG exited).
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -186,7 +195,9 @@ class IsoClient {
   int fd_ = -1;
 };
 
-/// One run, shared by the tests below (it takes a few seconds of wall time).
+/// One run, shared by the tests below when they run in one process (it takes a few seconds of
+/// wall time). ctest runs each test in a process of its own, possibly at the same time, so a
+/// run's files (pty link, scenario, report, capture) are named after the test that made it.
 struct PgRun {
   std::string skip;  ///< why the run could not be made here, or ""
   int pbvbus_status = -1;
@@ -198,14 +209,14 @@ struct PgRun {
   double wall_s = 0;
 };
 
-PgRun make_run() {
+PgRun make_run(const std::string& tag) {
   PgRun r;
   if (const auto why = test_support::missing_python(); !why.empty()) {
     r.skip = why;
     return r;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string base = std::string(PBVBUS_BINARY_DIR) + "/outside_pg_run";
+  const std::string base = std::string(PBVBUS_BINARY_DIR) + "/outside_pg_run_" + tag;
   const std::string link = base + ".pty", scenario_file = base + ".textproto";
   const std::string report_file = base + ".report.json", err_file = base + ".err";
   const std::string pg_file = base + ".pg.json";
@@ -299,7 +310,8 @@ PgRun make_run() {
 }
 
 const PgRun& the_run() {
-  static const PgRun run = make_run();
+  static const PgRun run =
+      make_run(::testing::UnitTest::GetInstance()->current_test_info()->name());
   return run;
 }
 
@@ -372,8 +384,8 @@ std::string bare_hex(std::string s) {
 }
 
 TEST(OutsidePgRun, TheCaptureShowsThePgsConnectionDecoded) {
-  REQUIRE_RUN(r);
   if (!ts::tshark_available()) GTEST_SKIP() << ts::kNoTshark;
+  REQUIRE_RUN(r);
   ASSERT_EQ(r.pg_rc, 0) << r.pg_json;
   // The MPI frames between the PG (0) and the CPU (2), in capture order.
   enum { kSa, kDa, kPdu, kNr, kRosctr, kFunc, kRet, kPduLen, kItems, kS7 };

@@ -52,6 +52,7 @@
 
 #include "../captures/tshark_helpers.hpp"
 #include "outside_slave_support.hpp"
+
 #include "pbvbus/tools/commands.hpp"
 
 namespace pbvbus::tools {
@@ -84,17 +85,16 @@ const Bytes kCr = {0x03, 0x00, 0x00, 0x16, 0x11, 0xE0, 0x00, 0x00, 0x00, 0x01, 0
                    0xC0, 0x01, 0x0A, 0xC1, 0x02, 0x01, 0x00, 0xC2, 0x02, 0x01, 0x02};
 /// Setup Communication: S7 header 32 01 0000 ref 0001 param 0008 data 0000; F0 00, AmQ calling
 /// 0001, called 0001, PDU length 00F0 (240). TPKT 4 + DT 3 + 10 + 8 = 25 = 0x19.
-const Bytes kSetup = {0x03, 0x00, 0x00, 0x19, 0x02, 0xF0, 0x80, 0x32, 0x01,
-                      0x00, 0x00, 0x00, 0x01, 0x00, 0x08, 0x00, 0x00, 0xF0,
-                      0x00, 0x00, 0x01, 0x00, 0x01, 0x00, 0xF0};
+const Bytes kSetup = {0x03, 0x00, 0x00, 0x19, 0x02, 0xF0, 0x80, 0x32, 0x01, 0x00, 0x00, 0x00, 0x01,
+                      0x00, 0x08, 0x00, 0x00, 0xF0, 0x00, 0x00, 0x01, 0x00, 0x01, 0x00, 0xF0};
 /// Write Var of DB1.DBB0, 16 bytes: header ref 0002, param 000E (14), data 0014 (4 + 16);
 /// 05 01 (one item), item 12 0A 10, transport 02 (BYTE), count 0010, DB 0001, area 84,
 /// address 00 00 00; data: reserved 00, transport 04 (BYTE/WORD/DWORD, length in bits),
 /// 0080 (128 bits), the 16 octets. TPKT 4 + 3 + 10 + 14 + 20 = 51 = 0x33.
 Bytes write_db1() {
-  Bytes b = {0x03, 0x00, 0x00, 0x33, 0x02, 0xF0, 0x80, 0x32, 0x01, 0x00, 0x00, 0x00, 0x02,
-             0x00, 0x0E, 0x00, 0x14, 0x05, 0x01, 0x12, 0x0A, 0x10, 0x02, 0x00, 0x10, 0x00,
-             0x01, 0x84, 0x00, 0x00, 0x00, 0x00, 0x04, 0x00, 0x80};
+  Bytes b = {0x03, 0x00, 0x00, 0x33, 0x02, 0xF0, 0x80, 0x32, 0x01, 0x00, 0x00, 0x00,
+             0x02, 0x00, 0x0E, 0x00, 0x14, 0x05, 0x01, 0x12, 0x0A, 0x10, 0x02, 0x00,
+             0x10, 0x00, 0x01, 0x84, 0x00, 0x00, 0x00, 0x00, 0x04, 0x00, 0x80};
   b.insert(b.end(), kDb1.begin(), kDb1.end());
   return b;
 }
@@ -223,14 +223,16 @@ PgRun make_run(const std::string& tag) {
   r.capture = base + ".pcapng";
   r.door_port = free_port();
   // PG 0 (the pty), OP 1, CPU 2: the MPI defaults (protocol-facts.md §H.1).
-  const std::string text =
-      "name: \"outside PG over the pty\"\n"
-      "line { name: \"MPI\" kind: MPI }\n"
-      "s7_cpu { name: \"CPU\" mpi_dp { mode: MPI line: \"MPI\" } db { number: 1 size: 64 } }\n"
-      "mpi_station { role: OP line: \"MPI\" read { cpu: 2 item: \"DB1.DBW0\" period: \"100ms\" } }\n"
-      "serial { line: \"MPI\" mode: STATION address: 0 timing: INTERFACE link: \"" + link + "\" }\n"
-      "s7_door { name: \"S7\" listen: \"127.0.0.1:" + std::to_string(r.door_port) + "\"\n"
-      "  route { rack: 0 slot: 2 cpu: \"CPU\" } }\n";
+  const std::string port = std::to_string(r.door_port);
+  std::string text = "name: \"outside PG over the pty\"\n";
+  text += "line { name: \"MPI\" kind: MPI }\n";
+  text += "s7_cpu { name: \"CPU\" mpi_dp { mode: MPI line: \"MPI\" } db { number: 1 size: 64 } }\n";
+  text += "mpi_station { role: OP line: \"MPI\"\n";
+  text += "  read { cpu: 2 item: \"DB1.DBW0\" period: \"100ms\" } }\n";
+  text += "serial { line: \"MPI\" mode: STATION address: 0 timing: INTERFACE\n";
+  text += "  link: \"" + link + "\" }\n";
+  text += "s7_door { name: \"S7\" listen: \"127.0.0.1:" + port + "\"\n";
+  text += "  route { rack: 0 slot: 2 cpu: \"CPU\" } }\n";
   std::ofstream(scenario_file) << text;
 
   std::cout.flush();
@@ -316,11 +318,11 @@ const PgRun& the_run() {
 }
 
 /// The run, or a skip / failure of the calling test when there is none.
-#define REQUIRE_RUN(r)                                                                        \
-  const PgRun& r = the_run();                                                                 \
-  if (!r.skip.empty()) GTEST_SKIP() << r.skip;                                                \
-  ASSERT_TRUE(WIFEXITED(r.pbvbus_status))                                                     \
-      << "pbvbus run did not exit normally (status " << r.pbvbus_status << "): " << r.err;    \
+#define REQUIRE_RUN(r)                                                                     \
+  const PgRun& r = the_run();                                                              \
+  if (!r.skip.empty()) GTEST_SKIP() << r.skip;                                             \
+  ASSERT_TRUE(WIFEXITED(r.pbvbus_status))                                                  \
+      << "pbvbus run did not exit normally (status " << r.pbvbus_status << "): " << r.err; \
   ASSERT_FALSE(r.report.empty()) << "report: " << r.report_json << "\nstderr: " << r.err
 
 TEST(OutsidePgRun, ThePgReadsWhatTheDoorWroteIntoDb1) {
@@ -414,8 +416,8 @@ TEST(OutsidePgRun, TheCaptureShowsThePgsConnectionDecoded) {
     };
   };
   std::string all;
-  for (const auto& row : rows) all += row[kSa] + ">" + row[kDa] + " " + row[kPdu] + " " +
-                                      row[kFunc] + " " + row[kRet] + "\n";
+  for (const auto& row : rows)
+    all += row[kSa] + ">" + row[kDa] + " " + row[kPdu] + " " + row[kFunc] + " " + row[kRet] + "\n";
 
   // §H.3: connect request from the PG to the CPU's SAP 0, the CPU's confirm, the acks.
   const auto cr = find(0, is("0", "2", "0xe0"));
@@ -426,7 +428,7 @@ TEST(OutsidePgRun, TheCaptureShowsThePgsConnectionDecoded) {
   const auto setup = find(*cc, data("0", "2", "1", "0xf0"));
   ASSERT_TRUE(setup) << all;
   EXPECT_EQ(rows[*setup][kPduLen], "240");
-  EXPECT_EQ(rows[*setup][kNr], "0");  // the PG's first data message
+  EXPECT_EQ(rows[*setup][kNr], "0");                       // the PG's first data message
   ASSERT_TRUE(find(*setup, is("2", "0", "0xb0"))) << all;  // the CPU's MPI ack
   const auto setup_ack = find(*setup, data("2", "0", "3", "0xf0"));
   ASSERT_TRUE(setup_ack) << all;

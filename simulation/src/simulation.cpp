@@ -459,11 +459,12 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
-  if (f.kind == PlanFault::Kind::CpuFailure) set_h_mpi_power(f.h_system, f.rack, !on);
   if (is_h_fault(f.kind)) {
     for (auto& h : m_h)
       if (h->plan().source == m_plan.h_systems.at(static_cast<std::size_t>(f.h_system)).source)
         h->apply(f, on);
+    // The CPU's MPI interface goes with it (after the fault's note: the note comes first).
+    if (f.kind == PlanFault::Kind::CpuFailure) set_h_mpi_power(f.h_system, f.rack, !on);
     return;
   }
   LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));

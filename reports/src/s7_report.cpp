@@ -23,7 +23,7 @@ void write_s7_text(const S7Report& r, std::ostream& os) {
   }
   for (const MpiStationReport& s : r.stations) {
     os << "\n" << (s.op ? "OP " : "PG ") << static_cast<int>(s.address) << " on " << s.line << ": "
-       << s.connects << " connects, " << s.breaks << " breaks";
+       << s.connects << " connects, " << s.breaks << " broken, " << s.refused << " refused";
     for (const auto& [why, n] : s.broken) os << ", " << why << " " << n;
     os << "\n";
     for (const S7ReadReport& rd : s.reads) {
@@ -70,7 +70,8 @@ void write_s7_json(const S7Report& r, std::ostream& os) {
     const MpiStationReport& s = r.stations[i];
     os << (i ? "," : "") << "{\"role\":\"" << (s.op ? "OP" : "PG") << "\",\"line\":"
        << json_quote(s.line) << ",\"address\":" << static_cast<int>(s.address)
-       << ",\"connects\":" << s.connects << ",\"breaks\":" << s.breaks << ",\"broken\":{";
+       << ",\"connects\":" << s.connects << ",\"breaks\":" << s.breaks
+       << ",\"refused\":" << s.refused << ",\"broken\":{";
     bool first = true;
     for (const auto& [why, n] : s.broken) {
       os << (first ? "" : ",") << json_quote(why) << ":" << n;

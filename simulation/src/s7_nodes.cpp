@@ -262,7 +262,9 @@ void MpiClientNode::on_station_event(const mpi_station::StationEvent& e) {
     case mpi_station::EventKind::Refused:
     case mpi_station::EventKind::Broken:
     case mpi_station::EventKind::Closed:
-      ++m_breaks;
+      ++(e.kind == mpi_station::EventKind::Refused ? m_refusals : m_breaks);
+      if (e.kind != mpi_station::EventKind::Refused)
+        ++m_ends[std::string(mpi_station::to_string(e.reason))];
       p->handle.reset();
       p->ready = false;
       p->outstanding = -1;

@@ -695,10 +695,8 @@ S7Report Simulation::s7_report() const {
     sr.address = pg->plan().address;
     sr.connects = pg->connects();
     sr.breaks = pg->breaks();
-    const auto& broken = pg->station().stats().broken;
-    for (std::size_t k = 0; k < broken.size(); ++k)
-      if (broken[k] != 0)
-        sr.broken[std::string(mpi_station::to_string(static_cast<mpi_station::EndReason>(k)))] = broken[k];
+    sr.refused = pg->refusals();
+    sr.broken = pg->ends();
     for (std::size_t k = 0; k < pg->reads().size(); ++k) {
       const auto& st = pg->reads()[k];
       const auto& rp = pg->plan().reads[k];

@@ -5,6 +5,7 @@
 // a scenario" have the decisions.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -131,7 +132,10 @@ class MpiClientNode final : public bus::EventTarget {
   /// Per planned read, in plan order.
   const std::vector<S7ReadStats>& reads() const { return m_stats; }
   std::uint64_t connects() const { return m_connects; }
-  std::uint64_t breaks() const { return m_breaks; }
+  std::uint64_t breaks() const { return m_breaks; }        ///< connections that broke or closed
+  std::uint64_t refusals() const { return m_refusals; }   ///< connect requests the CPU refused
+  /// Broken or closed connections by reason (mpi_station::to_string(EndReason)).
+  const std::map<std::string, std::uint64_t>& ends() const { return m_ends; }
 
   /// Starts the work at `now` (the station's power-on).
   void start(bus::Ticks now);
@@ -158,7 +162,8 @@ class MpiClientNode final : public bus::EventTarget {
   std::vector<S7ReadStats> m_stats;
   std::vector<bus::Ticks> m_due;  ///< per read: next time it is due
   std::vector<mpi_station::StationEvent> m_pending;  ///< station events not yet handled
-  std::uint64_t m_connects = 0, m_breaks = 0;
+  std::uint64_t m_connects = 0, m_breaks = 0, m_refusals = 0;
+  std::map<std::string, std::uint64_t> m_ends;
   std::uint64_t m_generation = 0;
 };
 

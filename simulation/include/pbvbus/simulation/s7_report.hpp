@@ -9,8 +9,10 @@
 //                 "dp_exchanges": int,                     // process-image exchanges with its DP masters
 //                 "unmapped_bytes": int } ],               // slave I/O that did not fit I/Q
 //     "stations": [ { "role": "PG"|"OP", "line": str, "address": int,
-//                     "connects","breaks": int,
-//                     "broken": { reason: int },            // stacks/mpi reasons, only those seen
+//                     "connects","breaks","refused": int,  // connect requests, broken or
+//                                                           // closed connections, refusals
+//                     "broken": { reason: int },            // broken or closed connections by
+//                                                           // reason (mpi_station), those seen
 //                     "reads": [ { "cpu": int, "item": str, "requests","ok","errors": int,
 //                                  "last_code": int,            // return code of the last error
 //                                  "last_value": str,           // hex, the last good answer
@@ -50,7 +52,7 @@ struct MpiStationReport {
   bool op = false;
   std::string line;
   std::uint8_t address = 0;
-  std::uint64_t connects = 0, breaks = 0;
+  std::uint64_t connects = 0, breaks = 0, refused = 0;
   std::map<std::string, std::uint64_t> broken;
   std::vector<S7ReadReport> reads;
 };

@@ -384,70 +384,10 @@ class HPlanner {
   }
 
   void plan_program(int i, const scenario::HProgram& pr, devices::ProgramSpec& spec) {
-    if (!pr.scan_time().empty())
-      if (auto t = ticks(i, {{"program"}, {"scan_time"}}, pr.scan_time(), true)) spec.scan_time = *t;
-    for (int k = 0; k < pr.copy_size(); ++k) {
-      const auto& n = pr.copy(k);
-      devices::CopyNetwork c;
-      c.from_input = n.from_input();
-      c.to_output = n.to_output();
-      c.direct = n.direct();
-      if (n.has_length()) {
-        if (n.length() == 0)
-          error_at(i, {{"program"}, {"copy", k}, {"length"}}, "copy network: length must be at least 1");
-        c.length = n.length();
-      }
-      spec.copies.push_back(c);
-    }
-    for (int k = 0; k < pr.counter_size(); ++k) {
-      const auto& n = pr.counter(k);
-      devices::CounterNetwork c;
-      c.output = n.output();
-      if (n.has_width()) {
-        if (n.width() != 1 && n.width() != 2 && n.width() != 4)
-          error_at(i, {{"program"}, {"counter", k}, {"width"}},
-                   "counter network: width " + std::to_string(n.width()) + " is not 1, 2 or 4 octets");
-        c.width = n.width();
-      }
-      if (!n.period().empty())
-        if (auto t = ticks(i, {{"program"}, {"counter", k}, {"period"}}, n.period(), true)) c.period = *t;
-      if (n.has_step()) c.step = n.step();
-      c.pulse_output = n.pulse_output();
-      if (n.pulse_bit() > 7)
-        error_at(i, {{"program"}, {"counter", k}, {"pulse_bit"}},
-                 "counter network: pulse_bit " + std::to_string(n.pulse_bit()) + " is not 0..7");
-      c.pulse_bit = static_cast<std::uint8_t>(n.pulse_bit() & 7U);
-      if (!n.pulse_high().empty())
-        if (auto t = ticks(i, {{"program"}, {"counter", k}, {"pulse_high"}}, n.pulse_high(), false)) {
-          c.pulse_high = *t;
-          if (c.pulse_high >= c.period)
-            error_at(i, {{"program"}, {"counter", k}, {"pulse_high"}},
-                     "counter network: pulse_high " + n.pulse_high() + " is not shorter than the period");
-        }
-      spec.counters.push_back(c);
-    }
-    for (int k = 0; k < pr.monitor_size(); ++k) {
-      const auto& n = pr.monitor(k);
-      devices::DiscrepancyNetwork d;
-      d.input_a = n.input_a();
-      d.input_b = n.input_b();
-      if (n.has_length()) {
-        if (n.length() == 0)
-          error_at(i, {{"program"}, {"monitor", k}, {"length"}}, "monitor network: length must be at least 1");
-        d.length = n.length();
-      }
-      if (n.has_mask()) {
-        if (n.mask() > 0xFF)
-          error_at(i, {{"program"}, {"monitor", k}, {"mask"}},
-                   "monitor network: mask " + std::to_string(n.mask()) + " is more than one octet");
-        d.mask = static_cast<std::uint8_t>(n.mask() & 0xFFU);
-      }
-      d.to_output = n.to_output();
-      if (!n.discrepancy_time().empty())
-        if (auto t = ticks(i, {{"program"}, {"monitor", k}, {"discrepancy_time"}}, n.discrepancy_time(), true))
-          d.discrepancy_time = *t;
-      spec.monitors.push_back(d);
-    }
+    plan_program_spec(pr, spec, [&](std::vector<HPathStep> path, std::string msg) {
+      path.insert(path.begin(), HPathStep{"program"});
+      error_at(i, path, std::move(msg));
+    });
   }
 
   /// A redundant_master_system is driven by at most one simulated pair; simulated pairs have
@@ -500,6 +440,92 @@ devices::UpdatePlanInput h_update_input(const ScenarioPlan& plan, const HSystemP
     in.systems.push_back(std::move(t));
   }
   return in;
+}
+
+namespace {
+/// A duration of a program field; nullopt with an error if it is bad or not above 0 when
+/// `positive`.
+std::optional<bus::Ticks> program_ticks(const ProgramError& error_at, const std::vector<HPathStep>& path,
+                                        const std::string& text, bool positive) {
+  auto t = bus::parse_duration(text);
+  const std::string name = path.back().field;
+  if (!t) {
+    error_at(path, "bad duration \"" + text + "\" for " + name + " (e.g. \"100ms\")");
+    return std::nullopt;
+  }
+  if (positive && *t <= 0) {
+    error_at(path, name + " must be longer than 0");
+    return std::nullopt;
+  }
+  return t;
+}
+}  // namespace
+
+void plan_program_spec(const scenario::HProgram& pr, devices::ProgramSpec& spec, const ProgramError& error_at) {
+  if (!pr.scan_time().empty())
+    if (auto t = program_ticks(error_at, {{"scan_time"}}, pr.scan_time(), true)) spec.scan_time = *t;
+  for (int k = 0; k < pr.copy_size(); ++k) {
+    const auto& n = pr.copy(k);
+    devices::CopyNetwork c;
+    c.from_input = n.from_input();
+    c.to_output = n.to_output();
+    c.direct = n.direct();
+    if (n.has_length()) {
+      if (n.length() == 0)
+        error_at({{"copy", k}, {"length"}}, "copy network: length must be at least 1");
+      c.length = n.length();
+    }
+    spec.copies.push_back(c);
+  }
+  for (int k = 0; k < pr.counter_size(); ++k) {
+    const auto& n = pr.counter(k);
+    devices::CounterNetwork c;
+    c.output = n.output();
+    if (n.has_width()) {
+      if (n.width() != 1 && n.width() != 2 && n.width() != 4)
+        error_at({{"counter", k}, {"width"}},
+                 "counter network: width " + std::to_string(n.width()) + " is not 1, 2 or 4 octets");
+      c.width = n.width();
+    }
+    if (!n.period().empty())
+      if (auto t = program_ticks(error_at, {{"counter", k}, {"period"}}, n.period(), true)) c.period = *t;
+    if (n.has_step()) c.step = n.step();
+    c.pulse_output = n.pulse_output();
+    if (n.pulse_bit() > 7)
+      error_at({{"counter", k}, {"pulse_bit"}},
+               "counter network: pulse_bit " + std::to_string(n.pulse_bit()) + " is not 0..7");
+    c.pulse_bit = static_cast<std::uint8_t>(n.pulse_bit() & 7U);
+    if (!n.pulse_high().empty())
+      if (auto t = program_ticks(error_at, {{"counter", k}, {"pulse_high"}}, n.pulse_high(), false)) {
+        c.pulse_high = *t;
+        if (c.pulse_high >= c.period)
+          error_at({{"counter", k}, {"pulse_high"}},
+                   "counter network: pulse_high " + n.pulse_high() + " is not shorter than the period");
+      }
+    spec.counters.push_back(c);
+  }
+  for (int k = 0; k < pr.monitor_size(); ++k) {
+    const auto& n = pr.monitor(k);
+    devices::DiscrepancyNetwork d;
+    d.input_a = n.input_a();
+    d.input_b = n.input_b();
+    if (n.has_length()) {
+      if (n.length() == 0)
+        error_at({{"monitor", k}, {"length"}}, "monitor network: length must be at least 1");
+      d.length = n.length();
+    }
+    if (n.has_mask()) {
+      if (n.mask() > 0xFF)
+        error_at({{"monitor", k}, {"mask"}},
+                 "monitor network: mask " + std::to_string(n.mask()) + " is more than one octet");
+      d.mask = static_cast<std::uint8_t>(n.mask() & 0xFFU);
+    }
+    d.to_output = n.to_output();
+    if (!n.discrepancy_time().empty())
+      if (auto t = program_ticks(error_at, {{"monitor", k}, {"discrepancy_time"}}, n.discrepancy_time(), true))
+        d.discrepancy_time = *t;
+    spec.monitors.push_back(d);
+  }
 }
 
 }  // namespace pbvbus::tools

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "pbvbus/s7h/h_program.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
@@ -233,6 +234,21 @@ class S7Planner {
         p.max_connections = c.max_connections();
     }
     p.run = c.mode() == scenario::S7Cpu::RUN;
+    if (c.has_program()) {
+      devices::ProgramSpec spec;
+      bool good = true;
+      plan_program_spec(c.program(), spec, [&](std::vector<HPathStep> path, std::string msg) {
+        Path at{{"program", -1}};
+        for (const auto& st : path) at.emplace_back(st.field, st.index);
+        error("s7_cpu", i, at, std::move(msg));
+        good = false;
+      });
+      if (good) {
+        const auto why = devices::validate(spec, p.input_bytes, p.output_bytes);
+        if (!why.empty()) error("s7_cpu", i, {{"program", -1}}, "program: " + why.front());
+        else p.program = std::move(spec);
+      }
+    }
     m_plan.s7.cpus.push_back(std::move(p));
   }
 

@@ -25,9 +25,18 @@ constexpr std::uint16_t kDoorPduSize = 960;
 
 }  // namespace
 
-S7CpuNode::S7CpuNode(const S7CpuPlan& plan, const fdl::BusParams* mpi_params)
-    : m_plan(plan), m_memory(sizes_of(plan)) {
+S7CpuNode::S7CpuNode(bus::Scheduler& sched, const S7CpuPlan& plan, const fdl::BusParams* mpi_params)
+    : m_sched(sched), m_plan(plan), m_memory(sizes_of(plan)) {
   for (const auto& db : plan.dbs) m_memory.create_db(db.number, db.size);
+  if (plan.program) {
+    m_program.emplace(*plan.program, plan.input_bytes, plan.output_bytes);
+    // M = the program's state from MB 0, then the free flags (docs/s7cpu.md).
+    m_image.emplace(plan.input_bytes, plan.output_bytes,
+                    std::max<std::size_t>(plan.flag_bytes, m_program->memory_size()));
+    m_memory.bind(s7cpu::Area::Inputs, m_image->pii());
+    m_memory.bind(s7cpu::Area::Outputs, m_image->piq());
+    m_memory.bind(s7cpu::Area::Flags, m_image->memory());
+  }
   m_info.order_number = plan.order_number;
   m_info.state = plan.run ? s7cpu::cpu_state::kRun : s7cpu::cpu_state::kStop;
   if (plan.mpi_line >= 0 && mpi_params != nullptr) {
@@ -38,6 +47,18 @@ S7CpuNode::S7CpuNode(const S7CpuPlan& plan, const fdl::BusParams* mpi_params)
     c.pool.max_connections = plan.max_connections;
     m_mpi = std::make_unique<mpi_station::MpiStation>(c, m_factory.get());
   }
+}
+
+void S7CpuNode::start(bus::Ticks now) {
+  if (m_program && m_info.state == s7cpu::cpu_state::kRun) m_sched.schedule(now, *this, 0);
+}
+
+void S7CpuNode::on_event(bus::Ticks now, std::uint64_t) {
+  if (!m_program || m_info.state != s7cpu::cpu_state::kRun) return;
+  m_program_events.clear();
+  m_program->scan(*m_image, now, m_program_events);
+  ++m_scans;
+  m_sched.schedule(now + m_program->scan_time(), *this, 0);
 }
 
 std::unique_ptr<s7cpu::S7Server> S7CpuNode::open_server() {

@@ -93,7 +93,7 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
   }
   for (const auto& c : m_plan.s7.cpus)
     m_s7_cpus.push_back(std::make_unique<S7CpuNode>(
-        c, c.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(c.mpi_line)).params : nullptr));
+        m_sched, c, c.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(c.mpi_line)).params : nullptr));
   for (const auto& m : m_plan.s7.stations)
     m_mpi_clients.push_back(std::make_unique<MpiClientNode>(
         m_sched, m, m_plan.lines.at(static_cast<std::size_t>(m.line)).params));
@@ -413,6 +413,7 @@ void Simulation::start() {
   }
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
+  for (auto& cpu : m_s7_cpus) cpu->start(m_sched.now());
   for (auto& pg : m_mpi_clients) pg->start(m_sched.now());
   build_gateways();
   schedule_faults();

@@ -155,3 +155,64 @@ mpi_station { role: OP line: "MPI" read { cpu: 2 item: "DB9.DBW0" } }
 
 }  // namespace
 }  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+namespace {
+
+TEST(S7ScenarioRun, TheCpusProgramWritesWhatClientsReadAndContinuesFromWhatTheyWrite) {
+  // A counter (+1 every 100 ms) on QW 0; its value is MD 8 (docs/h-programs.md: 16 octets of
+  // state per counter, the value at +8). The OP reads QW 0 and MD 8 over MPI.
+  const auto plan = plan_of(R"(name: "prog" duration: "1s"
+line { name: "MPI" kind: MPI }
+s7_cpu { name: "C" mpi_dp { line: "MPI" }
+  program { scan_time: "10ms" counter { output: 0 width: 2 period: "100ms" } } }
+mpi_station { role: OP line: "MPI" read { cpu: 2 item: "QW0" period: "100ms" } read { cpu: 2 item: "MD8" period: "100ms" } }
+)");
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  sim.start();
+  sim.run_until(500 * bus::kTicksPerMs);
+  auto& mem = sim.s7_cpu(0).memory();
+  const auto q = mem.area(s7cpu::Area::Outputs);
+  const auto m = mem.area(s7cpu::Area::Flags);
+  // Periods start at 0: at 500 ms the counter has counted at 0, 100, ..., 400 (and 500 if
+  // that scan has run): 5 or 6.
+  const int before = q[0] * 256 + q[1];
+  EXPECT_TRUE(before == 5 || before == 6) << before;
+  EXPECT_EQ(m[8] * 16777216 + m[9] * 65536 + m[10] * 256 + m[11], before);
+  // A client writes MD 8 = 1000 (as a Write Var would): the program continues from it.
+  m[8] = 0;
+  m[9] = 0;
+  m[10] = 0x03;
+  m[11] = 0xE8;
+  sim.run_until(*sim.duration());
+  const int after = q[0] * 256 + q[1];
+  EXPECT_GE(after, 1004);
+  EXPECT_LE(after, 1006);
+  // The OP read both over MPI; its last values agree with each other.
+  const auto r = sim.s7_report();
+  const auto& qw = r.stations.at(0).reads.at(0);
+  const auto& md = r.stations.at(0).reads.at(1);
+  ASSERT_EQ(qw.last_value.size(), 2u);
+  ASSERT_EQ(md.last_value.size(), 4u);
+  EXPECT_GE(qw.last_value[0] * 256 + qw.last_value[1], 1000);
+  EXPECT_GE(md.last_value[2] * 256 + md.last_value[3], 1000);
+  EXPECT_GT(sim.s7_cpu(0).scans(), 90u);
+}
+
+TEST(S7ScenarioRun, AProgramThatDoesNotFitTheImagesIsRefused) {
+  // `s7_cpu { name: "C" mpi_dp { line: "MPI" } ` is 9 + 10 + 9 + 12 + 2 = 42 columns: `program`
+  // at 43.
+  const auto r = parse_scenario(R"(name: "p" duration: "1s"
+line { name: "MPI" kind: MPI }
+s7_cpu { name: "C" mpi_dp { line: "MPI" } program { copy { from_input: 0 to_output: 200 length: 2 } } }
+)", kFile);
+  ASSERT_FALSE(r.ok());
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].line, 3);
+  EXPECT_EQ(r.errors[0].column, 43);
+  EXPECT_NE(r.errors[0].message.find("program: "), std::string::npos) << r.errors[0].message;
+}
+
+}  // namespace
+}  // namespace pbvbus::tools

@@ -38,6 +38,7 @@
 #include "pbvbus/s7h/h_program_spec.hpp"
 #include "pbvbus/s7h/h_update_timing.hpp"
 #include "pbvbus/scenario/dp_plan.hpp"
+#include "scenario.pb.h"
 
 namespace pbvbus::tools {
 
@@ -86,6 +87,14 @@ struct HPathStep {
 /// 1-based line and column of the field at the end of `path` inside h_system[index] (the
 /// nearest known position when the field is not in the text).
 using HLocator = std::function<std::pair<int, int>(int index, const std::vector<HPathStep>& path)>;
+
+/// Where a program's error is: the path inside the `program` message ({"counter", 2},
+/// {"width"}), and the message.
+using ProgramError = std::function<void(std::vector<HPathStep> path, std::string msg)>;
+/// The checked ProgramSpec of a `program` (h_system's or s7_cpu's; rules above: width 1/2/4,
+/// period > 0, ...). Errors go to `error`.
+void plan_program_spec(const scenario::HProgram& program, devices::ProgramSpec& spec,
+                       const ProgramError& error);
 
 struct ScenarioPlan;
 /// Plans the h_system entries (after plan_dp: they refer to redundant_master_systems).

@@ -18,7 +18,8 @@
 //    interface IS a dp_master entry: `line` + `address` must name one, of no other CPU, on a
 //    PROFIBUS-DP line. At least one interface. DB numbers 1..65535 unique, sizes 1..65534;
 //    I, Q, M sizes up to 16 384 (the largest S7-400 process image); max_connections 1..64
-//    (default 12: an S7-300 CPU's S7 connection resources).
+//    (default 12: an S7-300 CPU's S7 connection resources). A `program` is checked like an
+//    h_system's (plan_program_spec) and against the CPU's I/Q sizes (devices::validate).
 //  - Every h_system with a `cpu` part serves S7 (its memory: cpu.s7_memory, flags default 256,
 //    DBs as a single CPU's); an H pair's MPI addresses differ (the only thing in which CPU 1 may differ from CPU 0,
 //    seeds-digest.md §3.2); max_connections 1..64, default 44 (a 417-4H's MPI resources, the profile's CPU).
@@ -38,6 +39,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/s7h/h_program_spec.hpp"
 #include "pbvbus/s7h/h_s7_memory.hpp"
 #include "pbvbus/scenario/gateway_plan.hpp"
 
@@ -84,6 +86,7 @@ struct S7CpuPlan {
   std::uint32_t input_bytes = 128, output_bytes = 128, flag_bytes = 256;
   std::uint32_t max_connections = 12;
   bool run = true;
+  std::optional<devices::ProgramSpec> program;  ///< `program` (checked against I/Q sizes)
 };
 
 /// What S7 clients see of an h_system's CPUs (set whenever the h_system has a `cpu` part).

@@ -17,6 +17,7 @@
 #include "pbvbus/mpi_station/s7cpu_sessions.hpp"
 #include "pbvbus/s7cpu/cpu_memory.hpp"
 #include "pbvbus/s7cpu/s7_server.hpp"
+#include "pbvbus/s7h/h_program.hpp"
 #include "pbvbus/s7h/h_system.hpp"
 #include "pbvbus/scenario/s7_plan.hpp"
 
@@ -26,8 +27,11 @@ namespace pbvbus::tools {
 ///
 /// Decisions:
 /// - Its memory is an s7cpu::CpuMemory with the planned I/Q/M sizes and DBs (all zero at
-///   power-on of the run). It runs no user program of its own: what clients write to Q goes to
-///   the slaves of its DP interfaces, what the slaves send arrives in I.
+///   the start of the run). With a `program`, I, Q and M are views of a devices::ProcessImage
+///   (PII, PIQ, and the program's state from MB 0 followed by the free flags) and OB 1 runs
+///   every scan_time as one event (devices::Program::scan): what the program writes is what a
+///   client reads, and a client's write is what the next OB 1 sees. Without a program, what
+///   clients write to Q goes to the slaves, what the slaves send is read from I.
 /// - DP interfaces: at every token receipt of the interface's DP master (one DP cycle) the
 ///   master's slaves' inputs are copied into I and Q is copied to their outputs. The I/O
 ///   addresses are assigned as a configuration tool would with no addresses given: the master's
@@ -36,10 +40,14 @@ namespace pbvbus::tools {
 ///   X2's. Bytes that do not fit the image are not exchanged (the report says how many).
 /// - In STOP the CPU keeps answering S7 (SZL 0424 says STOP) and its DP masters write zero
 ///   outputs (the outputs of a CPU in STOP are disabled).
-class S7CpuNode {
+class S7CpuNode final : public bus::EventTarget {
  public:
   /// `mpi_params`: the MPI line's bus parameters when X1 is on MPI.
-  S7CpuNode(const S7CpuPlan& plan, const fdl::BusParams* mpi_params);
+  S7CpuNode(bus::Scheduler& sched, const S7CpuPlan& plan, const fdl::BusParams* mpi_params);
+  /// Starts OB 1 (with a program, in RUN) at `now`.
+  void start(bus::Ticks now);
+  void on_event(bus::Ticks now, std::uint64_t tag) override;
+  std::uint64_t scans() const { return m_scans; }
 
   const S7CpuPlan& plan() const { return m_plan; }
   s7cpu::CpuMemory& memory() { return m_memory; }
@@ -64,7 +72,12 @@ class S7CpuNode {
   };
   void map(dp::Master& master);
 
+  bus::Scheduler& m_sched;
   S7CpuPlan m_plan;
+  std::optional<devices::Program> m_program;
+  std::optional<devices::ProcessImage> m_image;
+  std::vector<devices::ProgramEvent> m_program_events;
+  std::uint64_t m_scans = 0;
   s7cpu::CpuMemory m_memory;
   s7cpu::CpuInfo m_info;
   std::unique_ptr<mpi_station::S7CpuSessionFactory> m_factory;

@@ -11,7 +11,7 @@
 namespace pbvbus::tools {
 
 namespace {
-constexpr std::uint64_t kTagEvents = 1;
+constexpr std::uint64_t kDoorTagEvents = 1;
 }  // namespace
 
 /// A client connection to a single CPU's memory: its own S7 server session, answered at once.
@@ -111,7 +111,7 @@ S7DoorNode::S7DoorNode(bus::Scheduler& sched, const S7DoorPlan& plan, std::vecto
     m_mpi = std::make_unique<mpi_station::MpiStation>(c);
     m_mpi->set_event_handler([this](const mpi_station::StationEvent& e) {
       m_pending.push_back(e);
-      if (m_pending.size() == 1) m_sched.schedule(e.at, *this, kTagEvents);
+      if (m_pending.size() == 1) m_sched.schedule(e.at, *this, kDoorTagEvents);
     });
   }
 }
@@ -188,7 +188,7 @@ iso_on_tcp::RouteResult S7DoorNode::open(const iso_on_tcp::RouteRequest& request
 }
 
 void S7DoorNode::on_event(bus::Ticks, std::uint64_t tag) {
-  if (tag != kTagEvents) return;
+  if (tag != kDoorTagEvents) return;
   auto events = std::move(m_pending);
   m_pending.clear();
   for (const auto& e : events) on_station_event(e);

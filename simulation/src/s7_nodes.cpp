@@ -167,12 +167,12 @@ HCpuMpiNode::~HCpuMpiNode() = default;
 
 namespace {
 
-constexpr bus::Ticks kRetry = bus::kTicksPerSecond;
-constexpr std::uint16_t kPduSize = 240;  // the most one MPI data message carries (docs/mpi.md)
+constexpr bus::Ticks kPgRetry = bus::kTicksPerSecond;
+constexpr std::uint16_t kPgPduSize = 240;  // the most one MPI data message carries (docs/mpi.md)
 // Tags: kind in the high 32 bits, peer index below.
-constexpr std::uint64_t kTagEvents = 1ull << 32;
-constexpr std::uint64_t kTagReconnect = 2ull << 32;
-constexpr std::uint64_t kTagPump = 3ull << 32;
+constexpr std::uint64_t kPgTagEvents = 1ull << 32;
+constexpr std::uint64_t kPgTagReconnect = 2ull << 32;
+constexpr std::uint64_t kPgTagPump = 3ull << 32;
 
 std::uint8_t area_code(S7ItemPlan::Area a) {
   switch (a) {
@@ -206,7 +206,7 @@ MpiClientNode::MpiClientNode(bus::Scheduler& sched, const MpiStationPlan& plan,
   m_station.set_event_handler([this](const mpi_station::StationEvent& e) {
     // Handled in an event of its own at the same tick: the station is inside its MAC callback.
     m_pending.push_back(e);
-    if (m_pending.size() == 1) m_sched.schedule(e.at, *this, kTagEvents);
+    if (m_pending.size() == 1) m_sched.schedule(e.at, *this, kPgTagEvents);
   });
 }
 
@@ -226,19 +226,19 @@ void MpiClientNode::connect(Peer& p) {
   p.outstanding = -1;
   p.handle = m_station.open(p.cpu);
   if (p.handle) ++m_connects;
-  else m_sched.schedule(m_sched.now() + kRetry, *this, kTagReconnect | static_cast<std::uint64_t>(&p - m_peers.data()));
+  else m_sched.schedule(m_sched.now() + kPgRetry, *this, kPgTagReconnect | static_cast<std::uint64_t>(&p - m_peers.data()));
 }
 
 void MpiClientNode::on_event(bus::Ticks now, std::uint64_t tag) {
   const std::uint64_t kind = tag & ~0xFFFFFFFFull;
   const auto index = static_cast<std::size_t>(tag & 0xFFFFFFFFull);
-  if (kind == kTagEvents) {
+  if (kind == kPgTagEvents) {
     auto events = std::move(m_pending);
     m_pending.clear();
     for (const auto& e : events) on_station_event(e);
-  } else if (kind == kTagReconnect && index < m_peers.size()) {
+  } else if (kind == kPgTagReconnect && index < m_peers.size()) {
     if (!m_peers[index].handle) connect(m_peers[index]);
-  } else if (kind == kTagPump && index < m_peers.size()) {
+  } else if (kind == kPgTagPump && index < m_peers.size()) {
     pump(m_peers[index], now);
   }
 }
@@ -250,7 +250,7 @@ void MpiClientNode::on_station_event(const mpi_station::StationEvent& e) {
   const auto index = static_cast<std::uint64_t>(p - m_peers.data());
   switch (e.kind) {
     case mpi_station::EventKind::Connected: {
-      const auto setup = s7::encode_setup_communication_request(p->next_ref++, {1, 1, kPduSize});
+      const auto setup = s7::encode_setup_communication_request(p->next_ref++, {1, 1, kPgPduSize});
       if (setup.ok()) m_station.submit(*p->handle, setup.value);
       break;
     }
@@ -289,7 +289,7 @@ void MpiClientNode::on_station_event(const mpi_station::StationEvent& e) {
       p->handle.reset();
       p->ready = false;
       p->outstanding = -1;
-      m_sched.schedule(e.at + kRetry, *this, kTagReconnect | index);
+      m_sched.schedule(e.at + kPgRetry, *this, kPgTagReconnect | index);
       break;
     case mpi_station::EventKind::Accepted:
       break;
@@ -307,7 +307,7 @@ void MpiClientNode::pump(Peer& p, bus::Ticks now) {
   const auto r = static_cast<std::size_t>(best);
   const auto index = static_cast<std::uint64_t>(&p - m_peers.data());
   if (m_due[r] > now) {
-    m_sched.schedule(m_due[r], *this, kTagPump | index);
+    m_sched.schedule(m_due[r], *this, kPgTagPump | index);
     return;
   }
   const S7ItemPlan& it = m_plan.reads[r].item;

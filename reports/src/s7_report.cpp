@@ -8,7 +8,7 @@
 namespace pbvbus::tools {
 
 namespace {
-std::string ms(bus::Ticks t) { return format_us(t / 1000) + " ms"; }
+std::string s7_ms(bus::Ticks t) { return format_us(t / 1000) + " ms"; }
 }  // namespace
 
 void write_s7_text(const S7Report& r, std::ostream& os) {
@@ -31,8 +31,8 @@ void write_s7_text(const S7Report& r, std::ostream& os) {
          << " requests, " << rd.ok << " ok, " << rd.errors << " errors";
       if (rd.errors != 0) os << " (last code " << hex_octets(std::span(&rd.last_code, 1)) << ")";
       if (rd.ok != 0)
-        os << "; last value " << hex_octets(rd.last_value) << ", latency last " << ms(rd.last_latency)
-           << ", max " << ms(rd.max_latency);
+        os << "; last value " << hex_octets(rd.last_value) << ", latency last " << s7_ms(rd.last_latency)
+           << ", max " << s7_ms(rd.max_latency);
       os << "\n";
     }
   }

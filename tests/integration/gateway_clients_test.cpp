@@ -31,8 +31,14 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include "loopback_support.hpp"
 
 namespace {
+
+using pbvbus::test::shell;
+using pbvbus::test::read_file;
+using pbvbus::test::free_port;
+using pbvbus::test::can_connect;
 
 using namespace std::chrono_literals;
 
@@ -40,54 +46,10 @@ constexpr const char* kPython = "/usr/bin/python3";
 const std::string kBinary = PBVBUS_BINARY_DIR "/bin/pbvbus";
 const std::string kGsd = PBVBUS_SOURCE_DIR "/examples/gsd/PBVB0A04.gsd";
 
-std::pair<int, std::string> shell(const std::string& cmd) {
-  std::string out;
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (p == nullptr) return {-1, ""};
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = ::pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 bool have(const std::string& program) { return shell("command -v " + program + " >/dev/null").first == 0; }
 bool python_has(const std::string& module) {
   return ::access(kPython, X_OK) == 0 &&
          shell(std::string(kPython) + " -c 'import " + module + "' >/dev/null").first == 0;
-}
-
-/// A free loopback TCP port (bound once with port 0, then released).
-std::uint16_t free_port() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof a;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0 ||
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
-    ::close(s);
-    return 0;
-  }
-  ::close(s);
-  return ntohs(a.sin_port);
-}
-
-bool can_connect(std::uint16_t port) {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(port);
-  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return ok;
 }
 
 /// `pbvbus run scenario --json --quiet` in a temp directory, ended with SIGINT (a user's Ctrl-C).

@@ -54,9 +54,12 @@
 #include "outside_slave_support.hpp"
 
 #include "pbvbus/tools/commands.hpp"
+#include "loopback_support.hpp"
 
 namespace pbvbus::tools {
 namespace {
+
+using pbvbus::test::free_port;
 
 using namespace std::chrono_literals;
 using test_support::Flat;
@@ -112,23 +115,6 @@ std::string hex(const Bytes& b, const char* sep) {
     s += buf;
   }
   return s;
-}
-
-/// A free loopback port for the door: bound and released (the door binds it a moment later;
-/// the run reports the port it listened on, which the test checks).
-std::uint16_t free_port() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in sa{};
-  sa.sin_family = AF_INET;
-  sa.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  sa.sin_port = 0;
-  socklen_t len = sizeof sa;
-  std::uint16_t port = 0;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&sa), sizeof sa) == 0 &&
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&sa), &len) == 0)
-    port = ntohs(sa.sin_port);
-  ::close(fd);
-  return port;
 }
 
 /// A blocking ISO-on-TCP client; reads give up after 20 s so that a broken door fails the test.

@@ -63,8 +63,14 @@
 #include <vector>
 
 #include "../captures/tshark_helpers.hpp"
+#include "loopback_support.hpp"
 
 namespace {
+
+using pbvbus::test::shell;
+using pbvbus::test::read_file;
+using pbvbus::test::free_port;
+using pbvbus::test::can_connect;
 
 using namespace std::chrono_literals;
 namespace ts = pbvbus::test;
@@ -73,22 +79,6 @@ constexpr const char* kPython = "/usr/bin/python3";
 const std::string kBinary = PBVBUS_BINARY_DIR "/bin/pbvbus";
 const std::string kClient = PBVBUS_SOURCE_DIR "/tests/integration/data/s7_door_run_client.js";
 const std::string kNodes7 = PBVBUS_BINARY_DIR "/nodes7/node_modules";
-
-std::pair<int, std::string> shell(const std::string& cmd) {
-  std::string out;
-  FILE* p = ::popen((cmd + " 2>&1").c_str(), "r");
-  if (p == nullptr) return {-1, ""};
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = ::pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream f(path);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
 
 /// Why the nodes7 tests cannot run here ("" when they can).
 std::string no_nodes7() {
@@ -99,32 +89,6 @@ std::string no_nodes7() {
            " (./pbvbus test installs it with npm; npm was unreachable?)";
   if (::access(kPython, X_OK) != 0) return "/usr/bin/python3 is missing (reads the JSON report)";
   return "";
-}
-
-/// A free loopback TCP port (bound once with port 0, then released).
-std::uint16_t free_port() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t len = sizeof a;
-  std::uint16_t port = 0;
-  if (::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0 &&
-      ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &len) == 0)
-    port = ntohs(a.sin_port);
-  ::close(s);
-  return port == 10102 ? free_port() : port;  // never the examples' port
-}
-
-bool can_connect(std::uint16_t port) {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(port);
-  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
-  ::close(s);
-  return ok;
 }
 
 /// `pbvbus run scenario.textproto --json --quiet --capture capture.pcapng` in a temp directory.

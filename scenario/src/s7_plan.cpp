@@ -295,7 +295,6 @@ class S7Planner {
     plan_h_memory(i);
     if (!h.has_cpu() || !h.cpu().has_mpi()) return;
     const auto& m = h.cpu().mpi();
-    const Path at{{"cpu", -1}, {"mpi", -1}};
     HMpiPlan p;
     for (std::size_t k = 0; k < m_plan.h_systems.size(); ++k)
       if (m_plan.h_systems[k].source == i) p.h_system = static_cast<int>(k);
@@ -313,7 +312,6 @@ class S7Planner {
       else
         p.max_connections = m.max_connections();
     }
-    (void)at;
     // The pair counts its ad-hoc connections against this (HCpuPair::connect).
     if (p.h_system >= 0 && m_plan.h_systems[static_cast<std::size_t>(p.h_system)].runtime)
       m_plan.h_systems[static_cast<std::size_t>(p.h_system)].runtime->pair.max_connections =

@@ -377,7 +377,7 @@ class Planner {
                            nested(m_root, sd, "switched_station", swp.source),
                            plan.lines[static_cast<std::size_t>(rp.line[side])].name, swp.address});
     }
-    add_mpi_entries(plan, entries);
+    add_mpi_entries(entries);
     // Cable order = order of appearance in the text. Without text, the order above.
     if (m_root.tree != nullptr) {
       std::stable_sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) {
@@ -439,7 +439,7 @@ class Planner {
 
   /// The MPI interfaces of s7_cpu (X1 in MPI mode), h_system CPUs, PGs/OPs and S7 doors as
   /// station entries, with their default addresses (s7_plan.hpp).
-  void add_mpi_entries(const ScenarioPlan& plan, std::vector<StationEntry>& entries) {
+  void add_mpi_entries(std::vector<StationEntry>& entries) {
     const auto* sd = scenario::Scenario::descriptor();
     for (int i = 0; i < m_proto.s7_cpu_size(); ++i) {
       const auto& c = m_proto.s7_cpu(i);
@@ -486,7 +486,6 @@ class Planner {
       entries.push_back({StationKind::S7DoorMpi, i, nested(m_root, sd, "s7_door", i), d.mpi_line(),
                          a, scenario::S7Door::descriptor(), "mpi_line", "mpi_address"});
     }
-    (void)plan;
   }
 
   /// MPI lines carry MPI stations and plain FDL stations, no DP; MPI stations sit on MPI lines

@@ -5,7 +5,9 @@
 namespace pbvbus::quantum {
 namespace {
 
-bool bit(std::uint16_t w, int n) { return (w & modicon_bit(n)) != 0; }
+bool bit(std::uint16_t w, int n) {
+  return (w & modicon_bit(n)) != 0;
+}
 void put(std::uint16_t& w, int n, bool v) {
   if (v) w = static_cast<std::uint16_t>(w | modicon_bit(n));
 }
@@ -18,7 +20,9 @@ void put_code(std::uint16_t& w, int hi, UnitCode c) {
   put(w, hi, (v & 2U) != 0);
   put(w, hi + 1, (v & 1U) != 0);
 }
-std::string ref4x(std::uint32_t i) { return reference_name(RefType::Register4x, i); }
+std::string ref4x(std::uint32_t i) {
+  return reference_name(RefType::Register4x, i);
+}
 
 }  // namespace
 
@@ -79,8 +83,8 @@ std::string check_non_transfer_area(const NonTransferArea& area, std::uint32_t p
       return "the non-transfer area " + ref4x(area.first) + ".." + last +
              " must lie inside the 4x registers transferred every scan, and none are";
     return "the non-transfer area " + ref4x(area.first) + ".." + last +
-           " does not lie entirely inside the 4x registers transferred every scan (" +
-           ref4x(0) + ".." + ref4x(per_scan_4x - 1) + ")";
+           " does not lie entirely inside the 4x registers transferred every scan (" + ref4x(0) +
+           ".." + ref4x(per_scan_4x - 1) + ")";
   }
   return {};
 }

@@ -12,9 +12,12 @@ std::int64_t round_div(std::int64_t num, std::int64_t den) {
 
 RefCounts baseline(CpuType cpu) {
   switch (cpu) {
-    case CpuType::X13: return {1536, 512, 3000, 1872, 0};
-    case CpuType::Cpu42402: return {1536, 512, 1212, 1872, 0};
-    case CpuType::Cpu43412: return {1536, 512, 512, 1872, 700};
+    case CpuType::X13:
+      return {1536, 512, 3000, 1872, 0};
+    case CpuType::Cpu42402:
+      return {1536, 512, 1212, 1872, 0};
+    case CpuType::Cpu43412:
+      return {1536, 512, 512, 1872, 700};
   }
   return {};
 }
@@ -25,9 +28,12 @@ bus::Ticks hsby_cost(CpuType cpu) {
 
 std::int64_t rate_us_per_1000_bytes(CpuType cpu) {
   switch (cpu) {
-    case CpuType::X13: return 1600;
-    case CpuType::Cpu42402: return 2000;
-    case CpuType::Cpu43412: return 1900;
+    case CpuType::X13:
+      return 1600;
+    case CpuType::Cpu42402:
+      return 2000;
+    case CpuType::Cpu43412:
+      return 1900;
   }
   return 0;
 }

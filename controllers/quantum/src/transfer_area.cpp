@@ -8,25 +8,33 @@
 namespace pbvbus::quantum {
 namespace {
 
-constexpr std::array<RefType, 4> kOrder = {RefType::Coil0x, RefType::Input1x,
-                                           RefType::Register3x, RefType::Register4x};
+constexpr std::array<RefType, 4> kOrder = {RefType::Coil0x, RefType::Input1x, RefType::Register3x,
+                                           RefType::Register4x};
 
 const char* type_words(RefType t) {
   switch (t) {
-    case RefType::Coil0x: return "coils (0x)";
-    case RefType::Input1x: return "discrete inputs (1x)";
-    case RefType::Register3x: return "input registers (3x)";
-    case RefType::Register4x: return "holding registers (4x)";
+    case RefType::Coil0x:
+      return "coils (0x)";
+    case RefType::Input1x:
+      return "discrete inputs (1x)";
+    case RefType::Register3x:
+      return "input registers (3x)";
+    case RefType::Register4x:
+      return "holding registers (4x)";
   }
   return "";
 }
 
 std::uint32_t size_of(const StateRamSizes& s, RefType t) {
   switch (t) {
-    case RefType::Coil0x: return s.coils;
-    case RefType::Input1x: return s.inputs;
-    case RefType::Register3x: return s.input_regs;
-    case RefType::Register4x: return s.holding;
+    case RefType::Coil0x:
+      return s.coils;
+    case RefType::Input1x:
+      return s.inputs;
+    case RefType::Register3x:
+      return s.input_regs;
+    case RefType::Register4x:
+      return s.holding;
   }
   return 0;
 }
@@ -35,11 +43,12 @@ std::array<std::uint32_t, 4> user_counts(const TransferConfig& c) {
   return {c.coils, c.inputs, c.input_regs, c.holding};
 }
 std::array<std::uint32_t, 4> additional_counts(const TransferConfig& c) {
-  return {c.additional.coils, c.additional.inputs, c.additional.input_regs,
-          c.additional.holding};
+  return {c.additional.coils, c.additional.inputs, c.additional.input_regs, c.additional.holding};
 }
 
-TransferPlanResult refuse(std::string why) { return {std::nullopt, std::move(why)}; }
+TransferPlanResult refuse(std::string why) {
+  return {std::nullopt, std::move(why)};
+}
 
 void set_every_scan(TransferPlan& p, const std::array<std::uint32_t, 4>& counts) {
   for (std::size_t i = 0; i < kOrder.size(); ++i)
@@ -93,8 +102,8 @@ TransferPlanResult plan_transfer(const TransferConfig& cfg, const StateRamSizes&
   } else if (cfg.mode == Mode::Default12K) {
     // User defined and additional entries are ignored with 12K (p. 98).
     const auto [t3, t4] = allocate_12k_registers(sizes.input_regs, sizes.holding);
-    set_every_scan(plan, {std::min(sizes.coils, kTwelveKBits),
-                          std::min(sizes.inputs, kTwelveKBits), t3, t4});
+    set_every_scan(
+        plan, {std::min(sizes.coils, kTwelveKBits), std::min(sizes.inputs, kTwelveKBits), t3, t4});
   } else if (cfg.mode == Mode::TransferAll) {
     const auto u = user_counts(cfg);
     if (cfg.additional.enabled || std::any_of(u.begin(), u.end(), [](auto v) { return v != 0; }))
@@ -129,10 +138,9 @@ TransferPlanResult plan_transfer(const TransferConfig& cfg, const StateRamSizes&
                         type_words(kOrder[i]) + " is not 0 or a multiple of 16");
         if (std::uint64_t{u[i]} + a[i] > size_of(sizes, kOrder[i]))
           return refuse(std::string("the additional ") + type_words(kOrder[i]) + " after the " +
-                        std::to_string(u[i]) +
-                        " sent every scan end at " + std::to_string(u[i] + a[i]) +
-                        ", beyond the " + std::to_string(size_of(sizes, kOrder[i])) +
-                        " configured in state RAM");
+                        std::to_string(u[i]) + " sent every scan end at " +
+                        std::to_string(u[i] + a[i]) + ", beyond the " +
+                        std::to_string(size_of(sizes, kOrder[i])) + " configured in state RAM");
       }
       if (std::all_of(a.begin(), a.end(), [](auto v) { return v == 0; }))
         return refuse(

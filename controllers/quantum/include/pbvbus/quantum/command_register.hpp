@@ -74,9 +74,9 @@ inline constexpr int kCmdLogicMismatchBit = 13;
 inline constexpr int kCmdExecUpgradeBit = 12;
 inline constexpr std::array<int, 3> kCmdSwapDisabledBits = {8, 7, 6};
 /// Every bit the command register defines.
-inline constexpr std::uint16_t kCommandMask =
-    modicon_bit(16) | modicon_bit(15) | modicon_bit(14) | modicon_bit(13) | modicon_bit(12) |
-    modicon_bit(8) | modicon_bit(7) | modicon_bit(6);
+inline constexpr std::uint16_t kCommandMask = modicon_bit(16) | modicon_bit(15) | modicon_bit(14) |
+                                              modicon_bit(13) | modicon_bit(12) | modicon_bit(8) |
+                                              modicon_bit(7) | modicon_bit(6);
 
 CommandRegister decode_command(std::uint16_t word);
 std::uint16_t encode_command(const CommandRegister& c);

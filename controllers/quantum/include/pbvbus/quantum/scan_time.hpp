@@ -31,9 +31,9 @@
 namespace pbvbus::quantum {
 
 enum class CpuType : std::uint8_t {
-  X13,      ///< CPU x13 (984 ladder logic)
-  Cpu42402, ///< CPU 424 02
-  Cpu43412, ///< CPU 434 12 / CPU 534 14 (984 or IEC)
+  X13,       ///< CPU x13 (984 ladder logic)
+  Cpu42402,  ///< CPU 424 02
+  Cpu43412,  ///< CPU 434 12 / CPU 534 14 (984 or IEC)
 };
 
 struct RefCounts {
@@ -49,20 +49,20 @@ bus::Ticks hsby_cost(CpuType cpu);
 std::int64_t rate_us_per_1000_bytes(CpuType cpu);
 
 struct ScanInputs {
-  RefCounts transferred;        ///< state RAM transferred (references of each type)
-  bus::Ticks standalone = 0;    ///< the application's standalone scan time
+  RefCounts transferred;      ///< state RAM transferred (references of each type)
+  bus::Ticks standalone = 0;  ///< the application's standalone scan time
   /// Replace the CPU type's rate (µs per 1000 B); the seed's 984 example uses the x13's 1600.
   std::optional<std::int64_t> rate_override;
 };
 
 struct ScanEstimate {
-  RefCounts deltas;             ///< transferred − baseline (iec_regs: all of them, see above)
+  RefCounts deltas;  ///< transferred − baseline (iec_regs: all of them, see above)
   std::int64_t coil_bytes = 0, input_bytes = 0, input_reg_bytes = 0, holding_bytes = 0,
                iec_bytes = 0;
-  std::int64_t bytes = 0;       ///< sum of the five
-  bus::Ticks transfer = 0;      ///< bytes × rate (exact, ticks; may be negative)
-  std::int64_t transfer_ms = 0; ///< the same rounded to the nearest ms, as the seed writes it
-  bus::Ticks hsby = 0;          ///< hsby_cost(cpu)
+  std::int64_t bytes = 0;        ///< sum of the five
+  bus::Ticks transfer = 0;       ///< bytes × rate (exact, ticks; may be negative)
+  std::int64_t transfer_ms = 0;  ///< the same rounded to the nearest ms, as the seed writes it
+  bus::Ticks hsby = 0;           ///< hsby_cost(cpu)
   bus::Ticks standalone = 0;
   /// hsby + standalone + transfer (ticks, exact); the HSBY part (hsby + transfer) never below 0.
   bus::Ticks total = 0;

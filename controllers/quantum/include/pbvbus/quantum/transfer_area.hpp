@@ -36,10 +36,10 @@ struct TransferConfig {
     std::uint32_t coils = 0, inputs = 0, input_regs = 0, holding = 0;
     int scans = 1;
   } additional;
-  NonTransferArea non_transfer;       ///< 0-based 4x index, count (0 = none)
-  std::uint32_t command_register = 0; ///< 0-based 4x index: 400001 -> 0
-  bool iec = false;                   ///< IEC Hot Standby: everything is transferred
-  std::uint32_t iec_heap_bytes = 0;   ///< IEC heap (program data + DFB instance data)
+  NonTransferArea non_transfer;        ///< 0-based 4x index, count (0 = none)
+  std::uint32_t command_register = 0;  ///< 0-based 4x index: 400001 -> 0
+  bool iec = false;                    ///< IEC Hot Standby: everything is transferred
+  std::uint32_t iec_heap_bytes = 0;    ///< IEC heap (program data + DFB instance data)
 };
 
 /// The 12K option's register split: (3x, 4x) transferred every scan for the configured

@@ -55,7 +55,7 @@ void set_every_scan(TransferPlan& p, const std::array<std::uint32_t, 4>& counts)
     if (counts[i] != 0) p.every_scan.push_back({kOrder[i], 0, counts[i]});
 }
 
-std::array<std::uint32_t, 4> all_of(const StateRamSizes& s) {
+std::array<std::uint32_t, 4> whole_tables(const StateRamSizes& s) {
   return {s.coils, s.inputs, s.input_regs, s.holding};
 }
 
@@ -98,7 +98,7 @@ TransferPlanResult plan_transfer(const TransferConfig& cfg, const StateRamSizes&
       return refuse("state RAM (" + std::to_string(ram) + " B) plus IEC heap (" +
                     std::to_string(cfg.iec_heap_bytes) + " B) is " + std::to_string(total) +
                     " B, more than the 131072 B (128 KB) an IEC Hot Standby transfer carries");
-    set_every_scan(plan, all_of(sizes));
+    set_every_scan(plan, whole_tables(sizes));
   } else if (cfg.mode == Mode::Default12K) {
     // User defined and additional entries are ignored with 12K (p. 98).
     const auto [t3, t4] = allocate_12k_registers(sizes.input_regs, sizes.holding);
@@ -110,7 +110,7 @@ TransferPlanResult plan_transfer(const TransferConfig& cfg, const StateRamSizes&
       return refuse(
           "\"Transfer All State RAM\" does not allow a user defined or additional state RAM "
           "range");
-    set_every_scan(plan, all_of(sizes));
+    set_every_scan(plan, whole_tables(sizes));
   } else {
     const auto u = user_counts(cfg);
     for (std::size_t i = 0; i < kOrder.size(); ++i) {

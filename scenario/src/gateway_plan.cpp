@@ -36,6 +36,28 @@ std::optional<GwEndpoint> parse_endpoint(const std::string& text) {
   return GwEndpoint{host, static_cast<std::uint16_t>(value)};
 }
 
+GwRtu plan_modbus_rtu(const scenario::ModbusRtu& m,
+                      const std::function<void(const char* field, const std::string& msg)>& error) {
+  GwRtu rtu;
+  if (m.port_case() == scenario::ModbusRtu::kLink) {
+    rtu.link = m.link();
+    if (rtu.link.empty()) error("link", "link must not be empty");
+  } else if (m.port_case() == scenario::ModbusRtu::kDevice) {
+    rtu.device = m.device();
+    if (rtu.device.empty()) error("device", "device must not be empty");
+  } else {
+    error(nullptr, "modbus_rtu needs a link (a pty) or a device");
+  }
+  if (m.baud() != 0) rtu.baud = m.baud();
+  rtu.parity = m.parity() == scenario::ModbusRtu::EVEN ? 'E'
+               : m.parity() == scenario::ModbusRtu::ODD ? 'O' : 'N';
+  if (m.has_stop_bits()) {
+    if (m.stop_bits() != 1 && m.stop_bits() != 2) error("stop_bits", "stop_bits must be 1 or 2");
+    rtu.stop_bits = static_cast<int>(m.stop_bits());
+  }
+  return rtu;
+}
+
 namespace {
 
 GwWordOrder word_order(scenario::WordOrder w) {
@@ -203,26 +225,13 @@ class GwPlanner {
       gp.max_clients = g.modbus_tcp().max_clients();
     }
     for (int r = 0; r < g.modbus_rtu_size(); ++r) {
-      const auto& m = g.modbus_rtu(r);
-      GwRtu rtu;
-      if (m.port_case() == scenario::ModbusRtu::kLink) {
-        rtu.link = m.link();
-        if (rtu.link.empty()) error(i, {{"modbus_rtu", r}, {"link"}}, "link must not be empty");
-        link(i, {{"modbus_rtu", r}, {"link"}}, rtu.link);
-      } else if (m.port_case() == scenario::ModbusRtu::kDevice) {
-        rtu.device = m.device();
-        if (rtu.device.empty()) error(i, {{"modbus_rtu", r}, {"device"}}, "device must not be empty");
-      } else {
-        error(i, {{"modbus_rtu", r}}, "modbus_rtu needs a link (a pty) or a device");
-      }
-      if (m.baud() != 0) rtu.baud = m.baud();
-      rtu.parity = m.parity() == scenario::ModbusRtu::EVEN ? 'E'
-                   : m.parity() == scenario::ModbusRtu::ODD ? 'O' : 'N';
-      if (m.has_stop_bits()) {
-        if (m.stop_bits() != 1 && m.stop_bits() != 2)
-          error(i, {{"modbus_rtu", r}, {"stop_bits"}}, "stop_bits must be 1 or 2");
-        rtu.stop_bits = static_cast<int>(m.stop_bits());
-      }
+      GwRtu rtu = plan_modbus_rtu(g.modbus_rtu(r), [&](const char* field, const std::string& msg) {
+        if (field != nullptr)
+          error(i, {{"modbus_rtu", r}, {field}}, msg);
+        else
+          error(i, {{"modbus_rtu", r}}, msg);
+      });
+      if (!rtu.link.empty()) link(i, {{"modbus_rtu", r}, {"link"}}, rtu.link);
       gp.modbus_rtu.push_back(std::move(rtu));
     }
     const auto& o = g.modbus();

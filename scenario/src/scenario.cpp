@@ -231,6 +231,7 @@ class Planner {
       return std::pair(w.line < 0 ? 0 : w.line + 1, w.column < 0 ? 0 : w.column + 1);
     };
     plan_s7(plan, slocate, m_errors);
+    plan_quantum(plan, slocate, m_errors);
     plan_captures(plan);
     plan_faults(plan);
     if (!m_errors.empty()) return std::nullopt;
@@ -1004,6 +1005,98 @@ class Planner {
     return good;
   }
 
+  /// The Quantum Hot Standby faults and operator actions (quantum_plan.hpp): the pair by name
+  /// (optional with only one), rack 0 or 1 where the kind names one; repair_at only where a
+  /// repair exists (an update, a command write and a program load have none).
+  bool plan_quantum_fault(const ScenarioPlan& plan, const scenario::Fault& f, const Where& w, PlanFault& pf) {
+    using K = PlanFault::Kind;
+    using FK = scenario::Fault::KindCase;
+    const auto* fd = scenario::Fault::descriptor();
+    const char* field = nullptr;
+    std::string name;
+    std::optional<std::uint32_t> rack;
+    bool needs_rack = true;
+    bool repair = true;
+    switch (f.kind_case()) {
+      case FK::kQuantumPowerLoss:
+        pf.kind = K::QuantumPowerLoss; field = "quantum_power_loss"; name = f.quantum_power_loss().quantum();
+        if (f.quantum_power_loss().has_rack()) rack = f.quantum_power_loss().rack();
+        break;
+      case FK::kQuantumCpuStop:
+        pf.kind = K::QuantumCpuStop; field = "quantum_cpu_stop"; name = f.quantum_cpu_stop().quantum();
+        if (f.quantum_cpu_stop().has_rack()) rack = f.quantum_cpu_stop().rack();
+        break;
+      case FK::kQuantumKey:
+        pf.kind = K::QuantumKey; field = "quantum_key"; name = f.quantum_key().quantum();
+        if (f.quantum_key().has_rack()) rack = f.quantum_key().rack();
+        pf.key = f.quantum_key().position() == scenario::QuantumRack::XFER ? 2 : 1;
+        if (f.quantum_key().position() == scenario::QuantumRack::RUN) {
+          error(nested(w, fd, field), "quantum_key needs a position OFF_LINE or XFER (RUN is its repair_at)");
+          return false;
+        }
+        break;
+      case FK::kQuantumUpdate:
+        pf.kind = K::QuantumUpdate; field = "quantum_update"; name = f.quantum_update().quantum();
+        if (f.quantum_update().has_rack()) rack = f.quantum_update().rack();
+        repair = false;
+        break;
+      case FK::kQuantumFibre:
+        pf.kind = K::QuantumFibre; field = "quantum_fibre"; name = f.quantum_fibre().quantum();
+        pf.fibre = f.quantum_fibre().kind() == scenario::QuantumFibre::NOT_CROSSED ? 1 : 0;
+        needs_rack = false;
+        break;
+      case FK::kQuantumCommand:
+        pf.kind = K::QuantumCommand; field = "quantum_command"; name = f.quantum_command().quantum();
+        pf.run_a = f.quantum_command().run_a();
+        pf.run_b = f.quantum_command().run_b();
+        needs_rack = false;
+        repair = false;
+        break;
+      case FK::kQuantumLogicChange:
+        pf.kind = K::QuantumLogicChange; field = "quantum_logic_change"; name = f.quantum_logic_change().quantum();
+        if (f.quantum_logic_change().has_rack()) rack = f.quantum_logic_change().rack();
+        pf.checksum = f.quantum_logic_change().logic_checksum();
+        repair = false;
+        break;
+      default: return false;
+    }
+    pf.line = -1;
+    const Where kw = nested(w, fd, field);
+    const pb::Descriptor* kd = fd->FindFieldByName(field)->message_type();
+    if (!repair && !f.repair_at().empty()) {
+      error(at_field(w, fd, "repair_at"), std::string(field) + " has no repair");
+      return false;
+    }
+    if (plan.quantum.empty()) {
+      error(kw, std::string(field) + " needs a quantum_hot_standby in the scenario");
+      return false;
+    }
+    if (name.empty()) {
+      if (plan.quantum.size() > 1) {
+        error(kw, std::string(field) + " must name its quantum_hot_standby (quantum: \"...\"): the scenario has " +
+                      std::to_string(plan.quantum.size()));
+        return false;
+      }
+      pf.quantum = 0;
+    } else {
+      for (std::size_t k = 0; k < plan.quantum.size(); ++k)
+        if (plan.quantum[k].name == name) pf.quantum = static_cast<int>(k);
+      if (pf.quantum < 0) {
+        error(at_field(kw, kd, "quantum"), "no quantum_hot_standby named \"" + name + "\"");
+        return false;
+      }
+    }
+    if (needs_rack) {
+      if (!rack || *rack > 1) {
+        error(kw, std::string(field) + " needs a rack: 0 or 1");
+        return false;
+      }
+      pf.rack = static_cast<int>(*rack);
+    }
+    pf.description = quantum_fault_description(pf);
+    return true;
+  }
+
   void plan_faults(ScenarioPlan& plan) {
     const auto* sd = scenario::Scenario::descriptor();
     const auto* fd = scenario::Fault::descriptor();
@@ -1077,6 +1170,15 @@ class Planner {
         case FK::kExpansionRackFailure:
         case FK::kCycleOverload:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
+          continue;
+        case FK::kQuantumPowerLoss:
+        case FK::kQuantumCpuStop:
+        case FK::kQuantumKey:
+        case FK::kQuantumUpdate:
+        case FK::kQuantumFibre:
+        case FK::kQuantumCommand:
+        case FK::kQuantumLogicChange:
+          if (plan_quantum_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::KIND_NOT_SET:
           // The message predates the DP slave faults; tests and users match it as it is.
@@ -1245,6 +1347,38 @@ std::string h_fault_description(const PlanFault& f) {
              " longer";
     }
     default: return {};
+  }
+}
+
+bool is_quantum_fault(PlanFault::Kind k) {
+  using K = PlanFault::Kind;
+  switch (k) {
+    case K::QuantumPowerLoss:
+    case K::QuantumCpuStop:
+    case K::QuantumKey:
+    case K::QuantumUpdate:
+    case K::QuantumFibre:
+    case K::QuantumCommand:
+    case K::QuantumLogicChange:
+      return true;
+    default:
+      return false;
+  }
+}
+
+std::string quantum_fault_description(const PlanFault& f) {
+  using K = PlanFault::Kind;
+  const std::string rack = "rack " + std::to_string(f.rack);
+  switch (f.kind) {
+    case K::QuantumPowerLoss: return rack + " loses power";
+    case K::QuantumCpuStop: return rack + "'s CPU stops";
+    case K::QuantumKey: return rack + "'s keyswitch to " + (f.key == 2 ? "Xfer" : "Off Line");
+    case K::QuantumUpdate: return rack + ": update button and key to Xfer (program and state RAM copied)";
+    case K::QuantumFibre: return f.fibre == 1 ? "CHS fibre Tx/Rx not crossed" : "CHS fibre cut";
+    case K::QuantumCommand:
+      return std::string("command register written: run A ") + (f.run_a ? "1" : "0") + ", run B " + (f.run_b ? "1" : "0");
+    case K::QuantumLogicChange: return rack + " gets program " + std::to_string(f.checksum);
+    default: return "?";
   }
 }
 

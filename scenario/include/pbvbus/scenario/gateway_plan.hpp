@@ -36,6 +36,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
+#include "scenario.pb.h"
 
 namespace pbvbus::tools {
 
@@ -70,6 +71,11 @@ struct GwRtu {
   char parity = 'N';   ///< 'N', 'E', 'O'
   int stop_bits = 1;
 };
+
+/// A `modbus_rtu` entry checked (link or device, stop bits); `error(field, message)` for each
+/// problem (field nullptr: the entry itself). The link's uniqueness is the caller's check.
+GwRtu plan_modbus_rtu(const scenario::ModbusRtu& m,
+                      const std::function<void(const char* field, const std::string& msg)>& error);
 
 struct GwCan {
   std::vector<std::pair<std::uint8_t, std::uint8_t>> nodes;  ///< explicit: address -> node id

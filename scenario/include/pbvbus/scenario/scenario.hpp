@@ -42,6 +42,7 @@
 #include "pbvbus/scenario/dp_plan.hpp"
 #include "pbvbus/scenario/gateway_plan.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
+#include "pbvbus/scenario/quantum_plan.hpp"
 #include "pbvbus/scenario/s7_plan.hpp"
 #include "scenario.pb.h"
 
@@ -148,6 +149,14 @@ struct PlanFault {
     // F8 expansion racks, OB 80
     ExpansionRackFailure,  ///< F8, `rack_number` (`rack` = its CPU); repair: power back
     CycleOverload,         ///< the next OB 1 lasts scan_time + `extra` (OB 80)
+    // Quantum Hot Standby (quantum_plan.hpp): `quantum`, and `rack` where the kind names one.
+    QuantumPowerLoss,     ///< the rack's power fails; repair: power back
+    QuantumCpuStop,       ///< the rack's CPU stops; repair: started again
+    QuantumKey,           ///< keyswitch to `key` (1 Off Line, 2 Xfer); repair: back to Run
+    QuantumUpdate,        ///< update button + key to Xfer on the standby, then back to Run
+    QuantumFibre,         ///< the CHS fibre cut (`fibre` 0) or Tx/Rx not crossed (`fibre` 1); repair: mended
+    QuantumCommand,       ///< a host writes the command register's run bits `run_a`, `run_b`
+    QuantumLogicChange,   ///< a program with identity `checksum` is loaded into `rack`
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;
@@ -178,7 +187,16 @@ struct PlanFault {
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
   int rack_number = 0;   ///< expansion_rack_failure: the expansion rack (1..21)
   bus::Ticks extra = 0;  ///< cycle_overload: how much longer the next OB 1 lasts
+  int quantum = -1;      ///< Quantum faults: index into ScenarioPlan::quantum
+  int key = 0;           ///< quantum_key: 1 Off Line, 2 Xfer
+  bool run_a = false, run_b = false;  ///< quantum_command
+  std::uint32_t checksum = 0;         ///< quantum_logic_change
 };
+
+/// A Quantum Hot Standby fault kind (QuantumPowerLoss .. QuantumLogicChange)?
+bool is_quantum_fault(PlanFault::Kind k);
+/// "rack 0 loses power", "CHS fibre cut", ... (without the pair's name).
+std::string quantum_fault_description(const PlanFault& f);
 
 /// An H-system fault kind (CpuFailure .. SyncError, ExpansionRackFailure, CycleOverload)?
 bool is_h_fault(PlanFault::Kind k);
@@ -200,6 +218,7 @@ struct ScenarioPlan {
   std::vector<HSystemPlan> h_systems;  ///< h_system entries (update timing; runtime if simulated)
   std::vector<GatewayPlan> gateways;   ///< gateway entries, in file order (gateway_plan.hpp)
   S7Plan s7;  ///< s7_cpu, mpi_station, s7_door entries and the H CPUs' MPI interfaces
+  std::vector<QuantumPlan> quantum;  ///< quantum_hot_standby entries, valid ones, file order
 };
 
 struct LoadResult {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <string>
 
+#include "pbvbus/gateways/modbus_device_id.hpp"
 #include "pbvbus/gateways/modbus_image.hpp"
 
 namespace pbvbus::gateways {
@@ -342,7 +343,7 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
 
 std::size_t ModbusGateway::device_id(const ModbusUnitMap* u, const ModbusRequest& rq,
                                      std::span<std::uint8_t, kModbusMaxPdu> rsp) {
-  std::string objects[3];
+  std::array<std::string, 3> objects;
   objects[0] = "pbvbus";
   if (u) {
     char buf[8];
@@ -353,34 +354,7 @@ std::size_t ModbusGateway::device_id(const ModbusUnitMap* u, const ModbusRequest
     objects[1] = "gateway";
     objects[2] = m_source.name();
   }
-  for (auto& o : objects)
-    if (o.size() > 64) o.resize(64);  // 3 objects of ≤ 66 octets always fit one PDU
-  std::uint8_t first = rq.object_id;
-  std::uint8_t last = 2;
-  if (rq.read_device_id_code == 4) {
-    if (first > 2) {
-      rsp[0] = kFcEncapsulatedInterface | 0x80;
-      rsp[1] = kExIllegalDataAddress;
-      return 2;
-    }
-    last = first;
-  } else if (first > 2) {
-    first = 0;  // stream access with an unknown object id restarts at the beginning
-  }
-  std::size_t n = 0;
-  rsp[n++] = kFcEncapsulatedInterface;
-  rsp[n++] = kMeiReadDeviceId;
-  rsp[n++] = rq.read_device_id_code;
-  rsp[n++] = 0x81;  // conformity: basic identification, stream and individual access
-  rsp[n++] = 0x00;  // more follows: no
-  rsp[n++] = 0x00;  // next object id
-  rsp[n++] = static_cast<std::uint8_t>(last - first + 1);
-  for (std::uint8_t id = first; id <= last; ++id) {
-    rsp[n++] = id;
-    rsp[n++] = static_cast<std::uint8_t>(objects[id].size());
-    for (char c : objects[id]) rsp[n++] = static_cast<std::uint8_t>(c);
-  }
-  return n;
+  return modbus_device_id_response(rq, std::move(objects), rsp);
 }
 
 }  // namespace pbvbus::gateways

@@ -1,21 +1,16 @@
 #include "pbvbus/gateways/modbus_gateway.hpp"
 
 #include <modbus/modbus.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cstdio>
 #include <string>
 
+#include "pbvbus/gateways/modbus_device_id.hpp"
 #include "pbvbus/gateways/modbus_image.hpp"
 
 namespace pbvbus::gateways {
 namespace {
-
-constexpr std::size_t kMbapLen = 7;
-constexpr int kSpace = 0x10000;  // every address 0..65535 in the libmodbus mapping
 
 bool in_range(std::uint32_t first, std::uint32_t count, std::uint32_t lo, std::uint32_t n) {
   return first >= lo && first + count <= lo + n;
@@ -36,25 +31,9 @@ void put_u32(std::vector<std::uint16_t>& r, std::size_t at, std::uint64_t v) {
 }  // namespace
 
 ModbusGateway::ModbusGateway(ProcessSource& source, ModbusGatewayOptions options)
-    : m_source(source), m_options(std::move(options)), m_map(source, m_options) {
-  if (::socketpair(AF_UNIX, SOCK_STREAM, 0, m_pair) != 0) {
-    m_pair[0] = m_pair[1] = -1;
-    return;
-  }
-  m_ctx = modbus_new_tcp(nullptr, 0);
-  if (m_ctx) modbus_set_socket(m_ctx, m_pair[0]);
-  m_mapping = modbus_mapping_new_start_address(0, kSpace, 0, kSpace, 0, kSpace, 0, kSpace);
-}
+    : m_source(source), m_options(std::move(options)), m_map(source, m_options) {}
 
-ModbusGateway::~ModbusGateway() {
-  if (m_ctx) {
-    modbus_set_socket(m_ctx, -1);  // we own the pair: libmodbus must not close it
-    modbus_free(m_ctx);
-  }
-  if (m_mapping) modbus_mapping_free(m_mapping);
-  for (int fd : m_pair)
-    if (fd >= 0) ::close(fd);
-}
+ModbusGateway::~ModbusGateway() = default;
 
 std::size_t ModbusGateway::handle(std::uint8_t unit, std::span<const std::uint8_t> pdu,
                                   std::span<std::uint8_t, kModbusMaxPdu> rsp, bool broadcast) {
@@ -78,59 +57,12 @@ std::size_t ModbusGateway::answer(std::uint8_t unit, std::span<const std::uint8_
   }
   const bool gw = m_options.gateway_units && (unit == 0 || unit == 255);
   const ModbusUnitMap* u = gw ? nullptr : m_map.unit(unit);
-  if (!gw && !u) return exception(unit, pdu, kExGatewayPathUnavailable, rsp);
+  if (!gw && !u) return m_engine.exception(unit, pdu, kExGatewayPathUnavailable, rsp);
   const ModbusDecoded d = decode_modbus_request(pdu);
-  if (!d.ok()) return exception(unit, pdu, d.error.exception, rsp);
-  if (!engine_ok()) return exception(unit, pdu, kExServerDeviceFailure, rsp);
+  if (!d.ok()) return m_engine.exception(unit, pdu, d.error.exception, rsp);
+  if (!engine_ok()) return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
   if (d.request.function == kFcEncapsulatedInterface) return device_id(u, d.request, rsp);
   return gw ? gateway_unit(unit, d.request, pdu, rsp) : slave_unit(*u, d.request, pdu, rsp);
-}
-
-std::size_t ModbusGateway::exception(std::uint8_t unit, std::span<const std::uint8_t> pdu,
-                                     std::uint8_t code,
-                                     std::span<std::uint8_t, kModbusMaxPdu> rsp) {
-  // libmodbus builds FC + 0x80 in an int and truncates: for a function code that already has
-  // bit 7 set (never a valid request) answer by hand with bit 7 kept.
-  if (pdu[0] >= 0x80 || !m_ctx) {
-    rsp[0] = static_cast<std::uint8_t>(pdu[0] | 0x80);
-    rsp[1] = code;
-    return 2;
-  }
-  return engine(unit, pdu, code, rsp);
-}
-
-std::size_t ModbusGateway::engine(std::uint8_t unit, std::span<const std::uint8_t> pdu,
-                                  std::uint8_t exception_code,
-                                  std::span<std::uint8_t, kModbusMaxPdu> rsp) {
-  std::array<std::uint8_t, kMbapLen + kModbusMaxPdu> adu{};
-  const auto len = static_cast<std::uint16_t>(pdu.size() + 1);
-  adu[4] = static_cast<std::uint8_t>(len >> 8);  // TID 0, protocol 0, length, unit
-  adu[5] = static_cast<std::uint8_t>(len & 0xFF);
-  adu[6] = unit;
-  std::copy(pdu.begin(), pdu.end(), adu.begin() + kMbapLen);
-  const int adu_len = static_cast<int>(kMbapLen + pdu.size());
-  const int rc = exception_code == 0
-                     ? modbus_reply(m_ctx, adu.data(), adu_len, m_mapping)
-                     : modbus_reply_exception(m_ctx, adu.data(), exception_code);
-  std::array<std::uint8_t, kMbapLen + kModbusMaxPdu + 8> back{};
-  std::size_t got = 0;
-  if (rc > 0) {
-    // The pair's buffer holds far more than one ADU, so the whole answer is there already.
-    while (got < back.size()) {
-      const ssize_t r = ::recv(m_pair[1], back.data() + got, back.size() - got, MSG_DONTWAIT);
-      if (r <= 0) break;
-      got += static_cast<std::size_t>(r);
-    }
-  }
-  if (got <= kMbapLen || got - kMbapLen > kModbusMaxPdu) {
-    // The engine failed (cannot happen for pre-checked requests): answer 0x04 by hand.
-    rsp[0] = static_cast<std::uint8_t>(pdu[0] | 0x80);
-    rsp[1] = kExServerDeviceFailure;
-    return 2;
-  }
-  const std::size_t n = got - kMbapLen;
-  std::copy_n(back.begin() + kMbapLen, n, rsp.begin());
-  return n;
 }
 
 std::vector<std::uint16_t> ModbusGateway::status_registers(const ModbusUnitMap& u) const {
@@ -203,11 +135,11 @@ std::size_t ModbusGateway::gateway_unit(std::uint8_t unit, const ModbusRequest& 
   switch (rq.function) {
     case kFcReadInputRegisters: {
       if (!in_range(rq.read_address, rq.read_quantity, 0, kGwInputRegisters))
-        return exception(unit, pdu, kExIllegalDataAddress, rsp);
+        return m_engine.exception(unit, pdu, kExIllegalDataAddress, rsp);
       const auto regs = gateway_registers();
       for (std::uint16_t i = 0; i < rq.read_quantity; ++i)
-        m_mapping->tab_input_registers[rq.read_address + i] = regs[rq.read_address + i];
-      return engine(unit, pdu, 0, rsp);
+        m_engine.mapping().tab_input_registers[rq.read_address + i] = regs[rq.read_address + i];
+      return m_engine.reply(unit, pdu, rsp);
     }
     case kFcReadHoldingRegisters:
     case kFcWriteSingleRegister:
@@ -218,15 +150,15 @@ std::size_t ModbusGateway::gateway_unit(std::uint8_t unit, const ModbusRequest& 
       const bool writes = rq.function != kFcReadHoldingRegisters;
       if ((reads && !in_range(rq.read_address, rq.read_quantity, 0, kGwHoldingRegisters)) ||
           (writes && !in_range(rq.write_address, rq.write_quantity, 0, kGwHoldingRegisters)))
-        return exception(unit, pdu, kExIllegalDataAddress, rsp);
+        return m_engine.exception(unit, pdu, kExIllegalDataAddress, rsp);
       if (writes) {
         const std::uint16_t v = rq.write_value(0);
-        if (v < 2 || v > 4) return exception(unit, pdu, kExIllegalDataValue, rsp);
+        if (v < 2 || v > 4) return m_engine.exception(unit, pdu, kExIllegalDataValue, rsp);
         if (!m_source.command(static_cast<dp::MasterMode>(v - 1)))
-          return exception(unit, pdu, kExServerDeviceFailure, rsp);
+          return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
       }
-      m_mapping->tab_registers[kGwHrMasterMode] = modbus_mode_code(m_source.mode());
-      const std::size_t n = engine(unit, pdu, 0, rsp);
+      m_engine.mapping().tab_registers[kGwHrMasterMode] = modbus_mode_code(m_source.mode());
+      const std::size_t n = m_engine.reply(unit, pdu, rsp);
       // FC23 reads after its write: libmodbus put the written value into the mapping, the
       // answer must show the mode the master is in now.
       if (rq.function == kFcReadWriteMultipleRegisters && n == 4) {
@@ -237,7 +169,7 @@ std::size_t ModbusGateway::gateway_unit(std::uint8_t unit, const ModbusRequest& 
       return n;
     }
     default:  // the gateway has no bit tables
-      return exception(unit, pdu, kExIllegalDataAddress, rsp);
+      return m_engine.exception(unit, pdu, kExIllegalDataAddress, rsp);
   }
 }
 
@@ -245,7 +177,7 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
                                       std::span<const std::uint8_t> pdu,
                                       std::span<std::uint8_t, kModbusMaxPdu> rsp) {
   const std::uint8_t unit = u.unit;
-  if (rq.writes() && !u.writable) return exception(unit, pdu, kExIllegalFunction, rsp);
+  if (rq.writes() && !u.writable) return m_engine.exception(unit, pdu, kExIllegalFunction, rsp);
 
   // Where does the request land? Status block (registers only), data area, or nowhere.
   const bool status_read =
@@ -284,18 +216,19 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
                  in_range(rq.read_address, rq.read_quantity, 0, u.holding_registers));
       break;
     default:
-      return exception(unit, pdu, kExIllegalFunction, rsp);
+      return m_engine.exception(unit, pdu, kExIllegalFunction, rsp);
   }
-  if (!data_ok) return exception(unit, pdu, kExIllegalDataAddress, rsp);
+  if (!data_ok) return m_engine.exception(unit, pdu, kExIllegalDataAddress, rsp);
 
   // The status block is always readable (FC03/FC04 only; FC23 writes process data).
   if (status_read && rq.function != kFcReadWriteMultipleRegisters) {
     const auto regs = status_registers(u);
-    std::uint16_t* tab = rq.function == kFcReadInputRegisters ? m_mapping->tab_input_registers
-                                                              : m_mapping->tab_registers;
+    std::uint16_t* tab = rq.function == kFcReadInputRegisters
+                             ? m_engine.mapping().tab_input_registers
+                             : m_engine.mapping().tab_registers;
     for (std::uint16_t i = 0; i < rq.read_quantity; ++i)
       tab[rq.read_address + i] = regs[rq.read_address - kStatusBase + i];
-    return engine(unit, pdu, 0, rsp);
+    return m_engine.reply(unit, pdu, rsp);
   }
 
   SlaveStatus st;
@@ -303,47 +236,47 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
   if (ost) st = *ost;
   const bool stale = !ost || !st.data_valid;
   if (stale && u.stale == StaleReaction::Exception)
-    return exception(unit, pdu, kExGatewayTargetFailed, rsp);
+    return m_engine.exception(unit, pdu, kExGatewayTargetFailed, rsp);
 
   switch (rq.function) {
     case kFcReadInputRegisters:
     case kFcReadDiscreteInputs: {
       std::vector<std::uint8_t> in(u.input_len, 0);
       if (!m_source.read_inputs(u.address, u.side, in))
-        return exception(unit, pdu, kExServerDeviceFailure, rsp);
+        return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
       if (stale && u.stale == StaleReaction::Zero) std::fill(in.begin(), in.end(), 0);
       const bool value = stale && u.stale == StaleReaction::Value;
       if (rq.function == kFcReadInputRegisters) {
         auto regs = telegram_to_registers(u, in, false);
         if (value) std::fill(regs.begin(), regs.end(), u.stale_value);
         for (std::uint16_t i = 0; i < rq.read_quantity; ++i)
-          m_mapping->tab_input_registers[rq.read_address + i] = regs[rq.read_address + i];
+          m_engine.mapping().tab_input_registers[rq.read_address + i] = regs[rq.read_address + i];
       } else {
         for (std::uint16_t i = 0; i < rq.read_quantity; ++i) {
           const std::size_t b = rq.read_address + i;
-          m_mapping->tab_input_bits[b] =
+          m_engine.mapping().tab_input_bits[b] =
               value ? static_cast<std::uint8_t>(u.stale_value & 1u)
                     : static_cast<std::uint8_t>((in[b / 8] >> (b % 8)) & 1u);
         }
       }
-      return engine(unit, pdu, 0, rsp);
+      return m_engine.reply(unit, pdu, rsp);
     }
     case kFcReadHoldingRegisters:
     case kFcReadCoils: {
       std::vector<std::uint8_t> out(u.output_len, 0);
       if (!m_source.read_outputs(u.address, u.side, out))
-        return exception(unit, pdu, kExServerDeviceFailure, rsp);
+        return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
       if (rq.function == kFcReadHoldingRegisters) {
         const auto regs = telegram_to_registers(u, out, true);
         for (std::uint16_t i = 0; i < rq.read_quantity; ++i)
-          m_mapping->tab_registers[rq.read_address + i] = regs[rq.read_address + i];
+          m_engine.mapping().tab_registers[rq.read_address + i] = regs[rq.read_address + i];
       } else {
         for (std::uint16_t i = 0; i < rq.read_quantity; ++i) {
           const std::size_t b = rq.read_address + i;
-          m_mapping->tab_bits[b] = static_cast<std::uint8_t>((out[b / 8] >> (b % 8)) & 1u);
+          m_engine.mapping().tab_bits[b] = static_cast<std::uint8_t>((out[b / 8] >> (b % 8)) & 1u);
         }
       }
-      return engine(unit, pdu, 0, rsp);
+      return m_engine.reply(unit, pdu, rsp);
     }
     default:
       break;
@@ -353,7 +286,7 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
   // whole, in slot order, before anything else runs (one DP cycle).
   std::vector<std::uint8_t> out(u.output_len, 0);
   if (!m_source.read_outputs(u.address, Side::Primary, out))
-    return exception(unit, pdu, kExServerDeviceFailure, rsp);
+    return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
   std::vector<bool> touched(u.modules.size(), false);
   const bool coils =
       rq.function == kFcWriteSingleCoil || rq.function == kFcWriteMultipleCoils;
@@ -376,9 +309,9 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
     const auto& mm = u.modules[m];
     if (!m_source.write_module_outputs(
             u.address, m, std::span<const std::uint8_t>(out).subspan(mm.out_offset, mm.out_len)))
-      return exception(unit, pdu, kExServerDeviceFailure, rsp);
+      return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
   }
-  if (rq.function != kFcReadWriteMultipleRegisters) return engine(unit, pdu, 0, rsp);
+  if (rq.function != kFcReadWriteMultipleRegisters) return m_engine.reply(unit, pdu, rsp);
 
   // FC23: the read part after the write, from the outputs as they are now (or the status
   // block mirror).
@@ -390,12 +323,12 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
   } else {
     std::vector<std::uint8_t> now(u.output_len, 0);
     if (!m_source.read_outputs(u.address, Side::Primary, now))
-      return exception(unit, pdu, kExServerDeviceFailure, rsp);
+      return m_engine.exception(unit, pdu, kExServerDeviceFailure, rsp);
     regs = telegram_to_registers(u, now, true);
   }
   for (std::uint16_t i = 0; i < rq.read_quantity; ++i)
-    m_mapping->tab_registers[rq.read_address + i] = regs[rq.read_address - base + i];
-  const std::size_t n = engine(unit, pdu, 0, rsp);
+    m_engine.mapping().tab_registers[rq.read_address + i] = regs[rq.read_address - base + i];
+  const std::size_t n = m_engine.reply(unit, pdu, rsp);
   // libmodbus copied the written values into its mapping before reading: where the ranges
   // overlap the answer must show the image (e.g. the dropped low byte of an odd module).
   if (n == 2 + 2u * rq.read_quantity && rsp[0] == kFcReadWriteMultipleRegisters) {
@@ -410,7 +343,7 @@ std::size_t ModbusGateway::slave_unit(const ModbusUnitMap& u, const ModbusReques
 
 std::size_t ModbusGateway::device_id(const ModbusUnitMap* u, const ModbusRequest& rq,
                                      std::span<std::uint8_t, kModbusMaxPdu> rsp) {
-  std::string objects[3];
+  std::array<std::string, 3> objects;
   objects[0] = "pbvbus";
   if (u) {
     char buf[8];
@@ -421,34 +354,7 @@ std::size_t ModbusGateway::device_id(const ModbusUnitMap* u, const ModbusRequest
     objects[1] = "gateway";
     objects[2] = m_source.name();
   }
-  for (auto& o : objects)
-    if (o.size() > 64) o.resize(64);  // 3 objects of ≤ 66 octets always fit one PDU
-  std::uint8_t first = rq.object_id;
-  std::uint8_t last = 2;
-  if (rq.read_device_id_code == 4) {
-    if (first > 2) {
-      rsp[0] = kFcEncapsulatedInterface | 0x80;
-      rsp[1] = kExIllegalDataAddress;
-      return 2;
-    }
-    last = first;
-  } else if (first > 2) {
-    first = 0;  // stream access with an unknown object id restarts at the beginning
-  }
-  std::size_t n = 0;
-  rsp[n++] = kFcEncapsulatedInterface;
-  rsp[n++] = kMeiReadDeviceId;
-  rsp[n++] = rq.read_device_id_code;
-  rsp[n++] = 0x81;  // conformity: basic identification, stream and individual access
-  rsp[n++] = 0x00;  // more follows: no
-  rsp[n++] = 0x00;  // next object id
-  rsp[n++] = static_cast<std::uint8_t>(last - first + 1);
-  for (std::uint8_t id = first; id <= last; ++id) {
-    rsp[n++] = id;
-    rsp[n++] = static_cast<std::uint8_t>(objects[id].size());
-    for (char c : objects[id]) rsp[n++] = static_cast<std::uint8_t>(c);
-  }
-  return n;
+  return modbus_device_id_response(rq, std::move(objects), rsp);
 }
 
 }  // namespace pbvbus::gateways

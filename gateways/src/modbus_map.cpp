@@ -133,6 +133,14 @@ ModbusMap::ModbusMap(const ProcessSource& source, const ModbusGatewayOptions& op
         continue;
       }
       if (pass == 1 && !s.switched) continue;  // a one-sided slave has no standby side
+      if (pass == 1 && s.address > kMaxStandbyAddress) {
+        // Seed 003 p. 93 (Swap Address at Switchover): primary addresses 1..119, the standby at
+        // address + 128 <= 247; 248..255 are reserved by Modbus over Serial Line §2.2.
+        m_warnings.push_back("slave at address " + std::to_string(s.address) +
+                             " has no standby unit: address + 128 would be a reserved Modbus "
+                             "address (standby units only for addresses 1..119)");
+        continue;
+      }
       const ModbusSlaveOptions& so = options.slave(s.address);
       ModbusUnitMap u;
       u.address = s.address;

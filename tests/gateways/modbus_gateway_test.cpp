@@ -330,6 +330,20 @@ TEST_F(ModbusGatewayTest, StatusFlagsOfASwitchedStationAndTheStandbyUnit) {
   EXPECT_EQ(ask(20, encode_modbus_read(0x04, 0, 1)), (Bytes{4, 2, 0x0A, 0x0B}));
 }
 
+TEST_F(ModbusGatewayTest, NoStandbyUnitAboveAddress119) {
+  src.set_redundant(true);
+  opt.standby_units = true;
+  src.add_slave(119, 1, {{"DI2", 0, 2, 0, 0, false}}).switched = true;
+  src.add_slave(120, 2, {{"DI2", 0, 2, 0, 0, false}}).switched = true;
+  src.data(119, Side::Standby).inputs = {0x11, 0x22};
+  src.data(120).inputs = {0x12, 0x34};
+  // 119 + 128 = 247: the standby side of 119.
+  EXPECT_EQ(ask(247, encode_modbus_read(0x04, 0, 1)), (Bytes{4, 2, 0x11, 0x22}));
+  // 120 + 128 = 248 is reserved: unknown unit, 0x0A; 120 answers at its primary unit only.
+  EXPECT_EQ(ask(248, encode_modbus_read(0x04, 0, 1)), (Bytes{0x84, 0x0A}));
+  EXPECT_EQ(ask(120, encode_modbus_read(0x04, 0, 1)), (Bytes{4, 2, 0x12, 0x34}));
+}
+
 TEST_F(ModbusGatewayTest, NoStandbyUnitsOnAPlainMasterSystem) {
   src.add_slave(6, 1, {{"DI2", 0, 2, 0, 0, false}}).switched = true;
   opt.standby_units = true;  // ignored: the source is not redundant

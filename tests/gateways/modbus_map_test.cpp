@@ -76,6 +76,29 @@ TEST(ModbusMap, AddressZeroIsNotMappedAndStandbyUnitsOnlyForSwitchedStations) {
   EXPECT_EQ(map.units().size(), 3u);  // 3, 7, 135
 }
 
+TEST(ModbusMap, StandbyUnitsOnlyUpToAddress119) {
+  // Seed 003 p. 93: primary addresses 1..119, standby at + 128 with 247 the maximum. So 119
+  // has its standby at 247; 120 (and up to 125) would land on the reserved 248..253: none.
+  FakeSource src;
+  src.set_redundant(true);
+  src.add_slave(119, 1, {{"DI1", 0, 1, 0, 0, false}}).switched = true;
+  src.add_slave(120, 2, {{"DI1", 0, 1, 0, 0, false}}).switched = true;
+  src.add_slave(125, 3, {{"DI1", 0, 1, 0, 0, false}}).switched = true;
+  ModbusGatewayOptions opt;
+  opt.standby_units = true;
+  ModbusMap map(src, opt);
+  ASSERT_NE(map.unit(247), nullptr);
+  EXPECT_EQ(map.unit(247)->address, 119);
+  EXPECT_EQ(map.unit(247)->side, Side::Standby);
+  ASSERT_NE(map.unit(120), nullptr);  // reachable at its primary unit
+  ASSERT_NE(map.unit(125), nullptr);
+  for (int u = 248; u <= 255; ++u) EXPECT_EQ(map.unit(static_cast<std::uint8_t>(u)), nullptr) << u;
+  EXPECT_EQ(map.units().size(), 4u);  // 119, 120, 125, 247
+  ASSERT_EQ(map.warnings().size(), 2u);
+  EXPECT_NE(map.warnings()[0].find("address 120 has no standby unit"), std::string::npos);
+  EXPECT_NE(map.warnings()[1].find("address 125 has no standby unit"), std::string::npos);
+}
+
 TEST(ModbusMap, ReadOnlySlave) {
   FakeSource src;
   add_io(src).outputs_writable = false;

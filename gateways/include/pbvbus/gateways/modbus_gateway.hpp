@@ -1,15 +1,13 @@
 #pragma once
-// The Modbus gateway core (docs/gateway-modbus.md): answers request PDUs for one ProcessSource following the
-// register layout of modbus_map.hpp. The doors (TCP/RTU) frame; this class only sees PDUs.
+// The Modbus gateway core (docs/gateway-modbus.md): answers request PDUs for one ProcessSource
+// following the register layout of modbus_map.hpp. The doors (TCP/RTU) frame; this class only sees
+// PDUs.
 //
-// libmodbus is the PDU engine (tools-and-formats §1.2/§1.3 Pattern A): one never-connected
-// `modbus_new_tcp(nullptr, 0)` context owned by the gateway, its socket one end of an AF_UNIX
-// socketpair. For each request the gateway pre-checks the PDU (modbus_pdu.hpp) and the unit's
-// map, fills only the requested ranges of a full-size `modbus_mapping_t` from the image, wraps
-// the PDU in an MBAP header, lets `modbus_reply()` (or `modbus_reply_exception()`) write the
-// answer into the pair, reads it back and strips the MBAP header. libmodbus therefore never
-// sees a request that is not well-formed and inside the map. MODBUS_ERROR_RECOVERY_LINK is never
-// set; `modbus_set_socket(ctx, -1)` before `modbus_free` (the gateway closes the pair itself).
+// libmodbus is the PDU engine (modbus_engine.hpp): for each request the gateway pre-checks the
+// PDU (modbus_pdu.hpp) and the unit's map, fills only the requested ranges of the engine's
+// full-size `modbus_mapping_t` from the image and lets `modbus_reply()` (or
+// `modbus_reply_exception()`) write the answer. libmodbus therefore never sees a request that is
+// not well-formed and inside the map.
 //
 // Decisions (docs/gateway-modbus.md):
 // - Exception order: 0x0A unknown unit; 0x01 unsupported FC (PDU check) ; 0x03 bad
@@ -37,14 +35,12 @@
 #include <span>
 #include <vector>
 
+#include "pbvbus/gateways/modbus_engine.hpp"
 #include "pbvbus/gateways/modbus_handler.hpp"
 #include "pbvbus/gateways/modbus_map.hpp"
 #include "pbvbus/gateways/modbus_options.hpp"
 #include "pbvbus/gateways/modbus_pdu.hpp"
 #include "pbvbus/gateways/process_source.hpp"
-
-struct _modbus;
-struct _modbus_mapping_t;
 
 namespace pbvbus::gateways {
 
@@ -75,7 +71,7 @@ class ModbusGateway final : public ModbusHandler {
   const ModbusMap& map() const { return m_map; }
   const ModbusGatewayOptions& options() const { return m_options; }
   const ModbusGatewayStats& stats() const { return m_stats; }
-  bool engine_ok() const { return m_ctx != nullptr && m_mapping != nullptr; }
+  bool engine_ok() const { return m_engine.ok(); }
 
  private:
   struct Answer;
@@ -91,19 +87,12 @@ class ModbusGateway final : public ModbusHandler {
                         std::span<std::uint8_t, kModbusMaxPdu> rsp);
   std::vector<std::uint16_t> status_registers(const ModbusUnitMap& u) const;
   std::vector<std::uint16_t> gateway_registers() const;
-  /// Runs modbus_reply (exception == 0) or modbus_reply_exception and copies the PDU out.
-  std::size_t engine(std::uint8_t unit, std::span<const std::uint8_t> pdu, std::uint8_t exception,
-                     std::span<std::uint8_t, kModbusMaxPdu> rsp);
-  std::size_t exception(std::uint8_t unit, std::span<const std::uint8_t> pdu, std::uint8_t code,
-                        std::span<std::uint8_t, kModbusMaxPdu> rsp);
 
   ProcessSource& m_source;
   ModbusGatewayOptions m_options;
   ModbusMap m_map;
   ModbusGatewayStats m_stats;
-  _modbus* m_ctx = nullptr;
-  _modbus_mapping_t* m_mapping = nullptr;
-  int m_pair[2] = {-1, -1};
+  ModbusEngine m_engine;
 };
 
 }  // namespace pbvbus::gateways

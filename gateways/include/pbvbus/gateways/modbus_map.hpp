@@ -1,12 +1,14 @@
 #pragma once
-// The Modbus register layout of one master system (docs/gateway-modbus.md), built once from a ProcessSource
-// and the gateway options; `pbvbus gateway map` prints it (to_text/to_json/to_csv).
+// The Modbus register layout of one master system (docs/gateway-modbus.md), built once from a
+// ProcessSource and the gateway options; `pbvbus gateway map` prints it (to_text/to_json/to_csv).
 //
 // Decisions fixed by the integrator (docs/gateway-modbus.md has the tables):
 // - Unit id = PROFIBUS address of the slave (1..125). A slave at address 0 is not mapped
 //   (unit 0 is the gateway): the map carries a warning. With `standby_units` on a redundant
 //   source, unit address + 128 is the same switched station seen through the Standby side
-//   (read-only); a one-sided slave has no standby unit (0x0A).
+//   (read-only); a one-sided slave has no standby unit (0x0A), nor has a slave above address
+//   119 (its unit would be a reserved Modbus address 248..253; seed 003 keeps the standby
+//   at <= 247): the map carries a warning.
 // - Input registers (FC04) from 0: the input telegram, each module starting on a new register,
 //   its first octet in the high byte; an odd-length module's last register has 0 in the low
 //   byte. Holding registers (FC03/06/16/23) from 0: the output telegram, same rule.
@@ -130,7 +132,7 @@ class ModbusMap {
   ModbusMap(const ProcessSource& source, const ModbusGatewayOptions& options);
 
   std::span<const ModbusUnitMap> units() const { return m_units; }
-  /// A process-data unit (1..125, or 129..253 standby); nullptr for any other unit.
+  /// A process-data unit (1..125, or 129..247 standby); nullptr for any other unit.
   const ModbusUnitMap* unit(std::uint8_t unit) const;
   bool gateway_units() const { return m_gateway_units; }
   /// E.g. a slave at address 0 that could not be mapped.

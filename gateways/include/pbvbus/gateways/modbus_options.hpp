@@ -36,13 +36,19 @@ struct ModbusSlaveOptions {
   std::uint16_t stale_value = 0;
 };
 
+/// Highest slave address with a standby unit (address + 128 = 247, the highest individual
+/// Modbus address; 248..255 are reserved, Modbus over Serial Line V1.02 §2.2).
+inline constexpr std::uint8_t kMaxStandbyAddress = 119;
+
 struct ModbusGatewayOptions {
   /// Per PROFIBUS address; slaves not listed get the defaults.
   std::map<std::uint8_t, ModbusSlaveOptions> slaves;
   /// Units 0 and 255 answer as the gateway itself (live list, counters, master mode).
   bool gateway_units = true;
   /// Quantum-style standby addressing (seeds-digest Q3): unit = address + 128 shows the
-  /// Standby side of a redundant source, read-only. Ignored for a plain master system.
+  /// Standby side of a redundant source, read-only. Ignored for a plain master system. Only
+  /// for addresses 1..kMaxStandbyAddress (seed 003: primary 1..119, standby <= 247): a slave
+  /// above 119 is reachable only at its primary unit (the map carries a warning).
   bool standby_units = false;
 
   const ModbusSlaveOptions& slave(std::uint8_t address) const {

@@ -260,7 +260,6 @@ void ActiveStation::set_passive(bool on, bus::Ticks now) {
     return;
   }
   m_passive = false;
-  m_shadow_da = kNobody;
   if (!m_powered) return;
   // Like a station that just lost the token: Listen_Token, TTO from the last frame heard.
   m_state = MacState::Listen_Token;
@@ -275,12 +274,13 @@ void ActiveStation::set_passive(bool on, bus::Ticks now) {
   arm(std::max(now, m_last_activity + m_tto));
 }
 
-void ActiveStation::observe(const Telegram& t, bool valid, bus::Ticks now) {
+void ActiveStation::shadow_fcb(const Telegram& t, bool valid) {
+  // FCB shadow (§C.6): a completed cycle of the (other) master at our address toggles its FCB
+  // towards that responder, exactly as it does in that master.
   if (!valid) {
     m_shadow_da = kNobody;
     return;
   }
-  // FCB shadow (§C.6): a completed cycle of the active master at our address toggles its FCB.
   if (t.is_request() && t.sa == m_ts) {
     const RequestFn fn = fc_request_fn(t.fc);
     if (fn_uses_fcb(fn) && t.da < kBroadcast) {
@@ -297,6 +297,11 @@ void ActiveStation::observe(const Telegram& t, bool valid, bus::Ticks now) {
   } else {
     m_shadow_da = kNobody;
   }
+}
+
+void ActiveStation::observe(const Telegram& t, bool valid, bus::Ticks now) {
+  shadow_fcb(t, valid);
+  if (!valid) return;
   // LAS: as in Listen_Token / Active_Idle.
   if (t.type == FrameType::SD4) {
     if (!m_las_valid) {
@@ -330,6 +335,9 @@ void ActiveStation::on_frame(const bus::RxFrame& f) {
     observe(t, valid, now);
     return;
   }
+  // Not holding the token: keep following the FCB of a master sending with our address (the
+  // reply to the last request seen while passive, or a duplicate address, see the header).
+  if (m_state == MacState::Listen_Token || m_state == MacState::Active_Idle) shadow_fcb(t, valid);
   if (valid && t.type != FrameType::SC && t.sa == m_ts) {
     // Someone else sends with our address.
     if (++m_dup_seen >= 2) {

@@ -81,7 +81,9 @@
 // listening all along), so on a line silent for TTO it claims at once, otherwise when TTO
 // expires (IEC 61158-4-3 claim after TTO; the FC310x's ClaimTokenTimeout (6 + 2·TS)·TSL). The
 // first request to a responder then carries the shadowed FCB (FCV=1, toggled), or the first
-// frame FCV=0/FCB=1 if no completed cycle was seen. If the old master is still sending, its
+// frame FCV=0/FCB=1 if no completed cycle was seen. Outside the token (Listen_Token,
+// Active_Idle) the station keeps following the FCB of cycles run with its SA by someone else
+// (the reply to a request seen while passive; a master at a duplicate address). If the old master is still sending, its
 // frames with our SA are a duplicate address: the station stays in Listen_Token (never claims
 // on a busy line) until the line falls silent — the misuse resolves without a collision.
 //
@@ -209,6 +211,7 @@ class ActiveStation final : public bus::Device {
   // Frame handling per state.
   void handle_passive(const bus::RxFrame& f, const Telegram& t, bool valid);
   void observe(const Telegram& t, bool valid, bus::Ticks now);
+  void shadow_fcb(const Telegram& t, bool valid);
   void answer_request(const bus::RxFrame& f, const Telegram& t);
   void token_to_me(const bus::RxFrame& f, const Telegram& t);
   void await_data_frame(const bus::RxFrame& f, const Telegram& t, bool valid);

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "confirmation_kind.hpp"
+
 #include "pbvbus/dp/master.hpp"
 
 namespace pbvbus::dp {
@@ -144,7 +145,8 @@ void Master::shadow_request(bus::Ticks now, const fdl::Telegram& t) {
   }
   switch (*t.dsap) {
     case kSapSetPrm:
-      if (t.data.size() == kPrmLenPureCmd && !s.p.prm_cmd.empty()) break;  // pure PrmCmd: stays in DX
+      if (t.data.size() == kPrmLenPureCmd && !s.p.prm_cmd.empty())
+        break;  // pure PrmCmd: stays in DX
       s.sh_dx = false;
       s.sh_prm_ok = shadow_same(t.data, s.prm);
       break;
@@ -156,7 +158,8 @@ void Master::shadow_request(bus::Ticks now, const fdl::Telegram& t) {
       m_sh_slave = idx;
       m_sh_kind = Kind::Diag;
       break;
-    default: break;
+    default:
+      break;
   }
 }
 
@@ -180,8 +183,8 @@ void Master::shadow_reply(Slave& s, Kind kind, const fdl::Telegram& t) {
   }
   if (kind == Kind::Diag && !sc && t.data.size() >= kStdDiagLen) {
     const std::uint8_t s1 = t.data[0], s2 = t.data[1];
-    if ((s1 & (kDiagStationNotReady | kDiagCfgFault | kDiagPrmFault | kDiagNotSupported)) != 0 || (s2 & kDiagPrmReq) != 0 ||
-        t.data[3] != m_p.address)
+    if ((s1 & (kDiagStationNotReady | kDiagCfgFault | kDiagPrmFault | kDiagNotSupported)) != 0 ||
+        (s2 & kDiagPrmReq) != 0 || t.data[3] != m_p.address)
       s.sh_dx = false;
   }
 }

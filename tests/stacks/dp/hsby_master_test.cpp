@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "frame_recorder.hpp"
+
 #include "pbvbus/bus/line.hpp"
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/dp/master.hpp"
@@ -39,9 +40,9 @@ const std::vector<std::uint8_t> kSlaves{10, 11, 12};
 // TTO(1) = 6·TSL + 2·1·TSL = 2400 t_bit; a character is 11 t_bit.
 constexpr std::int64_t kTid1 = 37;
 constexpr std::int64_t kTto1 = 6 * 300 + 2 * 1 * 300;
-constexpr std::int64_t kTokenBits = 3 * 11;     // DC 01 01
-constexpr std::int64_t kDxBits = 10 * 11;       // 68 04 04 68 DA SA FC out FCS 16
-constexpr std::int64_t kMinTsdr = 11;           // the slaves' TSDR after Set_Prm (min_tsdr = 11)
+constexpr std::int64_t kTokenBits = 3 * 11;  // DC 01 01
+constexpr std::int64_t kDxBits = 10 * 11;    // 68 04 04 68 DA SA FC out FCS 16
+constexpr std::int64_t kMinTsdr = 11;        // the slaves' TSDR after Set_Prm (min_tsdr = 11)
 // Claim (§C.4): DC TS TS at t, again TID1 after its end; the second one is the token receipt,
 // and the first request starts TID1 after its end.
 constexpr std::int64_t kClaimToFirstRequest = kTokenBits + kTid1 + kTokenBits + kTid1;  // 140

@@ -126,6 +126,7 @@ Master::Master(MasterParams params, std::vector<SlaveParams> slaves) : m_p(std::
     m_slaves.push_back(std::move(s));
   }
   m_mode = m_p.initial_mode;
+  m_standby = m_p.standby;
   m_scratch.reserve(kMaxDiagLen);
   reset_slaves();
 }
@@ -190,6 +191,7 @@ void Master::reset_slaves() {
     s.last_retry = bus::kNever;
     s.diag_after_dh = false;
     s.alarms_seen.clear();
+    s.probe = false;
     if (!s.p.active) {
       s.state = SlaveStatusState::Inactive;
       const StandardDiag d{0, kDiagDeactivated, 0, kNoMaster, s.p.ident};
@@ -232,6 +234,7 @@ void Master::on_power_on(bus::Ticks now) {
   m_out_slave = -1;
   m_last_gc = bus::kNever;
   reset_slaves();
+  reset_shadow();
 }
 
 void Master::on_token(bus::Ticks now, bus::Ticks /*trr*/) {
@@ -268,6 +271,7 @@ bool Master::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out)
   m_now = now;
   // All DP traffic is high priority (§B.4); a low-priority ask means we had nothing.
   if (prio != fdl::Priority::High) return false;
+  if (m_standby) return false;  // a hot-standby master only listens
   if (m_mode != MasterMode::Clear && m_mode != MasterMode::Operate) return false;
   if (m_out_kind != Kind::None) return false;  // one request at a time
 
@@ -617,6 +621,7 @@ void Master::on_dx(Slave& s, const Confirmation& con) {
     }
     s.image->publish_inputs(zero_ok ? std::span<const std::uint8_t>{} : con.data);
     ++s.stats.data_exchanges;
+    if (s.probe) probe_done(s, true);
     if (!zero_ok && con.status == ResponseStatus::DH) {
       ++s.stats.dh;
       s.diag_after_dh = true;
@@ -755,6 +760,7 @@ void Master::failure_event(Slave& s, bus::Ticks now, MasterEvent::Cause cause) {
 }
 
 void Master::restart(Slave& s, bus::Ticks now, MasterEvent::Cause cause) {
+  if (s.probe) probe_done(s, false);
   const bool was_in_dx = s.in_dx;
   s.in_dx = false;
   s.image->set_valid(false);
@@ -771,6 +777,7 @@ void Master::restart(Slave& s, bus::Ticks now, MasterEvent::Cause cause) {
 
 void Master::no_response(Slave& s, bus::Ticks now) {
   ++s.stats.no_response;
+  if (s.probe) probe_done(s, false);
   const bool was_in_dx = s.in_dx;
   s.in_dx = false;
   s.image->set_valid(false);

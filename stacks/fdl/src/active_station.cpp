@@ -237,8 +237,82 @@ void ActiveStation::on_power_on(bus::Ticks now) {
   m_nonop.reset();
   m_responder.reset();
   m_last_activity = now;
+  m_shadow_da = kNobody;
   m_user.on_power_on(now);
+  if (m_passive) {
+    m_timer_at = bus::kNever;
+    return;
+  }
   arm_tto();
+}
+
+void ActiveStation::set_passive(bool on, bus::Ticks now) {
+  if (on == m_passive) return;
+  if (on) {
+    // Give up whatever this station was doing on the line (a held token, an awaited reply).
+    if (m_powered && m_state != MacState::Listen_Token && m_state != MacState::Active_Idle)
+      leave_ring(now);
+    m_passive = true;
+    m_shadow_da = kNobody;
+    if (m_powered) m_state = MacState::Listen_Token;
+    m_in_ring = false;
+    m_timer_at = bus::kNever;
+    return;
+  }
+  m_passive = false;
+  if (!m_powered) return;
+  // Like a station that just lost the token: Listen_Token, TTO from the last frame heard.
+  m_state = MacState::Listen_Token;
+  m_in_ring = false;
+  m_dup_seen = 0;
+  m_token_at = bus::kNever;
+  m_token_candidate = kNobody;
+  m_pass_failures = 0;
+  m_pass_next = false;
+  m_sdn_pending = false;
+  m_nonop.reset();
+  arm(std::max(now, m_last_activity + m_tto));
+}
+
+void ActiveStation::shadow_fcb(const Telegram& t, bool valid) {
+  // FCB shadow (§C.6): a completed cycle of the (other) master at our address toggles its FCB
+  // towards that responder, exactly as it does in that master.
+  if (!valid) {
+    m_shadow_da = kNobody;
+    return;
+  }
+  if (t.is_request() && t.sa == m_ts) {
+    const RequestFn fn = fc_request_fn(t.fc);
+    if (fn_uses_fcb(fn) && t.da < kBroadcast) {
+      m_shadow_da = t.da;
+      m_shadow_fcb = fc_fcb(t.fc);
+    } else {
+      m_shadow_da = kNobody;
+    }
+  } else if (m_shadow_da != kNobody &&
+             (t.type == FrameType::SC ||
+              (t.type != FrameType::SD4 && !t.is_request() && t.da == m_ts && t.sa == m_shadow_da))) {
+    m_fcb_state[m_shadow_da] = m_shadow_fcb ? 1 : 2;
+    m_shadow_da = kNobody;
+  } else {
+    m_shadow_da = kNobody;
+  }
+}
+
+void ActiveStation::observe(const Telegram& t, bool valid, bus::Ticks now) {
+  shadow_fcb(t, valid);
+  if (!valid) return;
+  // LAS: as in Listen_Token / Active_Idle.
+  if (t.type == FrameType::SD4) {
+    if (!m_las_valid) {
+      discovery_token(t.sa);
+    } else {
+      las_token_seen(t.sa, t.da);
+    }
+    m_in_ring = false;
+  }
+  ++m_stats.frames_observed;
+  m_user.on_observed(now, t);
 }
 
 void ActiveStation::on_power_off(bus::Ticks) {
@@ -257,6 +331,13 @@ void ActiveStation::on_frame(const bus::RxFrame& f) {
   const bool valid = d.ok();
   const Telegram& t = d.telegram;
 
+  if (m_passive) {
+    observe(t, valid, now);
+    return;
+  }
+  // Not holding the token: keep following the FCB of a master sending with our address (the
+  // reply to the last request seen while passive, or a duplicate address, see the header).
+  if (m_state == MacState::Listen_Token || m_state == MacState::Active_Idle) shadow_fcb(t, valid);
   if (valid && t.type != FrameType::SC && t.sa == m_ts) {
     // Someone else sends with our address.
     if (++m_dup_seen >= 2) {
@@ -296,7 +377,7 @@ void ActiveStation::on_frame(const bus::RxFrame& f) {
 }
 
 void ActiveStation::on_timer(bus::Ticks now) {
-  if (!m_powered) return;
+  if (!m_powered || m_passive) return;
   if (now < m_timer_at) {
     port().set_timer(m_timer_at);
     return;

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <new>
 
+#include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_engine.hpp"
 
 namespace {
@@ -70,6 +71,53 @@ TEST(SlaveAllocation, DataExchangeDoesNotAllocate) {
   EXPECT_EQ(t_allocations, 0);
   EXPECT_TRUE(e.freeze_mode());
   EXPECT_EQ(reply.status, fdl::ResponseStatus::DL);
+}
+
+// The hot-standby master's shadow (master_hsby.cpp) runs for every frame on the line: following
+// the active master's Data_Exchange cycles does not allocate either. (Here because this file
+// holds the binary's replacement of operator new.)
+TEST(SlaveAllocation, StandbyMasterShadowDoesNotAllocate) {
+  SlaveParams sp;
+  sp.address = 10;
+  sp.ident = 0x1234;
+  sp.modules = {{{0xDF}, "32 in"}, {{0xEF}, "32 out"}};
+  MasterParams mp;
+  mp.standby = true;
+  Master m(mp, {sp});
+  m.on_power_on(0);
+  std::vector<std::uint8_t> out(32, 0x5A), in(32, 0x11);
+  fdl::Telegram req;
+  req.type = fdl::FrameType::SD2;
+  req.da = 10;
+  req.sa = 1;
+  req.fc = fdl::make_request_fc(fdl::RequestFn::SrdHigh, true, true);
+  req.data = out;
+  fdl::Telegram rsp;
+  rsp.type = fdl::FrameType::SD2;
+  rsp.da = 1;
+  rsp.sa = 10;
+  rsp.fc = fdl::make_response_fc(fdl::StationType::Slave, fdl::ResponseStatus::DL);
+  rsp.data = in;
+  fdl::Telegram token;
+  token.type = fdl::FrameType::SD4;
+  token.da = 1;
+  token.sa = 1;
+  m.on_observed(1, req);
+  m.on_observed(2, rsp);
+  ASSERT_TRUE(m.shadow_in_dx(10));
+  t_counting = true;
+  for (int i = 0; i < 1000; ++i) {
+    out[0] = static_cast<std::uint8_t>(i);
+    m.on_observed(10 * i + 3, req);
+    m.on_observed(10 * i + 4, rsp);
+    m.on_observed(10 * i + 5, token);
+  }
+  t_counting = false;
+  EXPECT_EQ(t_allocations, 0);
+  EXPECT_EQ(m.hsby_stats().dx_observed, 1001u);
+  std::vector<std::uint8_t> got(32);
+  ASSERT_EQ(m.image(10).read_outputs(1, got), ImageAccess::Ok);
+  EXPECT_EQ(got[0], static_cast<std::uint8_t>(999));
 }
 
 }  // namespace

@@ -62,6 +62,25 @@
 // - The API (set_mode, read, write, alarm_ack, global_control) is for the bus thread only, like
 //   the callbacks it triggers; the process images (image()) may be used from any thread.
 //
+// Hot standby (docs/quantum-hsby-dp.md; ProSoft PTQ-PDPMV1 for Quantum Hot Standby, Beckhoff
+// FC310x redundancy master). A master in standby sits on a passive (listen-only) ActiveStation
+// at the same address as the active master of the pair and runs no requests. From the frames the
+// station reports (on_observed) it shadows, per slave, whether the active master has it in data
+// exchange (a Data_Exchange answered with the configured input length; out again by a Set_Prm,
+// a Chk_Cfg, an RS/UE/RR or wrong-length answer, or a diagnosis showing Not_Ready, a fault,
+// Prm_Req or another master), whether the Set_Prm/Chk_Cfg it saw carried exactly this master's
+// parameters (unseen = assumed equal: both modules of a pair hold the same configuration), the
+// outputs last sent (copied into image(): outputs continue from what the slaves hold; the
+// application may overwrite them before the takeover), the inputs answered (published, but
+// data_valid() stays false), and the last Global_Control. take_over(now) leaves standby: every
+// slave the shadow saw in data exchange with our parameters goes straight to DataExchange (no
+// Set_Prm/Chk_Cfg — a Set_Prm would take the slave out of data exchange and clear its outputs),
+// no event; every other slave starts up normally. A resumed slave whose first Data_Exchange is
+// not answered as expected starts up normally too (the usual failure handling and events).
+// Global_Control is owed at once only if the last one seen did not announce our mode; otherwise
+// its interval runs on from the one seen. The station is switched separately:
+// ActiveStation::set_passive(false, now) right after take_over(now).
+//
 // Performance: the steady Data_Exchange path does not allocate (the Request's data vector keeps
 // its capacity, cycle statistics use a fixed ring).
 
@@ -136,6 +155,17 @@ struct MasterParams {
   bus::Ticks global_control_interval = 0;  ///< 0 = Data_Control_Time / 2
   bus::Ticks failed_retry_interval = 0;    ///< minimum time between Slave_Diag retries of an
                                            ///< absent or locked slave; 0 = once per pass
+  bool standby = false;                    ///< start in hot standby (see set_standby())
+};
+
+/// Counters of the hot-standby takeovers (see the header comment).
+struct HsbyStats {
+  std::uint64_t takeovers = 0;
+  std::uint64_t resumed = 0;    ///< slaves whose first Data_Exchange after a takeover succeeded
+  std::uint64_t restarted = 0;  ///< slaves started up after a takeover (not in DX in the shadow,
+                                ///< or their first Data_Exchange failed)
+  std::uint64_t frames_observed = 0;  ///< frames reported while in standby
+  std::uint64_t dx_observed = 0;      ///< the active master's completed Data_Exchange cycles
 };
 
 /// The master's view of a slave.
@@ -266,11 +296,23 @@ class Master final : public fdl::InitiatorUser {
   std::uint32_t alarm_ack(std::uint8_t address, std::uint8_t slot, std::uint8_t type,
                           std::uint8_t specifier, AcyclicCallback cb);
 
+  // --- hot standby (see the header comment) ---
+  /// Enter or leave standby. Entering keeps the master's own view of each slave as the start of
+  /// the shadow; leaving through set_standby(false) is take_over(m_now).
+  void set_standby(bool on);
+  bool standby() const { return m_standby; }
+  /// Leave standby and resume the slaves the shadow saw in data exchange.
+  void take_over(bus::Ticks now);
+  /// Whether the shadow currently sees the slave in data exchange with the active master.
+  bool shadow_in_dx(std::uint8_t address) const;
+  const HsbyStats& hsby_stats() const { return m_hsby; }
+
   // --- fdl::InitiatorUser ---
   void on_power_on(bus::Ticks now) override;
   bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override;
   void on_confirmation(const fdl::Confirmation& con) override;
   void on_token(bus::Ticks now, bus::Ticks trr) override;
+  void on_observed(bus::Ticks now, const fdl::Telegram& t) override;
 
  private:
   enum class Kind : std::uint8_t { None, GlobalControl, Diag, Prm, Cfg, DataExchange, Acyclic, PrmCmd };
@@ -318,6 +360,11 @@ class Master final : public fdl::InitiatorUser {
     MasterSlaveStats stats;
     std::array<bus::Ticks, kCycleSamples> cycles{};
     std::size_t cycle_pos = 0;
+    // Hot-standby shadow of the active master's view (master_hsby.cpp).
+    bool sh_dx = false;
+    bool sh_prm_ok = true;
+    bool sh_cfg_ok = true;
+    bool probe = false;  ///< resumed at a takeover, first Data_Exchange not yet answered
   };
 
   Slave& slave(std::uint8_t address);
@@ -344,6 +391,10 @@ class Master final : public fdl::InitiatorUser {
   void fail_jobs(Slave& s, bus::Ticks now);
   std::uint32_t queue_job(std::uint8_t address, Job job);
   void reset_slaves();
+  void reset_shadow();
+  void shadow_request(bus::Ticks now, const fdl::Telegram& t);
+  void shadow_reply(Slave& s, Kind kind, const fdl::Telegram& t);
+  void probe_done(Slave& s, bool ok);
   void emit(const MasterEvent& e) {
     if (m_events) m_events(e);
   }
@@ -370,6 +421,15 @@ class Master final : public fdl::InitiatorUser {
   Kind m_out_kind = Kind::None;
   int m_out_slave = -1;
   bool m_out_dh_diag = false;
+
+  // Hot standby.
+  bool m_standby = false;
+  HsbyStats m_hsby;
+  int m_sh_slave = -1;  ///< slave of the last observed request, awaiting its answer
+  Kind m_sh_kind = Kind::None;
+  bool m_sh_gc_seen = false;
+  bool m_sh_gc_clear = false;
+  bus::Ticks m_sh_gc_at = bus::kNever;
 
   std::uint32_t m_next_job_id = 1;
   std::vector<std::uint8_t> m_scratch;

@@ -67,6 +67,26 @@
 //  - Requests addressed to this master are answered like a passive station would (FCB filter,
 //    SAP mirroring, TSDR = min TSDR), with the FC's station type bits telling our MAC state.
 //
+// Passive (listen-only) mode, for a hot-standby master at the same address as an active one
+// (docs/quantum-hsby-dp.md; Beckhoff FC310x "Redundancy Mode", ProSoft PTQ-PDPMV1 passive
+// master): set_passive(true, now). The station then sends nothing at all (no token, no claim,
+// no reply, no FDL Status answer) and runs no timer, but it keeps receiving: every valid frame
+// goes to InitiatorUser::on_observed(); frames carrying its own SA are not taken for a
+// duplicate address (they are the active master's, which the passive one shadows); tokens keep
+// the LAS (Listen_Token discovery, then the live LAS rules); and it shadows the active master's
+// FCB towards each responder (a request from our SA with FCV/FCB, then a valid reply or SC from
+// that responder: the next FCB is the toggled one, exactly as the active master's own state).
+// set_passive(false, now) leaves it like a station that just lost the token: Listen_Token with
+// the LAS it tracked, and TTO counted from the end of the last frame heard (the station has been
+// listening all along), so on a line silent for TTO it claims at once, otherwise when TTO
+// expires (IEC 61158-4-3 claim after TTO; the FC310x's ClaimTokenTimeout (6 + 2·TS)·TSL). The
+// first request to a responder then carries the shadowed FCB (FCV=1, toggled), or the first
+// frame FCV=0/FCB=1 if no completed cycle was seen. Outside the token (Listen_Token,
+// Active_Idle) the station keeps following the FCB of cycles run with its SA by someone else
+// (the reply to a request seen while passive; a master at a duplicate address). If the old master is still sending, its
+// frames with our SA are a duplicate address: the station stays in Listen_Token (never claims
+// on a busy line) until the line falls silent — the misuse resolves without a collision.
+//
 // Steady state is allocation-free: the Request given to the user and the rotation sample
 // buffer are members reused from visit to visit.
 
@@ -115,6 +135,7 @@ struct ActiveStats {
   std::uint64_t duplicate_token = 0;     ///< foreign frames heard while holding the token
   std::uint64_t duplicate_address = 0;   ///< own address detected in use by another station
   std::uint64_t requests_answered = 0;   ///< requests from other masters answered
+  std::uint64_t frames_observed = 0;     ///< valid frames reported while passive
   std::array<std::uint64_t, 16> requests_by_fn{};  ///< message cycles by request function
 };
 
@@ -130,6 +151,13 @@ class ActiveStation final : public bus::Device {
   void on_frame(const bus::RxFrame& frame) override;
   void on_timer(bus::Ticks now) override;
   const char* kind() const override { return "active station"; }
+
+  /// Passive (listen-only) mode, see the header comment. May be called before power-on.
+  void set_passive(bool on, bus::Ticks now);
+  bool passive() const { return m_passive; }
+  /// Next FCB state towards `a` (0 = first frame FCV=0/FCB=1 next, 1 = FCB 0 next, 2 = FCB 1
+  /// next), as used or, while passive, as shadowed from the active master.
+  std::uint8_t fcb_state(std::uint8_t a) const { return a < 128 ? m_fcb_state[a] : 0; }
 
   MacState state() const { return m_state; }
   std::uint8_t address() const { return m_ts; }
@@ -182,6 +210,8 @@ class ActiveStation final : public bus::Device {
   void set_live(std::uint8_t a, std::optional<StationType> t);
   // Frame handling per state.
   void handle_passive(const bus::RxFrame& f, const Telegram& t, bool valid);
+  void observe(const Telegram& t, bool valid, bus::Ticks now);
+  void shadow_fcb(const Telegram& t, bool valid);
   void answer_request(const bus::RxFrame& f, const Telegram& t);
   void token_to_me(const bus::RxFrame& f, const Telegram& t);
   void await_data_frame(const bus::RxFrame& f, const Telegram& t, bool valid);
@@ -208,6 +238,10 @@ class ActiveStation final : public bus::Device {
   std::uint8_t m_ts;
   MacState m_state = MacState::Offline;
   bool m_powered = false;
+  bool m_passive = false;
+  // Passive FCB shadow: the responder of the last request from our SA with an FCB, and that FCB.
+  std::uint8_t m_shadow_da = kNobody;
+  bool m_shadow_fcb = false;
 
   // Durations in ticks.
   bus::Ticks m_tsyn, m_tid1, m_tid2, m_tsl, m_tto, m_ttr, m_gap_reserve, m_token_len;

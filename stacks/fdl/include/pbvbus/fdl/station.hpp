@@ -122,6 +122,11 @@ class InitiatorUser {
   virtual void on_request(const Indication& /*ind*/, Reply& /*reply*/) {}
   /// Token received (for statistics and the DP master's timing); trr = real rotation time.
   virtual void on_token(bus::Ticks /*now*/, bus::Ticks /*trr*/) {}
+  /// Passive (listen-only) mode of the station (ActiveStation::set_passive): every valid frame
+  /// heard on the line, `now` = its end. The telegram's data is valid only during the call.
+  /// Used by a hot-standby DP master to shadow the active master at the same address
+  /// (docs/quantum-hsby-dp.md).
+  virtual void on_observed(bus::Ticks /*now*/, const Telegram& /*t*/) {}
 
  protected:
   ~InitiatorUser() = default;

@@ -110,11 +110,11 @@ struct HsbyPairParams {
 };
 
 enum class SwitchoverCause : std::uint8_t {
-  PrimaryPowerOff,   ///< unplanned: the primary rack lost power
-  PrimaryCpuStop,    ///< unplanned: the primary's CPU stopped
-  LinkSilent,        ///< unplanned: no transfer and the line silent, the primary's fate unknown
-  KeyOffLine,        ///< planned: the primary's key to Off Line
-  CommandRegister,   ///< planned: override, the primary's run bit 0 (both 0 included)
+  PrimaryPowerOff,  ///< unplanned: the primary rack lost power
+  PrimaryCpuStop,   ///< unplanned: the primary's CPU stopped
+  LinkSilent,       ///< unplanned: no transfer and the line silent, the primary's fate unknown
+  KeyOffLine,       ///< planned: the primary's key to Off Line
+  CommandRegister,  ///< planned: override, the primary's run bit 0 (both 0 included)
 };
 std::string_view to_string(SwitchoverCause c);
 
@@ -129,8 +129,18 @@ struct SwitchoverRecord {
 };
 
 enum class PairEventKind : std::uint8_t {
-  Power, Key, State, Switchover, TransferLost, LogicMismatch, DuplicateDesignation, Fibre,
-  Update, Override, Cpu, Ignored,
+  Power,
+  Key,
+  State,
+  Switchover,
+  TransferLost,
+  LogicMismatch,
+  DuplicateDesignation,
+  Fibre,
+  Update,
+  Override,
+  Cpu,
+  Ignored,
 };
 std::string_view to_string(PairEventKind k);
 
@@ -156,8 +166,8 @@ class HsbyPair final : public bus::EventTarget {
   HsbyPair& operator=(const HsbyPair&) = delete;
 
   // ---- the program (per rack: a logic mismatch runs a different program) ----
-  void set_logic(UserLogic logic);           ///< both racks
-  void set_logic(int rack, UserLogic logic); ///< one rack
+  void set_logic(UserLogic logic);            ///< both racks
+  void set_logic(int rack, UserLogic logic);  ///< one rack
   /// Loads a different program on one rack (program identity `checksum`), e.g. to make a
   /// mismatch; the pair reconciles (a mismatching standby goes Offline by default).
   void load_program(int rack, std::uint32_t checksum, UserLogic logic);
@@ -236,16 +246,21 @@ class HsbyPair final : public bus::EventTarget {
     std::uint64_t scan_gen = 0;
     bus::Ticks next_scan = bus::kNever;  ///< the primary's next scan start
     bus::Ticks last_scan = bus::kNever;
-    std::uint64_t watch_gen = 0;         ///< the standby's transfer watchdog
+    std::uint64_t watch_gen = 0;                   ///< the standby's transfer watchdog
     bus::Ticks last_transfer_start = bus::kNever;  ///< as seen by this standby
-    std::string blocker;                 ///< why it last could not join (logged on change)
+    std::string blocker;  ///< why it last could not join (logged on change)
+  };
+  struct TransferValue {
+    RefType type = RefType::Coil0x;
+    std::uint32_t index = 0;
+    std::uint16_t value = 0;
   };
   struct InFlight {
     bool active = false;
     std::uint64_t gen = 0;
     int from = -1, to = -1;
     bus::Ticks scan_start = 0;
-    StateRam snapshot;
+    std::vector<TransferValue> values;  ///< the snapshot, in the plan's order
   };
   struct PendingFailure {
     bool active = false;
@@ -265,25 +280,26 @@ class HsbyPair final : public bus::EventTarget {
 
   void log(int rack, PairEventKind kind, std::string text);
   void set_state(int rack, CpuState s, std::string_view why);
-  bool run_bit(int rack) const;   // the override's run bit for rack's designation
+  bool run_bit(int rack) const;  // the override's run bit for rack's designation
   bool wants_run(int rack) const;
   bool wants_offline(int rack) const;
   std::string join_blocker(int rack) const;  // "" = may be Standby beside the other's Primary
-  void try_join_as_primary(int rack);        // the unit's own event (power, key, CPU start)
-  void become_primary(int rack, bus::Ticks now);
+  void join_on_own_event(int rack);          // power-on, key to Run, CPU start, update done
+  void become_primary(int rack, bus::Ticks now, const SwitchoverRecord* rec);
   void lose_in_flight(std::string_view why);
   void primary_gone(int rack, SwitchoverCause cause);
+  void abort_update(int rack, std::string_view why);
   void reconcile();
   void update_heads();
   void write_status(int rack);
   void arm_scan(int rack, bus::Ticks at);
   void arm_watch(int standby_rack);
+  void arm_update(int rack);
   void scan(int rack, bus::Ticks now);
   void transfer_done(std::uint64_t gen, bus::Ticks now);
   void watch(int rack, bus::Ticks now);
   void handover(int old_rack, bus::Ticks now);
   void update_done(int rack, bus::Ticks now);
-  void check_update_start(int rack);
 
   bus::Scheduler& m_sched;
   HsbyPairParams m_p;
@@ -293,6 +309,8 @@ class HsbyPair final : public bus::EventTarget {
   FibreState m_fibre = FibreState::Ok;
   InFlight m_flight;
   std::uint64_t m_flight_gen = 0;
+  bus::Ticks m_link_fault_time = 0;
+  bool m_alone_logged = false;  ///< "no standby to hand over to" logged since the last standby
   PendingFailure m_failure;
   PendingHandover m_handover;
   std::uint64_t m_transfers_done = 0;

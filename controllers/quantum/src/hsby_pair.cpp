@@ -259,6 +259,10 @@ void HsbyPair::set_state(int r, CpuState s, std::string_view why) {
   if (m_flight.active && (r == m_flight.from || r == m_flight.to))
     lose_in_flight(rack_name(r) + " " + std::string(to_string(s)));
   if (s == CpuState::Standby) m_alone_logged = false;
+  if (s == CpuState::Primary) {
+    k.primary_since = m_sched.now();
+    k.scans_as_primary = 0;
+  }
   k.state = s;
   if (s != CpuState::Primary) ++k.scan_gen;
   if (s == CpuState::Standby) arm_watch(r);
@@ -340,6 +344,15 @@ void HsbyPair::reconcile() {
       abort_update(r, "no CHS communication");
     else if (m_p.keyswitch_override)
       abort_update(r, "keyswitch override");
+  }
+  // Two primaries (a standby took over while the fibre and its line were both silent) hear
+  // each other again over the fibre: the later one gives control back and goes offline.
+  if (rk(0).state == CpuState::Primary && rk(1).state == CpuState::Primary &&
+      m_fibre == FibreState::Ok) {
+    const int later = rk(1).primary_since >= rk(0).primary_since ? 1 : 0;
+    log(later, PairEventKind::Switchover,
+        "two primaries meet again over the fibre: the later one goes offline");
+    set_state(later, CpuState::Offline, "second primary");
   }
   // The primary asked to go offline: the handover at its next scan boundary, if a standby
   // is there to take control; alone it keeps control. Before the standby's own rules (the

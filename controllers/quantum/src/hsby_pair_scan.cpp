@@ -49,7 +49,9 @@ void HsbyPair::on_event(bus::Ticks now, std::uint64_t tag) {
   switch (kind) {
     case kHsbyScan: {
       if (gen != rk(r).scan_gen || rk(r).state != CpuState::Primary) return;
-      if (m_handover.active) {
+      // A handover ends a scan: a new primary always runs its first scan (so two units whose
+      // command registers disagree cannot hand control back and forth within one instant).
+      if (m_handover.active && rk(r).scans_as_primary > 0) {
         const int o = 1 - r;
         if (rk(o).state == CpuState::Standby && wants_offline(r)) {
           handover(r, now);
@@ -78,6 +80,7 @@ void HsbyPair::scan(int r, bus::Ticks now) {
   Rack& p = rk(r);
   const int o = 1 - r;
   ++p.scans;
+  ++p.scans_as_primary;
   p.last_scan = now;
   // The command register (override) and every unit's status register at the scan start.
   reconcile();

@@ -183,6 +183,11 @@ TEST(HsbyFailover, FibreCutAndLineSilentBothBecomePrimary) {
   ASSERT_EQ(g.pair.switchovers().size(), 1u);
   EXPECT_EQ(g.pair.switchovers()[0].cause, SwitchoverCause::LinkSilent);
   EXPECT_EQ(g.pair.switchovers()[0].cause_time, 25 * kMs);
+  // The fibre repaired: the later primary goes offline, then joins as standby (key at Run).
+  g.at(47 * kMs);
+  g.pair.set_fibre(FibreState::Ok);
+  EXPECT_EQ(g.pair.state(0), CpuState::Primary);
+  EXPECT_EQ(g.pair.state(1), CpuState::Standby);
 }
 
 TEST(HsbyFailover, HeadHearingTheLineAfterAPowerFailureMeansNoTakeover) {

@@ -13,8 +13,7 @@ using namespace hsby_test;
 
 constexpr std::uint16_t kRunA = 0x0002, kRunB = 0x0004;
 
-HsbyPairParams override_params(std::uint16_t bits) {
-  (void)bits;
+HsbyPairParams override_params() {
   HsbyPairParams p = small_params();
   p.keyswitch_override = true;
   return p;
@@ -28,7 +27,7 @@ void start_with_bits(Rig& g, std::uint16_t bits) {
 }
 
 TEST(HsbyOverride, RunBitsDecideAtStartupKeysIgnored) {
-  Rig g(override_params(0));
+  Rig g(override_params());
   start_with_bits(g, kRunA | kRunB);
   EXPECT_EQ(g.pair.state(0), CpuState::Primary);
   EXPECT_EQ(g.pair.state(1), CpuState::Standby);
@@ -38,7 +37,7 @@ TEST(HsbyOverride, RunBitsDecideAtStartupKeysIgnored) {
 }
 
 TEST(HsbyOverride, RunBitBZeroAtStartupKeepsBOffline) {
-  Rig g(override_params(0));
+  Rig g(override_params());
   start_with_bits(g, kRunA);
   EXPECT_EQ(g.pair.state(0), CpuState::Primary);
   EXPECT_EQ(g.pair.state(1), CpuState::Offline);
@@ -50,7 +49,7 @@ TEST(HsbyOverride, RunBitBZeroAtStartupKeepsBOffline) {
 }
 
 TEST(HsbyOverride, Q5BothRunBitsZeroSwitchoverOldPrimaryOffline) {
-  Rig g(override_params(0));
+  Rig g(override_params());
   start_with_bits(g, kRunA | kRunB);
   g.at(13 * kMs);
   g.pair.ram(0).set_holding(0, 0);  // both bits 0, written into the primary
@@ -72,7 +71,7 @@ TEST(HsbyOverride, Q5BothRunBitsZeroSwitchoverOldPrimaryOffline) {
 }
 
 TEST(HsbyOverride, StandbyRunBitZeroGoesOffline) {
-  Rig g(override_params(0));
+  Rig g(override_params());
   start_with_bits(g, kRunA | kRunB);
   g.at(13 * kMs);
   g.pair.ram(0).set_holding(0, kRunA);
@@ -96,7 +95,7 @@ TEST(HsbyOverride, EnablingAtRunTimeReadsTheBitsAtOnce) {
 }
 
 TEST(HsbyOverride, NoProgramUpdateAtTheModule) {
-  HsbyPairParams p = override_params(0);
+  HsbyPairParams p = override_params();
   p.racks[1].logic_checksum = 2;
   Rig g(p);
   start_with_bits(g, kRunA | kRunB);

@@ -203,6 +203,25 @@ TEST(HsbyPair, StandbyKeyToOffLineGoesOfflinePrimaryRunsAlone) {
   EXPECT_EQ(g.pair.ram(1).holding(1), 1);  // the transfer of the 10 ms scan carried 1
 }
 
+TEST(HsbyPair, EventLogPowerStatesSwitchover) {
+  Rig g;
+  g.pair.power_on(0);
+  g.pair.power_on(1);
+  g.at(25 * kMs);
+  g.pair.power_off(0);
+  g.at(30 * kMs);
+  std::vector<std::pair<int, PairEventKind>> got;
+  for (const auto& e : g.pair.events()) got.emplace_back(e.rack, e.kind);
+  const std::vector<std::pair<int, PairEventKind>> want = {
+      {0, PairEventKind::Power}, {0, PairEventKind::State},  // offline -> primary
+      {1, PairEventKind::Power}, {1, PairEventKind::State},  // offline -> standby
+      {0, PairEventKind::Power}, {0, PairEventKind::State},  // power off; primary -> off
+      {1, PairEventKind::State}, {1, PairEventKind::Switchover}};
+  EXPECT_EQ(got, want);
+  EXPECT_EQ(g.pair.events().back().time, 30 * kMs);
+  EXPECT_EQ(g.pair.events()[1].text, "offline -> primary (no other primary)");
+}
+
 TEST(HsbyPair, ConstructionRefusesBadParameters) {
   bus::Scheduler s;
   HsbyPairParams p = small_params();

@@ -246,6 +246,8 @@ class HsbyPair final : public bus::EventTarget {
     std::uint64_t scan_gen = 0;
     bus::Ticks next_scan = bus::kNever;  ///< the primary's next scan start
     bus::Ticks last_scan = bus::kNever;
+    bus::Ticks primary_since = 0;                  ///< when it last became Primary
+    std::uint64_t scans_as_primary = 0;            ///< since it last became Primary
     std::uint64_t watch_gen = 0;                   ///< the standby's transfer watchdog
     bus::Ticks last_transfer_start = bus::kNever;  ///< as seen by this standby
     std::string blocker;  ///< why it last could not join (logged on change)

@@ -39,7 +39,8 @@ void HsbyPair::arm_watch(int s) {
   // The next transfer is due at the primary's next scan start; the primary's scan event there
   // was scheduled before this one, so at an equal instant the scan (and its transfer) comes
   // first and makes this event stale.
-  m_sched.schedule(rk(p).next_scan, *this, hsby_tag(kHsbyWatch, s, k.watch_gen));
+  m_sched.schedule(rk(p).next_scan + m_p.line_check_delay, *this,
+                   hsby_tag(kHsbyWatch, s, k.watch_gen));
 }
 
 void HsbyPair::on_event(bus::Ticks now, std::uint64_t tag) {
@@ -84,7 +85,8 @@ void HsbyPair::scan(int r, bus::Ticks now) {
   p.last_scan = now;
   // The command register (override) and every unit's status register at the scan start.
   reconcile();
-  if (rk(r).state != CpuState::Primary) return;  // cannot happen: a primary leaves at a boundary
+  // Two primaries meeting again over the fibre: the later one just went offline.
+  if (rk(r).state != CpuState::Primary) return;
 
   // CPU -> CHS: the snapshot of this scan's ranges; it reaches the standby after transfer_time.
   const bool to_standby = rk(o).state == CpuState::Standby && m_fibre == FibreState::Ok;

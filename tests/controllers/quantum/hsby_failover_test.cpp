@@ -204,3 +204,39 @@ TEST(HsbyFailover, HeadHearingTheLineAfterAPowerFailureMeansNoTakeover) {
 
 }  // namespace
 }  // namespace pbvbus::quantum
+
+namespace pbvbus::quantum {
+namespace {
+
+using namespace hsby_test;
+
+// A head that still hears the failed primary's last frames for 1 ms (its silence bound).
+TEST(HsbyFailover, LineCheckDelayLetsTheHeadsSilenceBoundPass) {
+  for (const bus::Ticks delay : {bus::Ticks{0}, 2 * kMs}) {
+    HsbyPairParams p = small_params();
+    p.line_check_delay = delay;
+    Rig g(p);
+    bus::Ticks failed_at = bus::kNever;
+    g.h1.hears.reset();
+    g.pair.power_on(0);
+    g.pair.power_on(1);
+    g.at(29 * kMs + kMs / 2);  // 0.5 ms before the due transfer
+    failed_at = g.sched.now();
+    g.pair.power_off(0);
+    // Emulate the bound: heard until 1 ms after the failure.
+    g.h1.hears = true;
+    g.sched.schedule(failed_at + kMs, [&g] { g.h1.hears = false; });
+    g.at(60 * kMs);
+    if (delay == 0) {
+      EXPECT_EQ(g.pair.state(1), CpuState::Offline);  // mistaken for a fibre fault
+      EXPECT_TRUE(g.pair.switchovers().empty());
+    } else {
+      ASSERT_EQ(g.pair.switchovers().size(), 1u);
+      EXPECT_EQ(g.pair.switchovers()[0].time, 32 * kMs);
+      EXPECT_EQ(g.pair.switchovers()[0].takeover_ticks, 2 * kMs + kMs / 2);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pbvbus::quantum

@@ -234,6 +234,9 @@ TEST(HsbyPair, ConstructionRefusesBadParameters) {
   p.scan_time = 0;
   EXPECT_THROW(HsbyPair(s, p, {nullptr, nullptr}), std::invalid_argument);
   p = small_params();
+  p.line_check_delay = kScan;
+  EXPECT_THROW(HsbyPair(s, p, {nullptr, nullptr}), std::invalid_argument);
+  p = small_params();
   p.transfer_time = 0;
   HsbyPair ok(s, p, {nullptr, nullptr});
   EXPECT_EQ(ok.transfer_time(), kScan / 4);

@@ -33,6 +33,10 @@
 //   Offline (Com Err), the primary runs alone; silent -> takeover at that instant (the new
 //   primary's first scan), i.e. within one scan of the failure (Q7). A standby failure: the
 //   primary runs alone. A transfer in flight at a failure is lost (event TransferLost).
+//   (line_check_delay moves the question to the head later, for a head's silence bound.) Two
+//   primaries (fibre and line silent) meeting again over the fibre: the later goes Offline.
+// - A planned handover ends a scan: a new primary always runs its first scan before it may
+//   hand control back.
 // - Scan (primary only, every scan_time): the snapshot of the plan's every_scan ranges plus the
 //   additional slice (scan number mod slices) without the non-transfer area, then
 //   read_inputs, the logic hook, write_outputs. The snapshot lands in the standby's state RAM
@@ -106,6 +110,12 @@ struct HsbyPairParams {
   bus::Ticks transfer_time = 0;
   /// Program update (Xfer + update button) duration, from the button's release. 0 = 1 s.
   bus::Ticks update_time = 0;
+  /// How long after a missing transfer's due instant the standby asks its IoHead whether the
+  /// active master is still heard. 0 (default) = at once: the takeover is then within one scan
+  /// of the failure (Q7). A real passive DP master only knows the line was silent for its own
+  /// silence bound; with a delay >= that bound a failure just before the due instant is not
+  /// mistaken for a fibre fault, at the price of takeover <= scan_time + delay. < scan_time.
+  bus::Ticks line_check_delay = 0;
   std::array<RackParams, 2> racks{RackParams{Designation::A}, RackParams{Designation::B}};
 };
 
@@ -160,7 +170,8 @@ class HsbyPair final : public bus::EventTarget {
  public:
   /// Heads may be null (no I/O: a silent standby then decides from the model's own truth, see
   /// the doc). Throws std::invalid_argument for a command register outside 4x, a transfer_time
-  /// > scan_time or scan_time <= 0. Both racks start unpowered.
+  /// > scan_time, a line_check_delay outside [0, scan_time) or scan_time <= 0. Both racks start
+  /// unpowered. The pair must outlive the scheduler's runs (its events point at it).
   HsbyPair(bus::Scheduler& sched, HsbyPairParams params, std::array<IoHead*, 2> heads);
   HsbyPair(const HsbyPair&) = delete;
   HsbyPair& operator=(const HsbyPair&) = delete;

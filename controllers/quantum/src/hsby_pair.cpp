@@ -31,7 +31,7 @@ std::uint16_t hsby_unit_code(CpuState s) {
   return 0;
 }
 
-std::string rack_name(int r) {
+std::string hsby_rack_name(int r) {
   return "rack " + std::to_string(r);
 }
 
@@ -259,7 +259,7 @@ void HsbyPair::set_state(int r, CpuState s, std::string_view why) {
       std::string(to_string(k.state)) + " -> " + std::string(to_string(s)) + " (" +
           std::string(why) + ")");
   if (m_flight.active && (r == m_flight.from || r == m_flight.to))
-    lose_in_flight(rack_name(r) + " " + std::string(to_string(s)));
+    lose_in_flight(hsby_rack_name(r) + " " + std::string(to_string(s)));
   if (s == CpuState::Standby) m_alone_logged = false;
   if (s == CpuState::Primary) {
     k.primary_since = m_sched.now();

@@ -48,8 +48,8 @@ HsbyPair::HsbyPair(bus::Scheduler& sched, HsbyPairParams params, std::array<IoHe
   if (m_transfer_time > m_p.scan_time)
     throw std::invalid_argument("hot standby: transfer time longer than the scan time");
   m_update_time = m_p.update_time > 0 ? m_p.update_time : bus::kTicksPerSecond;
-  if (m_p.line_check_delay < 0 || m_p.line_check_delay >= m_p.scan_time)
-    throw std::invalid_argument("hot standby: line check delay outside [0, scan time)");
+  if (m_p.line_check_delay < 0 || 2 * m_p.line_check_delay > m_p.scan_time)
+    throw std::invalid_argument("hot standby: line check delay outside [0, scan time / 2]");
   for (int r = 0; r < 2; ++r) {
     Rack& k = rk(r);
     const RackParams& rp = m_p.racks[static_cast<std::size_t>(r)];

@@ -36,11 +36,11 @@ void HsbyPair::arm_watch(int s) {
   if (rk(s).state != CpuState::Standby || rk(p).state != CpuState::Primary) return;
   Rack& k = rk(s);
   ++k.watch_gen;
+  k.rechecking = false;
   // The next transfer is due at the primary's next scan start; the primary's scan event there
   // was scheduled before this one, so at an equal instant the scan (and its transfer) comes
   // first and makes this event stale.
-  m_sched.schedule(rk(p).next_scan + m_p.line_check_delay, *this,
-                   hsby_tag(kHsbyWatch, s, k.watch_gen));
+  m_sched.schedule(rk(p).next_scan, *this, hsby_tag(kHsbyWatch, s, k.watch_gen));
 }
 
 void HsbyPair::on_event(bus::Ticks now, std::uint64_t tag) {
@@ -182,6 +182,15 @@ void HsbyPair::watch(int s, bus::Ticks now) {
   // The remote I/O line tells them apart: the active master still heard = the primary lives.
   const bool primary_alive = rk(p).state == CpuState::Primary;
   const bool heard = k.head != nullptr ? k.head->hears_active_master(now) : primary_alive;
+  if (heard && m_p.line_check_delay > 0 && !k.rechecking) {
+    // The head hears the line within its silence bound: the primary may have failed just
+    // before the due instant. Ask again once the bound has passed: still heard = the primary
+    // lives (fibre fault); silent = it failed less than 2 bounds ago (takeover then).
+    k.rechecking = true;
+    m_sched.schedule(now + m_p.line_check_delay, *this, hsby_tag(kHsbyWatch, s, k.watch_gen));
+    return;
+  }
+  k.rechecking = false;
   if (heard) {
     log(s, PairEventKind::Fibre,
         "no transfer from the primary and its I/O head still heard: CHS link failure, the "

@@ -234,7 +234,7 @@ TEST(HsbyPair, ConstructionRefusesBadParameters) {
   p.scan_time = 0;
   EXPECT_THROW(HsbyPair(s, p, {nullptr, nullptr}), std::invalid_argument);
   p = small_params();
-  p.line_check_delay = kScan;
+  p.line_check_delay = kScan / 2 + 1;
   EXPECT_THROW(HsbyPair(s, p, {nullptr, nullptr}), std::invalid_argument);
   p = small_params();
   p.transfer_time = 0;

@@ -33,7 +33,7 @@
 //   Offline (Com Err), the primary runs alone; silent -> takeover at that instant (the new
 //   primary's first scan), i.e. within one scan of the failure (Q7). A standby failure: the
 //   primary runs alone. A transfer in flight at a failure is lost (event TransferLost).
-//   (line_check_delay moves the question to the head later, for a head's silence bound.) Two
+//   (line_check_delay: a second question to the head after its silence bound, see below.) Two
 //   primaries (fibre and line silent) meeting again over the fibre: the later goes Offline.
 // - A planned handover ends a scan: a new primary always runs its first scan before it may
 //   hand control back.
@@ -110,11 +110,15 @@ struct HsbyPairParams {
   bus::Ticks transfer_time = 0;
   /// Program update (Xfer + update button) duration, from the button's release. 0 = 1 s.
   bus::Ticks update_time = 0;
-  /// How long after a missing transfer's due instant the standby asks its IoHead whether the
-  /// active master is still heard. 0 (default) = at once: the takeover is then within one scan
-  /// of the failure (Q7). A real passive DP master only knows the line was silent for its own
-  /// silence bound; with a delay >= that bound a failure just before the due instant is not
-  /// mistaken for a fibre fault, at the price of takeover <= scan_time + delay. < scan_time.
+  /// A passive head only knows the line has been silent for its own silence bound. When the
+  /// transfer due at the primary's scan start is missing and the head still hears the active
+  /// master, the standby asks again `line_check_delay` later (set it to the head's bound):
+  /// heard again = the primary lives, the fibre failed (the standby goes Offline); silent = the
+  /// primary failed less than 2 × line_check_delay before the takeover. A head that is silent
+  /// at the due instant means a takeover at once. So every takeover is within
+  /// max(scan_time, 2 × line_check_delay) of the failure: within one scan (Q7) while
+  /// 2 × line_check_delay <= scan_time, which the constructor demands. 0 = no second question
+  /// (heard at the due instant = fibre fault).
   bus::Ticks line_check_delay = 0;
   std::array<RackParams, 2> racks{RackParams{Designation::A}, RackParams{Designation::B}};
 };
@@ -170,7 +174,7 @@ class HsbyPair final : public bus::EventTarget {
  public:
   /// Heads may be null (no I/O: a silent standby then decides from the model's own truth, see
   /// the doc). Throws std::invalid_argument for a command register outside 4x, a transfer_time
-  /// > scan_time, a line_check_delay outside [0, scan_time) or scan_time <= 0. Both racks start
+  /// > scan_time, a line_check_delay < 0 or above scan_time / 2, or scan_time <= 0. Both racks start
   /// unpowered. The pair must outlive the scheduler's runs (its events point at it).
   HsbyPair(bus::Scheduler& sched, HsbyPairParams params, std::array<IoHead*, 2> heads);
   HsbyPair(const HsbyPair&) = delete;
@@ -261,6 +265,7 @@ class HsbyPair final : public bus::EventTarget {
     std::uint64_t scans_as_primary = 0;            ///< since it last became Primary
     std::uint64_t watch_gen = 0;                   ///< the standby's transfer watchdog
     bus::Ticks last_transfer_start = bus::kNever;  ///< as seen by this standby
+    bool rechecking = false;  ///< the watchdog asks the head again after line_check_delay
     std::string blocker;  ///< why it last could not join (logged on change)
   };
   struct TransferValue {

@@ -3,33 +3,14 @@
 // after each of them and at every scan start, the LEDs and the status register.
 #include "pbvbus/quantum/hsby_pair.hpp"
 
+#include "pbvbus/quantum/command_register.hpp"
+
 #include <stdexcept>
 #include <string>
 
 namespace pbvbus::quantum {
 
 namespace {
-
-// The command register's run bits (seed p. 90; Modicon numbering, bit 1 = MSB): bit 15 = run
-// mode of the unit designated A, bit 14 = of B. The bit positions are those of
-// command_register.hpp (decode_command), which replaces these two constants when merged.
-constexpr std::uint16_t kHsbyRunA = 0x0002;  // bit 15
-constexpr std::uint16_t kHsbyRunB = 0x0004;  // bit 14
-
-// The status register's codes (seed pp. 81, 95): 01 offline, 10 primary, 11 standby.
-std::uint16_t hsby_unit_code(CpuState s) {
-  switch (s) {
-    case CpuState::Off:
-      return 0;
-    case CpuState::Offline:
-      return 0b01;
-    case CpuState::Primary:
-      return 0b10;
-    case CpuState::Standby:
-      return 0b11;
-  }
-  return 0;
-}
 
 std::string hsby_rack_name(int r) {
   return "rack " + std::to_string(r);
@@ -275,8 +256,9 @@ bool HsbyPair::run_bit(int r) const {
   // a unit reads its own (battery-backed) copy.
   const int p = primary();
   const StateRam& src = p >= 0 ? rk(p).ram : rk(r).ram;
-  const std::uint16_t w = src.holding(m_p.command_register);
-  return (w & (rk(r).designation == Designation::A ? kHsbyRunA : kHsbyRunB)) != 0;
+  // Run modes: bit 15 for the unit designated A, bit 14 for B (seed p. 90; command_register.hpp).
+  const CommandRegister c = decode_command(src.holding(m_p.command_register));
+  return rk(r).designation == Designation::A ? c.run_a : c.run_b;
 }
 
 bool HsbyPair::wants_run(int r) const {
@@ -445,20 +427,29 @@ void HsbyPair::write_status(int r) {
 }
 
 std::uint16_t HsbyPair::status_word(int r) const {
-  // Private encoding, to be replaced by command_register.hpp's encode_status: Modicon bits
-  // 15-16 this unit, 13-14 the other unit (01/10/11; 00 when this unit cannot hear it), bit 12
-  // logic mismatch, bit 11 designation B, bit 1 hot standby active. Bit 2 (CHS interface error)
-  // stays 0: the CPU-CHS interface is not modelled.
+  // The seed's status register (command_register.hpp): this unit and the other (01/10/11; 00
+  // when this unit cannot hear it), logic mismatch, designation, hot standby active. The CHS
+  // interface error bit stays 0: the CPU-CHS interface is not modelled.
   if (!valid(r)) return 0;
   const Rack& k = rk(r);
   const Rack& o = rk(1 - r);
   const bool hears_other = o.powered && m_fibre == FibreState::Ok;
-  std::uint16_t w = hsby_unit_code(k.state);
-  if (hears_other) w = static_cast<std::uint16_t>(w | (hsby_unit_code(o.state) << 2));
-  if (hears_other && k.checksum != o.checksum) w |= 0x0010;  // bit 12
-  if (k.designation == Designation::B) w |= 0x0020;          // bit 11
-  w |= 0x8000;                                               // bit 1
-  return w;
+  auto code = [](CpuState s) {
+    switch (s) {
+      case CpuState::Offline: return UnitCode::Offline;
+      case CpuState::Primary: return UnitCode::Primary;
+      case CpuState::Standby: return UnitCode::Standby;
+      case CpuState::Off: break;
+    }
+    return UnitCode::None;
+  };
+  StatusRegister st;
+  st.this_unit = code(k.state);
+  st.other_unit = hears_other ? code(o.state) : UnitCode::None;
+  st.logic_mismatch = hears_other && k.checksum != o.checksum;
+  st.designation_b = k.designation == Designation::B;
+  st.hsby_active = true;
+  return encode_status(st);
 }
 
 // ---- observers -----------------------------------------------------------------------------

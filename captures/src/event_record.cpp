@@ -42,6 +42,8 @@ std::string_view to_string(EventCategory c) {
       return "redundancy";
     case EventCategory::Cpu:
       return "cpu";
+    case EventCategory::Hsby:
+      return "hsby";
     case EventCategory::Note:
       return "note";
   }

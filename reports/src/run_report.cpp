@@ -6,6 +6,7 @@
 #include <ostream>
 
 #include "pbvbus/reports/json_text.hpp"
+#include "pbvbus/reports/quantum_report.hpp"
 #include "pbvbus/reports/s7_report.hpp"
 
 namespace pbvbus::tools {
@@ -118,6 +119,7 @@ void write_text(const Report& r, std::ostream& os) {
   write_h_text(r.h_systems, os);
   write_gateways_text(r.gateways, os);
   write_s7_text(r.s7, os);
+  write_quantum_text(r.quantum, os);
   for (const auto& f : r.faults_not_reached) os << "not reached before the end: " << f << "\n";
 }
 
@@ -228,6 +230,7 @@ void write_json(const Report& r, std::ostream& os) {
   write_h_json(r.h_systems, os);
   write_gateways_json(r.gateways, os);
   write_s7_json(r.s7, os);
+  write_quantum_json(r.quantum, os);
   os << "}\n";
 }
 

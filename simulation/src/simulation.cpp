@@ -60,6 +60,7 @@ struct Simulation::Station {
   RedundantSystemNode* red = nullptr;
   int red_side = -1;
   int switched = -1;  ///< index into ScenarioPlan::switched
+  int quantum = -1;   ///< a Quantum pair's DP master modules: index into m_quantum
 };
 
 namespace {
@@ -111,6 +112,10 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
         m_sched, d, cpus,
         d.mpi_line >= 0 ? &m_plan.lines.at(static_cast<std::size_t>(d.mpi_line)).params : nullptr,
         [this](int h) { return h_model(h); }));
+  for (std::size_t k = 0; k < m_plan.quantum.size(); ++k) {
+    m_quantum.push_back(std::make_unique<QuantumNode>(m_plan, static_cast<int>(k), m_sched));
+    m_quantum.back()->set_capture(m_opts.capture);
+  }
   for (std::size_t li = 0; li < m_plan.lines.size(); ++li) build_line(li);
   for (auto& node : m_redundant) node->set_capture(m_opts.capture);
   std::string why;
@@ -164,6 +169,7 @@ bus::PacedRunner& Simulation::paced_runner(bus::Speed speed) {
       if (s.pty) s.pty->attach_io(*m_runner);
   for (auto& g : m_gateways) g->open(*m_runner);
   for (auto& d : m_s7_doors) d->open(*m_runner);
+  for (auto& q : m_quantum) q->open(*m_runner);
   return *m_runner;
 }
 
@@ -242,6 +248,13 @@ void Simulation::build_line(std::size_t li) {
           }
         if (st.red != nullptr) {
           st.position = st.red->model().attach(st.red_side, *ls->line, label);
+          break;
+        }
+        // A Quantum pair's DP master module: both racks' modules at this place (quantum_node.hpp).
+        for (std::size_t k = 0; k < m_quantum.size(); ++k)
+          if (m_plan.quantum[k].dp_master == mi) st.quantum = static_cast<int>(k);
+        if (st.quantum >= 0) {
+          st.position = m_quantum[static_cast<std::size_t>(st.quantum)]->attach_dp(*ls->line);
           break;
         }
         st.dp_master = std::make_unique<DpMasterNode>(*it, m_plan.dp_slaves, ps.params);
@@ -411,6 +424,8 @@ void Simulation::start() {
       }
     }
   }
+  // The Quantum pairs power their racks (and their DP master modules) themselves.
+  for (auto& q : m_quantum) q->start();
   // The CPU pairs' DP masters powered with their CPUs at time 0: still powering up.
   for (auto& ls : m_lines) ls->stats.faults.clear();
   for (auto& cpu : m_s7_cpus) cpu->start(m_sched.now());
@@ -460,6 +475,10 @@ void Simulation::schedule_faults() {
 }
 
 void Simulation::apply_fault(const PlanFault& f, bool on) {
+  if (is_quantum_fault(f.kind)) {
+    m_quantum.at(static_cast<std::size_t>(f.quantum))->apply(f, on);
+    return;
+  }
   if (is_h_fault(f.kind)) {
     for (auto& h : m_h)
       if (h->plan().source == m_plan.h_systems.at(static_cast<std::size_t>(f.h_system)).source)
@@ -664,6 +683,7 @@ Report Simulation::report(double wall_seconds) const {
   for (const auto& node : m_redundant) r.redundancy.push_back(node->report());
   for (const auto& h : m_h) r.h_systems.push_back(h->report());
   for (const auto& g : m_gateways) r.gateways.push_back(g->report());
+  for (const auto& q : m_quantum) r.quantum.push_back(q->report());
   r.s7 = s7_report();
   return r;
 }

@@ -368,6 +368,8 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     bus::PacedRunner& runner = *runner_ptr;
     for (std::size_t i = 0; i < sim->gateway_count(); ++i)
       for (const std::string& line : sim->gateway(i).door_lines()) err << line << "\n";
+    for (std::size_t i = 0; i < sim->quantum_count(); ++i)
+      for (const std::string& line : sim->quantum(i).door_lines()) err << line << "\n";
     boost::asio::signal_set signals(runner.io_context(), SIGINT, SIGTERM);
     signals.async_wait([&runner](const boost::system::error_code& ec, int) {
       if (!ec) {

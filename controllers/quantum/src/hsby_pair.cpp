@@ -230,15 +230,21 @@ void HsbyPair::set_standby_stays_on_logic_mismatch(bool on) {
 // ---- the rules -----------------------------------------------------------------------------
 
 void HsbyPair::log(int rack, PairEventKind kind, std::string text) {
-  m_events.push_back(PairEvent{m_sched.now(), rack, kind, std::move(text)});
+  log_as(rack, kind, std::move(text), valid(rack) ? rk(rack).state : CpuState::Off);
+}
+
+void HsbyPair::log_as(int rack, PairEventKind kind, std::string text, CpuState after) {
+  m_events.push_back(PairEvent{m_sched.now(), rack, kind, std::move(text), after});
+  if (m_on_event) m_on_event(m_events.back());
 }
 
 void HsbyPair::set_state(int r, CpuState s, std::string_view why) {
   Rack& k = rk(r);
   if (k.state == s) return;
-  log(r, PairEventKind::State,
-      std::string(to_string(k.state)) + " -> " + std::string(to_string(s)) + " (" +
-          std::string(why) + ")");
+  log_as(r, PairEventKind::State,
+         std::string(to_string(k.state)) + " -> " + std::string(to_string(s)) + " (" +
+             std::string(why) + ")",
+         s);
   if (m_flight.active && (r == m_flight.from || r == m_flight.to))
     lose_in_flight(hsby_rack_name(r) + " " + std::string(to_string(s)));
   if (s == CpuState::Standby) m_alone_logged = false;

@@ -44,6 +44,13 @@ enum class EventCategory : std::uint8_t {
   /// to << 32 | from << 40; text "CPU 0: STOP -> STARTUP".
   Cpu = 5,
   Note = 6,        ///< free text from a scenario or tool
+  /// Quantum Hot Standby pair events (docs/quantum-hsby.md "Captures"): code = event kind
+  /// (quantum::PairEventKind: 0 power, 1 key, 2 state, 3 switchover, 4 transfer lost, 5 logic
+  /// mismatch, 6 duplicate designation, 7 fibre, 8 update, 9 override, 10 CPU, 11 ignored),
+  /// line = -1, a = rack (-1 = the pair or the fibre), b = that rack's state after the event (0
+  /// off, 1 offline, 2 primary, 3 standby; -1 none), value = a switchover's takeover time in
+  /// ns; text "Quantum: rack 0: primary -> offline (...)".
+  Hsby = 7,
 };
 std::string_view to_string(EventCategory c);
 

@@ -155,6 +155,7 @@
 #include "pbvbus/fdl/bus_params.hpp"
 #include "pbvbus/simulation/dp_system.hpp"
 #include "pbvbus/simulation/gateway_report.hpp"
+#include "pbvbus/simulation/quantum_report.hpp"
 #include "pbvbus/simulation/s7_report.hpp"
 #include "pbvbus/simulation/line_stats.hpp"
 #include "pbvbus/simulation/h_report.hpp"
@@ -245,6 +246,7 @@ struct Report {
   std::vector<HSystemReport> h_systems;      ///< simulated H-system CPU pairs (docs/h-system.md)
   std::vector<GatewayReport> gateways;       ///< gateways (docs/gateway-modbus.md; gateway_report.hpp)
   S7Report s7;                               ///< S7 CPUs, PGs/OPs, S7 doors (s7_report.hpp)
+  std::vector<QuantumReport> quantum;        ///< Quantum Hot Standby pairs (quantum_report.hpp)
 };
 
 /// "master_in_ring", "master_ready", "master_not_ready", "slave".

@@ -38,6 +38,7 @@
 #include "pbvbus/simulation/capture_probes.hpp"
 #include "pbvbus/simulation/gateway_node.hpp"
 #include "pbvbus/simulation/h_system_node.hpp"
+#include "pbvbus/simulation/quantum_node.hpp"
 #include "pbvbus/simulation/redundancy_system.hpp"
 #include "pbvbus/simulation/s7_door_node.hpp"
 #include "pbvbus/simulation/s7_nodes.hpp"
@@ -112,8 +113,15 @@ class Simulation {
   /// Whether something outside the process is attached (a pty, a gateway): then the run must
   /// be paced.
   bool has_external_attachments() const {
-    return !m_serial.empty() || !m_plan.gateways.empty() || !m_plan.s7.doors.empty();
+    if (!m_serial.empty() || !m_plan.gateways.empty() || !m_plan.s7.doors.empty()) return true;
+    for (const auto& q : m_plan.quantum)
+      if (!q.modbus.empty()) return true;
+    return false;
   }
+  /// The Quantum Hot Standby pairs, in file order (quantum_node.hpp).
+  std::size_t quantum_count() const { return m_quantum.size(); }
+  QuantumNode& quantum(std::size_t i) { return *m_quantum.at(i); }
+  const QuantumNode& quantum(std::size_t i) const { return *m_quantum.at(i); }
   /// The gateways, in file order; built by start(), their doors opened by paced_runner().
   std::size_t gateway_count() const { return m_gateways.size(); }
   GatewayNode& gateway(std::size_t i) { return *m_gateways.at(i); }
@@ -183,6 +191,9 @@ class Simulation {
   std::vector<std::unique_ptr<MpiClientNode>> m_mpi_clients;
   std::vector<std::unique_ptr<S7DoorNode>> m_s7_doors;
   std::vector<std::unique_ptr<HCpuMpiNode>> m_h_mpi;  ///< the H CPUs' MPI interfaces
+  // Quantum pairs own DP master modules the lines hold, and Modbus doors on the runner's
+  // io_context: built before the lines, destroyed after them and before the runner.
+  std::vector<std::unique_ptr<QuantumNode>> m_quantum;
   std::vector<std::unique_ptr<LineState>> m_lines;
   // H-systems drive the redundant systems' models and schedule on m_sched: destroyed first.
   std::vector<std::unique_ptr<HSystemNode>> m_h;

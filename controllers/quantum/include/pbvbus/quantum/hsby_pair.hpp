@@ -163,6 +163,7 @@ struct PairEvent {
   int rack = -1;  ///< -1: the pair / the fibre
   PairEventKind kind = PairEventKind::State;
   std::string text;
+  CpuState state = CpuState::Off;  ///< `rack`'s state after the event (a State event: the new one)
 };
 
 /// The program update of one unit (seed pp. 21-22): button held, key to Xfer (Armed: Com Act
@@ -232,6 +233,8 @@ class HsbyPair final : public bus::EventTarget {
   bus::Ticks last_transfer_scan_start() const { return m_last_done_scan_start; }
   const std::vector<SwitchoverRecord>& switchovers() const { return m_switchovers; }
   const std::vector<PairEvent>& events() const { return m_events; }
+  /// Called with every event as it is logged (e.g. for a capture), at its virtual time.
+  void set_event_handler(std::function<void(const PairEvent&)> h) { m_on_event = std::move(h); }
 
   // Status register word this unit writes (private encoding with the seed's 01/10/11 codes,
   // to be replaced by command_register.hpp's encode_status when merged); see the doc.
@@ -297,6 +300,7 @@ class HsbyPair final : public bus::EventTarget {
   const Rack& rk(int r) const { return m_r[static_cast<std::size_t>(r)]; }
 
   void log(int rack, PairEventKind kind, std::string text);
+  void log_as(int rack, PairEventKind kind, std::string text, CpuState after);
   void set_state(int rack, CpuState s, std::string_view why);
   bool run_bit(int rack) const;  // the override's run bit for rack's designation
   bool wants_run(int rack) const;
@@ -320,6 +324,7 @@ class HsbyPair final : public bus::EventTarget {
   void update_done(int rack, bus::Ticks now);
 
   bus::Scheduler& m_sched;
+  std::function<void(const PairEvent&)> m_on_event;
   HsbyPairParams m_p;
   bus::Ticks m_transfer_time = 0;
   bus::Ticks m_update_time = 0;

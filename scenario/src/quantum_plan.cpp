@@ -449,12 +449,37 @@ class QuantumPlanner {
   }
 
   void plan_scan(int i, const scenario::QuantumHotStandby& q, QuantumPlan& p) {
+    // The seed's scan-time model (scan_time.hpp): the standalone scan, the Hot Standby cost and
+    // the transfer of what goes every scan beyond the CPU type's baseline. Computed whether or
+    // not scan_time is configured (`pbvbus timing` shows it either way).
+    quantum::ScanInputs in;
+    if (q.has_transfer_rate_us_per_kb()) {
+      const std::uint32_t r = q.transfer_rate_us_per_kb();
+      if (r < 1 || r > 100000)
+        error(i, {{"transfer_rate_us_per_kb", -1}},
+              "transfer_rate_us_per_kb " + std::to_string(r) + " is outside 1..100000");
+      else
+        in.rate_override = r;
+    }
+    if (q.iec_hsby_registers() != 0) {
+      if (!p.iec)
+        error(i, {{"iec_hsby_registers", -1}},
+              "iec_hsby_registers needs iec: true (IEC-HSBY registers exist in IEC Hot Standby only)");
+      else
+        in.transferred.iec_regs = q.iec_hsby_registers();
+    }
     if (!q.logic_time().empty())
       if (auto t = duration(i, {{"logic_time", -1}}, q.logic_time())) p.logic_time = *t;
     if (p.logic_time <= 0) {
       error(i, {{"logic_time", -1}}, "logic_time must be longer than 0");
       return;
     }
+    in.standalone = p.logic_time;
+    in.transferred.coils = quantum::per_scan_count(p.plan, RefType::Coil0x);
+    in.transferred.inputs = quantum::per_scan_count(p.plan, RefType::Input1x);
+    in.transferred.input_regs = quantum::per_scan_count(p.plan, RefType::Register3x);
+    in.transferred.holding = quantum::per_scan_count(p.plan, RefType::Register4x);
+    p.estimate = quantum::estimate_scan(p.cpu, in);
     if (!q.scan_time().empty()) {
       if (auto t = duration(i, {{"scan_time", -1}}, q.scan_time())) {
         if (*t < p.logic_time)
@@ -463,15 +488,6 @@ class QuantumPlanner {
       }
       return;
     }
-    // The seed's scan-time model (scan_time.hpp): the standalone scan, the Hot Standby cost and
-    // the transfer of what goes every scan beyond the CPU type's baseline.
-    quantum::ScanInputs in;
-    in.standalone = p.logic_time;
-    in.transferred.coils = quantum::per_scan_count(p.plan, RefType::Coil0x);
-    in.transferred.inputs = quantum::per_scan_count(p.plan, RefType::Input1x);
-    in.transferred.input_regs = quantum::per_scan_count(p.plan, RefType::Register3x);
-    in.transferred.holding = quantum::per_scan_count(p.plan, RefType::Register4x);
-    p.estimate = quantum::estimate_scan(p.cpu, in);
     p.scan_time = std::max(p.estimate.total, p.logic_time);
     p.scan_time_estimated = true;
   }

@@ -320,8 +320,14 @@ class Planner {
       m_line_index.emplace(l.name(), static_cast<int>(plan.lines.size()));
       plan.lines.push_back(std::move(pl));
     }
-    // A timing-only file (h_system figures for `pbvbus timing`) needs no line.
-    if (m_proto.line_size() == 0 && m_proto.h_system_size() == 0)
+    // A timing-only file (h_system figures, or quantum_hot_standby pairs with neither remote
+    // I/O nor Modbus ports: scan-time figures, for `pbvbus timing`) needs no line.
+    const auto& qs = m_proto.quantum_hot_standby();
+    const bool quantum_timing_only =
+        !qs.empty() && std::all_of(qs.begin(), qs.end(), [](const scenario::QuantumHotStandby& q) {
+          return !q.has_dp() && q.modbus_port_size() == 0;
+        });
+    if (m_proto.line_size() == 0 && m_proto.h_system_size() == 0 && !quantum_timing_only)
       error(m_root, "the scenario has no line");
   }
 

@@ -6,7 +6,10 @@
 // the system-level switchover (a whole line lost: short circuit, master stop/failure); the
 // planner's notes. For every dp_master outside a redundant system: its line's T_TR (its slaves
 // planned as one-sided slaves of line A, the system terms left out). The planner's input comes
-// from timing_plan.hpp.
+// from timing_plan.hpp. For every h_system: the update timing (docs/h-timing.md). For every
+// quantum_hot_standby: the seed's scan-time model (quantum/scan_time.hpp, docs/quantum-hsby.md
+// "Scan time in `pbvbus timing`"): the transfer area, the state RAM sent every scan beyond the
+// CPU type's baseline in bytes, the rate, the HSBY cost, the standalone scan and the total.
 // Exit 0 on success (also for a scenario without a DP master system), 2 for bad usage or a
 // broken scenario (FILE:LINE:COLUMN: reason on stderr).
 //
@@ -44,7 +47,29 @@
 //       "address": int,
 //       "bus_params": BUS,
 //       "line": LINE,
-//       "notes": [ str ] } ] }
+//       "notes": [ str ] } ],
+//     "h_systems": [ ... ],         // h_system entries (print_h_json below)
+//     "quantum": [ {                // quantum_hot_standby entries, in file order
+//       "name": str, "cpu": "x13"|"424 02"|"434 12" (also the 534 14), "iec": bool,
+//       "logic_time_ns": int,                   // the standalone scan (logic_time)
+//       "transfer": {
+//         "mode": "12k"|"user_defined"|"transfer_all"|"iec",
+//         "every_scan": REFS4,                  // references sent every scan
+//         "additional": [ [ {"first": REF, "count": int} ] ],  // slices, one a scan
+//         "non_transfer": {"first": REF, "count": int}|null,
+//         "command_register": REF },
+//       "model": {                  // quantum::estimate_scan (seed 003 pp. 33-35, 49-50)
+//         "every_scan": REFS, "baseline": REFS (IEC-HSBY: 0, not subtracted),
+//         "deltas": REFS, "bytes": REFS,        // every_scan − baseline; their bytes (rounded)
+//         "total_bytes": int,
+//         "rate_us_per_kb": int,                // µs per 1000 B (the seed's "ms/byte")
+//         "rate_source": "cpu"|"scenario",      // scenario: transfer_rate_us_per_kb
+//         "transfer_ns": int, "transfer_ms": int,   // bytes × rate; rounded to ms as the seed
+//         "hsby_ns": int, "standalone_ns": int,
+//         "total_ns": int,                      // hsby + standalone + transfer, exact
+//         "total_ms": int },                    // the seed's sum of whole ms ("40 + 36 + 28")
+//       "scan_time_ns": int,                    // the pair's scan time
+//       "scan_time_source": "estimated"|"configured" } ] }
 //
 //   BUS   = { "baud": int (bit/s), "tsl","min_tsdr","max_tsdr","tqui","tset","ttr","max_retry",
 //             "tid1","tid2": int (bit times except max_retry) }
@@ -58,6 +83,9 @@
 //             "t_tr_bits": int, "t_tr_ns": int,
 //             "failed_attempt": CYCLE,             // one unanswered attempt: request + TSL
 //             "recognition_bits": int, "recognition_ns": int }   // T_TR + (1 + max_retry) · that
+//   REF   = a 6-digit Quantum reference, "400001"
+//   REFS4 = { "coils", "inputs", "input_registers", "holding_registers": int }
+//   REFS  = REFS4 plus "iec_hsby_registers": int for an IEC pair
 //   CYCLE = { "request_bits": int, "tsdr_bits": int (responder delay, or TSL when unanswered),
 //             "response_bits": int, "idle_bits": int, "bits": int (their sum), "ns": int }
 
@@ -77,6 +105,8 @@
 #include "pbvbus/scenario/scenario.hpp"
 #include "pbvbus/scenario/timing_plan.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
+#include "pbvbus/scenario/quantum_plan.hpp"
+#include "pbvbus/quantum/reference.hpp"
 
 namespace pbvbus::tools {
 
@@ -95,7 +125,8 @@ constexpr const char* kTimingUsage =
     "the DP error-recognition time; per switched station T_DP_UM, T_SLAVE_UM (from the GSD or\n"
     "the scenario) and the switchover bound for either failing line; the system switchover\n"
     "when a whole line is lost (short circuit, master stop or failure); the planner's notes.\n"
-    "For every other dp_master: its line's T_TR.\n"
+    "For every other dp_master: its line's T_TR. For every h_system: the update timing. For\n"
+    "every quantum_hot_standby: the seed's scan-time model (docs/quantum-hsby.md).\n"
     "\n"
     "  --json    print the same as one JSON object (schema pbvbus.timing/1)\n"
     "  --help    this text\n"
@@ -507,6 +538,191 @@ void print_h_json(const std::vector<HTiming>& hs, std::ostream& out) {
   out << (hs.empty() ? "]" : "\n ]");
 }
 
+// --- Quantum Hot Standby scan time (quantum_hot_standby entries) ---------------------------
+
+const char* cpu_name(quantum::CpuType c) {
+  switch (c) {
+    case quantum::CpuType::X13: return "x13";
+    case quantum::CpuType::Cpu42402: return "424 02";
+    case quantum::CpuType::Cpu43412: return "434 12";
+  }
+  return "?";
+}
+
+const char* transfer_mode(const QuantumPlan& q) {
+  if (q.iec) return "iec";
+  switch (q.transfer.mode) {
+    case quantum::TransferConfig::Mode::Default12K: return "12k";
+    case quantum::TransferConfig::Mode::UserDefined: return "user_defined";
+    case quantum::TransferConfig::Mode::TransferAll: return "transfer_all";
+  }
+  return "?";
+}
+
+const char* transfer_mode_text(const QuantumPlan& q) {
+  if (q.iec) return "IEC: all state RAM";
+  switch (q.transfer.mode) {
+    case quantum::TransferConfig::Mode::Default12K: return "12K (default)";
+    case quantum::TransferConfig::Mode::UserDefined: return "user defined";
+    case quantum::TransferConfig::Mode::TransferAll: return "transfer all";
+  }
+  return "?";
+}
+
+/// The rate the model used (µs per 1000 B) and whether the scenario set it.
+std::pair<std::int64_t, bool> quantum_rate(const ScenarioPlan& plan, const QuantumPlan& q) {
+  const auto& e = plan.proto.quantum_hot_standby(q.source);
+  if (e.has_transfer_rate_us_per_kb()) return {e.transfer_rate_us_per_kb(), true};
+  return {quantum::rate_us_per_1000_bytes(q.cpu), false};
+}
+
+/// References of one type sent every scan, the baseline, the delta and its bytes.
+struct QuantumRow {
+  const char* type;  ///< "0x", "1x", "3x", "4x", "IEC-HSBY 3x"
+  const char* key;   ///< the JSON name
+  std::int64_t transferred, baseline, delta, bytes;
+};
+
+std::vector<QuantumRow> quantum_rows(const QuantumPlan& q) {
+  const quantum::RefCounts b = quantum::baseline(q.cpu);
+  const quantum::ScanEstimate& e = q.estimate;
+  auto sent = [&](quantum::RefType t) {
+    return static_cast<std::int64_t>(quantum::per_scan_count(q.plan, t));
+  };
+  std::vector<QuantumRow> rows = {
+      {"0x", "coils", sent(quantum::RefType::Coil0x), b.coils, e.deltas.coils, e.coil_bytes},
+      {"1x", "inputs", sent(quantum::RefType::Input1x), b.inputs, e.deltas.inputs, e.input_bytes},
+      {"3x", "input_registers", sent(quantum::RefType::Register3x), b.input_regs,
+       e.deltas.input_regs, e.input_reg_bytes},
+      {"4x", "holding_registers", sent(quantum::RefType::Register4x), b.holding, e.deltas.holding,
+       e.holding_bytes}};
+  // The seed's IEC example counts every IEC-HSBY register (its baseline's 700 not taken off).
+  if (q.iec)
+    rows.push_back({"IEC-HSBY 3x", "iec_hsby_registers", e.deltas.iec_regs, 0, e.deltas.iec_regs,
+                    e.iec_bytes});
+  return rows;
+}
+
+std::string range_text(const quantum::TransferRange& r) {
+  return quantum::format_reference(r.type, r.first) + ".." + quantum::format_reference(r.type, r.first + r.count - 1);
+}
+
+/// "40 + 36 + 28 = 104 ms" (a negative transfer as "- 44").
+std::string seed_sum(const quantum::ScanEstimate& e) {
+  const std::int64_t standalone = (e.standalone + bus::kTicksPerMs / 2) / bus::kTicksPerMs;
+  std::string s = num(e.hsby / bus::kTicksPerMs) + " + " + num(standalone) +
+                  (e.transfer_ms < 0 ? " - " + num(-e.transfer_ms) : " + " + num(e.transfer_ms));
+  return s + " = " + num(e.total_ms) + " ms";
+}
+
+void print_quantum_text(const ScenarioPlan& plan, const QuantumPlan& q, std::ostream& out) {
+  const quantum::ScanEstimate& e = q.estimate;
+  out << "\nQuantum Hot Standby \"" << q.name << "\": scan time (seed 003 pp. 33-35, 49-50; "
+      << "docs/quantum-hsby.md)\n";
+  out << "  CPU " << cpu_name(q.cpu) << ", " << (q.iec ? "IEC" : "984") << " Hot Standby; logic "
+      << "(standalone scan) " << ms(q.logic_time) << "\n";
+  out << "  transfer area: " << transfer_mode_text(q) << "\n";
+  out << "    every scan: 0x " << quantum::per_scan_count(q.plan, quantum::RefType::Coil0x)
+      << ", 1x " << quantum::per_scan_count(q.plan, quantum::RefType::Input1x) << ", 3x "
+      << quantum::per_scan_count(q.plan, quantum::RefType::Register3x) << ", 4x "
+      << quantum::per_scan_count(q.plan, quantum::RefType::Register4x) << "\n";
+  if (q.plan.additional_slices.empty()) {
+    out << "    additional: none\n";
+  } else {
+    out << "    additional: " << q.plan.additional_slices.size() << " slices, one a scan\n";
+    for (std::size_t k = 0; k < q.plan.additional_slices.size(); ++k) {
+      out << "      slice " << k << ":";
+      for (const auto& r : q.plan.additional_slices[k]) out << " " << range_text(r);
+      out << "\n";
+    }
+  }
+  const quantum::NonTransferArea& n = q.plan.non_transfer;
+  if (n.count == 0)
+    out << "    non-transfer area: none\n";
+  else
+    out << "    non-transfer area: "
+        << range_text({quantum::RefType::Register4x, n.first, n.count}) << " (" << n.count
+        << " registers)\n";
+  out << "    command register: "
+      << quantum::format_reference(quantum::RefType::Register4x, q.command_register) << "\n";
+
+  out << "  scan-time model (every scan's state RAM beyond the CPU type's baseline)\n";
+  Table t;
+  t.add({"type", "every scan", "baseline", "delta", "bytes"});
+  for (const QuantumRow& r : quantum_rows(q))
+    t.add({r.type, num(r.transferred), std::string(r.key) == "iec_hsby_registers" ? "-" : num(r.baseline),
+           num(r.delta), num(r.bytes)});
+  t.add({"total", "", "", "", num(e.bytes) + " B"});
+  t.print(out, "    ");
+  const auto [rate, set] = quantum_rate(plan, q);
+  out << "  rate " << rate << " us per 1000 B ("
+      << (set ? std::string("transfer_rate_us_per_kb; the CPU's is ") +
+                    num(quantum::rate_us_per_1000_bytes(q.cpu))
+              : std::string("the CPU's"))
+      << "; the seed's \"ms/byte\" read as ms per ~1000 B)\n";
+  out << "  transfer " << num(e.bytes) << " B x " << rate << " us / 1000 B = " << ms(e.transfer)
+      << " ~ " << e.transfer_ms << " ms\n";
+  out << "  HSBY cost " << ms(e.hsby) << ", standalone " << ms(e.standalone) << "\n";
+  out << "  total " << seed_sum(e) << " (exact " << ms(e.total) << ")\n";
+  out << "  scan time " << ms(q.scan_time)
+      << (q.scan_time_estimated ? " (estimated: the model's total)" : " (configured)") << "\n";
+  out << "  note: the per-scan transfer adds scan time only when the logic is shorter than the "
+         "transfer (seed p. 33); it never causes a watchdog timeout (pp. 35, 51)\n";
+}
+
+void print_quantum_json(const ScenarioPlan& plan, std::ostream& out) {
+  out << ",\n \"quantum\": [";
+  for (std::size_t n = 0; n < plan.quantum.size(); ++n) {
+    const QuantumPlan& q = plan.quantum[n];
+    const quantum::ScanEstimate& e = q.estimate;
+    out << (n ? "," : "") << "\n  {\"name\": " << json_quote(q.name) << ", \"cpu\": \""
+        << cpu_name(q.cpu) << "\", \"iec\": " << (q.iec ? "true" : "false")
+        << ", \"logic_time_ns\": " << bus::ticks_to_ns(q.logic_time) << ",\n   \"transfer\": {\"mode\": \""
+        << transfer_mode(q) << "\", \"every_scan\": {";
+    const auto rows = quantum_rows(q);
+    for (std::size_t k = 0; k < 4; ++k)
+      out << (k ? ", " : "") << "\"" << rows[k].key << "\": " << rows[k].transferred;
+    out << "},\n    \"additional\": [";
+    for (std::size_t k = 0; k < q.plan.additional_slices.size(); ++k) {
+      out << (k ? ", " : "") << "[";
+      const auto& slice = q.plan.additional_slices[k];
+      for (std::size_t r = 0; r < slice.size(); ++r)
+        out << (r ? ", " : "") << "{\"first\": \"" << quantum::format_reference(slice[r].type, slice[r].first)
+            << "\", \"count\": " << slice[r].count << "}";
+      out << "]";
+    }
+    out << "], \"non_transfer\": ";
+    const quantum::NonTransferArea& nt = q.plan.non_transfer;
+    if (nt.count == 0)
+      out << "null";
+    else
+      out << "{\"first\": \"" << quantum::format_reference(quantum::RefType::Register4x, nt.first)
+          << "\", \"count\": " << nt.count << "}";
+    out << ", \"command_register\": \""
+        << quantum::format_reference(quantum::RefType::Register4x, q.command_register) << "\"},\n";
+    auto obj = [&](auto field) {
+      std::string s = "{";
+      for (std::size_t k = 0; k < rows.size(); ++k)
+        s += std::string(k ? ", " : "") + "\"" + rows[k].key + "\": " + num(field(rows[k]));
+      return s + "}";
+    };
+    const auto [rate, set] = quantum_rate(plan, q);
+    out << "   \"model\": {\"every_scan\": " << obj([](const QuantumRow& r) { return r.transferred; })
+        << ",\n    \"baseline\": " << obj([](const QuantumRow& r) { return r.baseline; })
+        << ",\n    \"deltas\": " << obj([](const QuantumRow& r) { return r.delta; })
+        << ",\n    \"bytes\": " << obj([](const QuantumRow& r) { return r.bytes; })
+        << ",\n    \"total_bytes\": " << e.bytes << ", \"rate_us_per_kb\": " << rate
+        << ", \"rate_source\": \"" << (set ? "scenario" : "cpu") << "\", \"transfer_ns\": "
+        << bus::ticks_to_ns(e.transfer) << ", \"transfer_ms\": " << e.transfer_ms
+        << ",\n    \"hsby_ns\": " << bus::ticks_to_ns(e.hsby) << ", \"standalone_ns\": "
+        << bus::ticks_to_ns(e.standalone) << ", \"total_ns\": " << bus::ticks_to_ns(e.total)
+        << ", \"total_ms\": " << e.total_ms << "},\n";
+    out << "   \"scan_time_ns\": " << bus::ticks_to_ns(q.scan_time) << ", \"scan_time_source\": \""
+        << (q.scan_time_estimated ? "estimated" : "configured") << "\"}";
+  }
+  out << (plan.quantum.empty() ? "]" : "\n ]");
+}
+
 }  // namespace
 
 int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
@@ -591,18 +807,20 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
   if (json) {
     print_json(plan, systems, masters, out);
     print_h_json(hs, out);
+    print_quantum_json(plan, out);
     out << "}\n";
     return 0;
   }
   out << "Scenario \"" << plan.name << "\" (" << plan.file
       << "): planned DP rotation and switchover times\n";
-  if (systems.empty() && masters.empty() && hs.empty()) {
+  if (systems.empty() && masters.empty() && hs.empty() && plan.quantum.empty()) {
     out << "no DP master system in this scenario: nothing to plan\n";
     return 0;
   }
   for (const auto& s : systems) print_system_text(plan, s, out);
   for (const auto& m : masters) print_master_text(m, out);
   for (const auto& h : hs) print_h_text(h, out);
+  for (const auto& q : plan.quantum) print_quantum_text(plan, q, out);
   return 0;
 }
 

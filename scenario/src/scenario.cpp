@@ -1055,6 +1055,7 @@ class Planner {
         pf.kind = K::QuantumCommand; field = "quantum_command"; name = f.quantum_command().quantum();
         pf.run_a = f.quantum_command().run_a();
         pf.run_b = f.quantum_command().run_b();
+        pf.keyswitch_override = f.quantum_command().keyswitch_override();
         needs_rack = false;
         repair = false;
         break;
@@ -1382,7 +1383,8 @@ std::string quantum_fault_description(const PlanFault& f) {
     case K::QuantumUpdate: return rack + ": update button and key to Xfer (program and state RAM copied)";
     case K::QuantumFibre: return f.fibre == 1 ? "CHS fibre Tx/Rx not crossed" : "CHS fibre cut";
     case K::QuantumCommand:
-      return std::string("command register written: run A ") + (f.run_a ? "1" : "0") + ", run B " + (f.run_b ? "1" : "0");
+      return std::string("command register written: keyswitch override ") + (f.keyswitch_override ? "on" : "off") +
+             ", run A " + (f.run_a ? "1" : "0") + ", run B " + (f.run_b ? "1" : "0");
     case K::QuantumLogicChange: return rack + " gets program " + std::to_string(f.checksum);
     default: return "?";
   }

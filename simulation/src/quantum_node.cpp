@@ -12,6 +12,7 @@
 #include "pbvbus/gateways/state_ram_modbus.hpp"
 #include "pbvbus/quantum/command_register.hpp"
 #include "pbvbus/quantum/reference.hpp"
+#include "pbvbus/quantum/transfer_area.hpp"
 
 namespace pbvbus::tools {
 
@@ -59,9 +60,14 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   p.keyswitch_override = q.keyswitch_override;
   p.standby_stays_on_logic_mismatch = q.standby_stays_on_logic_mismatch;
   p.scan_time = q.scan_time;
-  // The CHS → CHS copy over the fibre while the primary solves its logic (scan_time.hpp):
-  // at least the fibre time of what goes every scan, within the scan.
-  p.transfer_time = std::clamp<bus::Ticks>(q.estimate.bytes > 0 ? quantum::fibre_transfer_time(q.estimate.bytes) : 0,
+  // The CHS → CHS copy over the fibre while the primary solves its logic (scan_time.hpp): the
+  // state RAM sent every scan (0x/1x one bit each, 3x/4x two octets) at 10 Mbit/s, within the
+  // scan.
+  const std::int64_t bits = quantum::per_scan_count(q.plan, quantum::RefType::Coil0x) +
+                            quantum::per_scan_count(q.plan, quantum::RefType::Input1x);
+  const std::int64_t regs = quantum::per_scan_count(q.plan, quantum::RefType::Register3x) +
+                            quantum::per_scan_count(q.plan, quantum::RefType::Register4x);
+  p.transfer_time = std::clamp<bus::Ticks>(quantum::fibre_transfer_time((bits + 7) / 8 + 2 * regs),
                                            bus::kTicksPerUs, q.scan_time);
   for (int r = 0; r < 2; ++r) {
     const QuantumRackPlan& rp = q.racks[static_cast<std::size_t>(r)];
@@ -89,6 +95,16 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     }
   }
   m_pair = std::make_unique<quantum::HsbyPair>(m_sched, p, heads);
+  // The Hot Standby dialog's settings are the command register's start value in both units
+  // (seed 003 pp. 88-93): override, both run modes Run, the logic-mismatch option, each port's
+  // swap setting.
+  quantum::CommandRegister c;
+  c.keyswitch_override = q.keyswitch_override;
+  c.run_a = c.run_b = true;
+  c.standby_stays_on_logic_mismatch = q.standby_stays_on_logic_mismatch;
+  for (const QuantumModbusPortPlan& mp : q.modbus)
+    c.swap_disabled[static_cast<std::size_t>(mp.port - 1)] = mp.no_swap;
+  for (int r = 0; r < 2; ++r) m_pair->ram(r).set_holding(q.command_register, quantum::encode_command(c));
   m_pair->set_logic([this](quantum::StateRam& ram, bus::Ticks) { logic(ram); });
   m_pair->set_event_handler([this](const quantum::PairEvent& e) { on_event(e); });
   for (const QuantumModbusPortPlan& mp : q.modbus) {
@@ -98,8 +114,8 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     Port* raw = port.get();
     auto resolve = [this, raw](std::uint8_t unit) -> quantum::StateRam* {
       if (unit == 0) {  // broadcast: what the primary holds is what the next transfer carries
-        const int p = m_pair->primary();
-        return p >= 0 ? &m_pair->ram(p) : nullptr;
+        const int pr = m_pair->primary();
+        return pr >= 0 ? &m_pair->ram(pr) : nullptr;
       }
       const int r = raw->plan.wiring == QuantumModbusPortPlan::Wiring::Rack0   ? raw->addressing->rack_only(0, unit)
                     : raw->plan.wiring == QuantumModbusPortPlan::Wiring::Rack1 ? raw->addressing->rack_only(1, unit)
@@ -266,6 +282,7 @@ void QuantumNode::note(const std::string& text) {
 void QuantumNode::apply(const PlanFault& f, bool on) {
   using K = PlanFault::Kind;
   note((on ? "" : "repair: ") + f.description);
+  refresh_addresses();  // the Modbus addresses before what the fault causes
   quantum::HsbyPair& q = *m_pair;
   switch (f.kind) {
     case K::QuantumPowerLoss: on ? q.power_off(f.rack) : q.power_on(f.rack); break;
@@ -294,8 +311,11 @@ void QuantumNode::apply(const PlanFault& f, bool on) {
         quantum::CommandRegister c = quantum::decode_command(ram.holding(plan().command_register));
         c.run_a = f.run_a;
         c.run_b = f.run_b;
+        c.keyswitch_override = f.keyswitch_override;
         ram.set_holding(plan().command_register, quantum::encode_command(c));
       }
+      // The override bit acts at once (seed p. 90: the primary then reads bits 14 and 15).
+      q.set_keyswitch_override(f.keyswitch_override);
       break;
     }
     case K::QuantumLogicChange:
@@ -303,7 +323,6 @@ void QuantumNode::apply(const PlanFault& f, bool on) {
       break;
     default: break;
   }
-  refresh_addresses();
 }
 
 QuantumReport QuantumNode::report() const {

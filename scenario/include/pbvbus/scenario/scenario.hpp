@@ -190,6 +190,7 @@ struct PlanFault {
   int quantum = -1;      ///< Quantum faults: index into ScenarioPlan::quantum
   int key = 0;           ///< quantum_key: 1 Off Line, 2 Xfer
   bool run_a = false, run_b = false;  ///< quantum_command
+  bool keyswitch_override = false;    ///< quantum_command: the override bit written
   std::uint32_t checksum = 0;         ///< quantum_logic_change
 };
 

@@ -17,6 +17,8 @@
 //   holds (a gateway in front of the port's network), the RTU door answers nothing (multidrop).
 //   Broadcasts (RTU unit 0) go to the primary's state RAM. FC43 names the answering rack's
 //   designation ("HSBY unit A").
+// - The command register starts with the configuration (the Hot Standby dialog): override,
+//   both run modes Run, the logic-mismatch option, each port's swap setting.
 // - The command faults write the run bits into the primary's command register as a host would
 //   over Modbus; the keyswitch override must be configured for them to act.
 // - Capture: every pair event as an Hsby record (captures/event_record.hpp) at its virtual

@@ -207,6 +207,10 @@ class QuantumPlanner {
       if (!e.power_on_at().empty())
         if (auto t = duration(i, {{"rack", r}, {"power_on_at", -1}}, e.power_on_at())) rp.power_on_at = *t;
       if (e.has_logic_checksum()) rp.logic_checksum = e.logic_checksum();
+      if (e.local_io_size() > 0)
+        error(i, {{"rack", r}, {"local_io", 0}},
+              "local I/O \"" + e.local_io(0) + "\" in a Hot Standby rack: only remote I/O is supported, "
+              "local I/O is not carried across a switchover (seed 003 p. 17); put it on the DP line");
     }
   }
 

@@ -12,6 +12,7 @@
 //    inside the non-transfer area, a non-transfer area shorter than 4 registers or not inside
 //    the per-scan 4x area) are reported at the field they concern, with the seed's rule.
 //  - References are written as the configurators write them ("400001" or "40001").
+//  - Local I/O in a rack (rack.local_io) is refused: the seed's pair supports remote I/O only.
 //  - Racks: at most two entries (rack 0, rack 1); designations default A and B; rack 0 powers
 //    at 0 s and rack 1 at 100 ms unless told (the first powered becomes primary). Same
 //    designation on both racks is allowed: it is a fault the seed describes (the second stays
@@ -94,7 +95,7 @@ struct QuantumPlan {
   bus::Ticks logic_time = 20 * bus::kTicksPerMs;
   bus::Ticks scan_time = 0;  ///< configured or estimated
   bool scan_time_estimated = false;
-  quantum::ScanEstimate estimate;  ///< the model's figures (scan_time_estimated)
+  quantum::ScanEstimate estimate;  ///< the model's figures (also when scan_time is configured)
   std::array<QuantumRackPlan, 2> racks;
   int dp_line = -1;
   int dp_master = -1;  ///< index into ScenarioPlan::dp_masters
@@ -105,8 +106,8 @@ struct QuantumPlan {
   std::vector<QuantumCopyPlan> copies;
 };
 
-/// Plans the quantum_hot_standby entries (after the dp systems and the gateways and S7 doors:
-/// it shares their TCP port rule through `used_ports`).
+/// Plans the quantum_hot_standby entries (after the dp systems, the gateways and the S7 doors:
+/// their TCP ports and pty links may not be used twice).
 void plan_quantum(ScenarioPlan& plan, const S7Locator& locate, std::vector<Diagnostic>& errors);
 
 }  // namespace pbvbus::tools

@@ -1,6 +1,6 @@
 #include "pbvbus/quantum/command_register.hpp"
 
-#include "pbvbus/quantum/reference_names.hpp"
+#include "pbvbus/quantum/reference.hpp"
 
 namespace pbvbus::quantum {
 namespace {
@@ -21,7 +21,7 @@ void put_code(std::uint16_t& w, int hi, UnitCode c) {
   put(w, hi + 1, (v & 1U) != 0);
 }
 std::string ref4x(std::uint32_t i) {
-  return reference_name(RefType::Register4x, i);
+  return format_reference(RefType::Register4x, i);
 }
 
 }  // namespace

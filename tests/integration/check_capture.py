@@ -19,7 +19,9 @@ What an analyzer at the capture's probe point would tell a commissioning enginee
                    legitimate ones: the first token seen, a repeated pass by the last passer when
                    nothing was heard after its pass (Check_Token_Pass retry, or giving up and
                    passing to the next station), and a claim (DC n n) after at least
-                   TTO(n) = 6*TSL + 2*n*TSL of silence;
+                   TTO(n) = 6*TSL + 2*n*TSL of silence (also when n was the last holder: a
+                   lone master's token to itself after TTO of silence is a claim; listed
+                   under "claims" with the idle before it);
   ring membership  token passes (SA>DA) per time window.
 
 Times are in seconds in the arguments and the report (ns inside). Bit times use the baud from
@@ -328,7 +330,7 @@ def analyse(itf, recs, args, allow):
                    for a, v in sorted(live.items())}
 
     # Tokens.
-    tokens, conflicts = [], []
+    tokens, conflicts, claims = [], [], []
     holder, last_pass, heard_since_pass = None, None, True
     busy_until = None
     for f in frames:
@@ -343,12 +345,17 @@ def analyse(itf, recs, args, allow):
         tto = 6 * args.tsl + 2 * sa * args.tsl
         if holder is None:
             kind = "first"
+        elif sa == da and idle is not None and bits(idle) >= tto:
+            # Before "pass": a lone master's token to itself (n>n) is a claim too when it
+            # follows TTO(n) of silence (the ring was lost, e.g. a master module that took over
+            # the address of one that failed); a working holder never leaves the line idle
+            # that long (TTO is what makes every other master claim).
+            kind = "claim"
+            claims.append({"t": sec(f.start), "token": "%d>%d" % (sa, da), "idle_bits": bits(idle)})
         elif sa == holder:
             kind = "pass"
         elif last_pass is not None and sa == last_pass[0] and not heard_since_pass:
             kind = "retry" if da == last_pass[1] else "next"
-        elif sa == da and idle is not None and bits(idle) >= tto:
-            kind = "claim"
         else:
             kind = "conflict"
         tokens.append((f.start, sa, da, kind))
@@ -357,6 +364,7 @@ def analyse(itf, recs, args, allow):
                               "holder": holder, "allowed": in_any(f.start, allow)})
         holder, last_pass, heard_since_pass = da, (sa, da), False
     rep["token_conflicts"] = conflicts
+    rep["claims"] = claims
     rep["token_kinds"] = {}
     for _, _, _, k in tokens:
         rep["token_kinds"][k] = rep["token_kinds"].get(k, 0) + 1

@@ -18,7 +18,8 @@
 //  - Progress (virtual time, speed ratio, frames, error frames) goes to stderr only when stderr
 //    is a terminal, --quiet is not given, and the run has taken more than a second of wall
 //    time; it is erased before the report.
-//  - A scenario with a gateway or an s7_door runs paced (its doors face programs in real time);
+//  - A scenario with a gateway, an s7_door or a Quantum pair's Modbus port runs paced (its doors
+//    face programs in real time);
 //    --fast with an s7_door leaves the door closed (its report says "not open"); with a gateway --fast is
 //    refused for it. The doors print where they listen (the port an ephemeral one got); a door
 //    that cannot open ends the run with exit 1 before it starts.
@@ -300,8 +301,12 @@ int cmd_run(const Args& args, std::ostream& out, std::ostream& err) {
     return fail(2, plan.file + " has a gateway: its doors need a paced run (drop --fast)");
   // An S7 door is not needed to run the plant (no outputs depend on it): a fast run (tests,
   // captures) simply does not open it, and the report says so.
-  const bool paced =
-      ra.paced || (!ra.fast && (has_serial || !plan.gateways.empty() || !plan.s7.doors.empty()));
+  // A Quantum pair's Modbus ports are doors too (paced by default; --fast leaves them closed, as
+  // it does an S7 door: the pair runs the same without a host polling it).
+  bool has_quantum_doors = false;
+  for (const auto& q : plan.quantum) has_quantum_doors |= !q.modbus.empty();
+  const bool paced = ra.paced || (!ra.fast && (has_serial || !plan.gateways.empty() ||
+                                               !plan.s7.doors.empty() || has_quantum_doors));
   const std::optional<bus::Ticks> duration = ra.duration ? ra.duration : plan.duration;
   if (!duration && !paced)
     return fail(2, plan.file + ": the scenario has no duration; add duration: \"5s\" or use --duration");

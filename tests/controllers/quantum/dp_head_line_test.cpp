@@ -197,6 +197,39 @@ TEST(DpHeadLine, PrimaryCpuStopTakenOverWithinOneScan) {
   EXPECT_TRUE(r.frames_of(r.sys.head(0).attachment(), r.frames_of(r.sys.head(1).attachment(), from)[0]).empty());
 }
 
+TEST(DpHeadLine, PrimaryCpuStopJustBeforeTheTransferIsDueIsATakeoverNotAFibreFault) {
+  // A stopped CPU's module goes passive at once, but a frame it had on the wire still ends
+  // after the stop. When that frame spans the instant the standby's transfer was due, the line
+  // is still "heard" there; the second question (TTO later) asks for a frame that STARTED after
+  // the first one, so the finishing frame is no sign of life: takeover, not a CHS link failure
+  // (docs/quantum-hsby-campaign.md F2). The simulation is deterministic: a first run finds the
+  // primary module's frames that span a scan start; each case stops the CPU one tick after such
+  // a frame started.
+  std::vector<bus::Ticks> starts;
+  {
+    DlRig dry;
+    dry.sys.run_until(1000 * kDlMs);
+    for (std::size_t i : dry.frames_of(dry.sys.head(0).attachment(), 0)) {
+      const auto& f = dry.rec.frame(i);
+      const bus::Ticks due = (f.end / kDlScan) * kDlScan;  // the last scan start before its end
+      if (f.start > 200 * kDlMs && f.start < due && starts.size() < 12) starts.push_back(f.start);
+    }
+  }
+  ASSERT_GE(starts.size(), 3u);
+  for (bus::Ticks t : starts) {
+    SCOPED_TRACE(t);
+    DlRig r;
+    r.sys.run_until(t + 1);
+    r.sys.pair().stop_cpu(0);
+    r.sys.run_until(t + 100 * kDlMs);
+    ASSERT_EQ(r.sys.pair().switchovers().size(), 1u);
+    EXPECT_EQ(r.sys.pair().switchovers()[0].cause, SwitchoverCause::PrimaryCpuStop);
+    EXPECT_LE(r.sys.pair().switchovers()[0].takeover_ticks, kDlScan);
+    EXPECT_EQ(r.sys.pair().primary(), 1);
+    r.expect_slaves_kept_data_exchange();
+  }
+}
+
 TEST(DpHeadLine, PlannedHandoverKeyOffLine) {
   DlRig r;
   r.sys.run_until(305 * kDlMs);

@@ -283,5 +283,26 @@ TEST(DpHeadLine, OverrideSwitchoverBothRunBitsZero) {
   r.expect_slaves_kept_data_exchange();
 }
 
+// Finding F1 of the campaign (docs/quantum-hsby-campaign.md), a reproduction kept disabled
+// until the pair decides: a unit that joins as standby holds the state RAM it had before its
+// own outage until the first transfer completes (scan start + transfer time). A primary failure
+// in that window makes it take over from that old state RAM: the counter goes back by the
+// scans it missed (here 5 and more), at the slaves and through Modbus. The seed says nothing
+// about a standby's readiness beyond "the standby indicator is on"; the campaign counts the pair
+// redundant only after a transfer to the new standby completed.
+TEST(DpHeadLine, DISABLED_FindingF1PrimaryFailureBeforeTheFirstTransferToANewStandby) {
+  DlRig r;
+  r.sys.run_until(307 * kDlMs);
+  r.sys.pair().power_off(0);
+  r.sys.run_until(450 * kDlMs);  // rack 1 primary since 320 ms, scans at 320 + 20 k ms
+  r.sys.pair().power_on(0);      // standby at once, its state RAM from 307 ms
+  ASSERT_EQ(r.sys.pair().standby(), 0);
+  r.sys.run_until(461 * kDlMs);  // the scan at 460 ms started a transfer due at 465 ms
+  r.sys.pair().power_off(1);
+  r.sys.run_until(560 * kDlMs);
+  EXPECT_EQ(r.sys.pair().primary(), 0);
+  EXPECT_EQ(r.stale, 0u);  // fails today: the slaves see the counter go back
+}
+
 }  // namespace
 }  // namespace pbvbus::quantum

@@ -36,6 +36,8 @@ namespace {
 
 constexpr std::size_t kHcMaxReports = 20;
 constexpr std::uint16_t kHcStaleSetBack = 5;
+constexpr std::uint64_t kHcPoll = 0;
+constexpr std::uint64_t kHcDeferredPoll = 1;
 
 double hc_ms(bus::Ticks t) {
   return static_cast<double>(t) / static_cast<double>(bus::kTicksPerMs);
@@ -75,7 +77,7 @@ class HcRun final : public bus::EventTarget {
   HsbyCampaignResult run() {
     const auto w0 = std::chrono::steady_clock::now();
     m_sys.start();
-    m_sys.scheduler().schedule(m_o.poll_period, *this, 0);
+    m_sys.scheduler().schedule(m_o.poll_period, *this, kHcPoll);
     m_expect_primary = 0;
     settle("start-up");
     run_to_random_phase();
@@ -101,9 +103,13 @@ class HcRun final : public bus::EventTarget {
     return std::move(m_r);
   }
 
-  void on_event(bus::Ticks now, std::uint64_t) override {
-    poll(now);
-    m_sys.scheduler().schedule(now + m_o.poll_period, *this, 0);
+  void on_event(bus::Ticks now, std::uint64_t tag) override {
+    if (tag == kHcDeferredPoll) {
+      poll(now, false);
+      return;
+    }
+    poll(now, true);
+    m_sys.scheduler().schedule(now + m_o.poll_period, *this, kHcPoll);
   }
 
  private:
@@ -160,9 +166,16 @@ class HcRun final : public bus::EventTarget {
     }
   }
 
-  void poll(bus::Ticks now) {
-    ++m_r.modbus_polls;
+  void poll(bus::Ticks now, bool may_defer) {
     const int r = m_port.rack_for(1);
+    const auto& sw = m_sys.pair().switchovers();
+    if (may_defer && r >= 0 && !sw.empty() && sw.back().time == now && sw.back().new_rack == r) {
+      // Decision C9: a request reaching the new primary at the instant of its takeover is
+      // served after its first scan (scheduled at this instant before this poll: FIFO).
+      m_sys.scheduler().schedule(now, *this, kHcDeferredPoll);
+      return;
+    }
+    ++m_r.modbus_polls;
     if (r < 0) {
       ++m_r.modbus_no_answer;
       if (m_silent_since == bus::kNever) m_silent_since = now;

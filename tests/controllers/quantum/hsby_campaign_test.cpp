@@ -16,7 +16,7 @@ namespace {
 
 constexpr bus::Ticks kHcTestMs = bus::kTicksPerMs;
 
-void expect_clean(const HsbyCampaignResult& r) {
+void hc_expect_clean(const HsbyCampaignResult& r) {
   EXPECT_TRUE(r.clean()) << r.summary();
   EXPECT_EQ(r.pulses, 0u);
   EXPECT_EQ(r.stale_outputs, 0u);
@@ -35,7 +35,7 @@ TEST(HsbyCampaign, ThousandFaultsOnTheLineFindNothing) {
   o.slaves = 8;
   const HsbyCampaignResult r = run_hsby_campaign(o);
   RecordProperty("summary", r.summary());
-  expect_clean(r);
+  hc_expect_clean(r);
   EXPECT_GE(r.faults, 1000);
   EXPECT_EQ(r.faults, r.repairs);
   for (int k = 0; k < kHsbyFaultKinds; ++k) EXPECT_GT(r.drawn[static_cast<std::size_t>(k)], 50) << k;
@@ -60,7 +60,7 @@ TEST(HsbyCampaign, EveryFaultKindAloneFindsNothing) {
     o.weights.fill(0);
     o.weights[static_cast<std::size_t>(k)] = 1;
     const HsbyCampaignResult r = run_hsby_campaign(o);
-    expect_clean(r);
+    hc_expect_clean(r);
     EXPECT_EQ(r.drawn[static_cast<std::size_t>(k)], 30);
     const auto f = static_cast<HsbyFault>(k);
     const bool swaps = f == HsbyFault::PrimaryPower || f == HsbyFault::PrimaryCpuStop ||

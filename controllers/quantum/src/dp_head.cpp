@@ -7,7 +7,8 @@ namespace pbvbus::quantum {
 
 DpHead::DpHead(const dp::MasterParams& master, std::vector<dp::SlaveParams> slaves,
                const fdl::BusParams& params, std::vector<DpIoMap> map, bus::Ticks silence_bound)
-    : m_master(master, std::move(slaves)), m_map(std::move(map)), m_bound(silence_bound) {
+    : m_master(master, std::move(slaves)), m_map(std::move(map)), m_bound(silence_bound),
+      m_tbit(bus::ticks_per_bit(params.baud)) {
   m_station = std::make_unique<fdl::ActiveStation>(master.address, params, *this);
   for (const DpIoMap& e : m_map) {
     const dp::MasterImage& img = m_master.image(e.slave);
@@ -33,6 +34,7 @@ void DpHead::set_role(bus::Ticks now, HeadRole role) {
       m_master.set_standby(true);
       m_station->set_passive(true, now);
       m_last_heard = bus::kNever;
+      m_last_start = bus::kNever;
       if (was == HeadRole::Off && m_line != nullptr) m_line->set_power(m_att, true);
       return;
     case HeadRole::Active:
@@ -110,8 +112,33 @@ bool DpHead::hears_active_master(bus::Ticks now) const {
   return m_role == HeadRole::Passive && m_last_heard != bus::kNever && now - m_last_heard <= m_bound;
 }
 
+bool DpHead::heard_since(bus::Ticks since, bus::Ticks now) const {
+  (void)now;
+  return m_role == HeadRole::Passive && m_last_start != bus::kNever && m_last_start >= since;
+}
+
+namespace {
+
+/// Octets of a telegram on the wire (IEC 61158-4-3 frame formats): SC 1, SD4 3, SD1 6, SD3 14,
+/// SD2 LE + 6 with LE = DA SA FC + the address extension octets + the DU.
+std::size_t dph_octets(const fdl::Telegram& t) {
+  switch (t.type) {
+    case fdl::FrameType::SC: return 1;
+    case fdl::FrameType::SD4: return 3;
+    case fdl::FrameType::SD1: return 6;
+    case fdl::FrameType::SD3: return 14;
+    case fdl::FrameType::SD2: break;
+  }
+  const std::size_t ext = (t.dsap ? 1 : 0) + (t.ssap ? 1 : 0) + (t.da_segment ? 1 : 0) +
+                          (t.sa_segment ? 1 : 0);
+  return 3 + ext + t.data.size() + 6;
+}
+
+}  // namespace
+
 void DpHead::on_power_on(bus::Ticks now) {
   m_last_heard = bus::kNever;
+  m_last_start = bus::kNever;
   m_master.on_power_on(now);
 }
 
@@ -128,7 +155,10 @@ void DpHead::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
 void DpHead::on_token(bus::Ticks now, bus::Ticks trr) { m_master.on_token(now, trr); }
 
 void DpHead::on_observed(bus::Ticks now, const fdl::Telegram& t) {
-  if (t.sa == m_station->address()) m_last_heard = now;
+  if (t.sa == m_station->address()) {
+    m_last_heard = now;
+    m_last_start = now - static_cast<bus::Ticks>(dph_octets(t) * 11) * m_tbit;
+  }
   m_master.on_observed(now, t);
 }
 

@@ -181,8 +181,14 @@ void HsbyPair::watch(int s, bus::Ticks now) {
   // No transfer started at the primary's scan start: the primary failed, or the fibre did.
   // The remote I/O line tells them apart: the active master still heard = the primary lives.
   const bool primary_alive = rk(p).state == CpuState::Primary;
-  const bool heard = k.head != nullptr ? k.head->hears_active_master(now) : primary_alive;
+  // The second question asks for a frame STARTED since the first one: a frame already on the
+  // wire when the primary failed may end after the first question (docs/quantum-hsby-campaign.md
+  // F2: a CPU stop just before the transfer was due was taken for a fibre fault).
+  const bool heard = k.head == nullptr ? primary_alive
+                     : k.rechecking    ? k.head->heard_since(k.first_check, now)
+                                       : k.head->hears_active_master(now);
   if (heard && m_p.line_check_delay > 0 && !k.rechecking) {
+    k.first_check = now;
     // The head hears the line within its silence bound: the primary may have failed just
     // before the due instant. Ask again once the bound has passed: still heard = the primary
     // lives (fibre fault); silent = it failed less than 2 bounds ago (takeover then).

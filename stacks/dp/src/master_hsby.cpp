@@ -129,6 +129,11 @@ void Master::shadow_request(bus::Ticks now, const fdl::Telegram& t) {
     return;
   }
   if (!has_slave(t.da)) return;
+  // Only SRD carries DP services (IEC 61158-6-3); the MAC's own requests to a slave address,
+  // e.g. the GAP poll's Request FDL Status (FC 0x49, answered with an empty status reply), are
+  // neither a Data_Exchange nor a DP service.
+  const fdl::RequestFn fn = fdl::fc_request_fn(t.fc);
+  if (fn != fdl::RequestFn::SrdLow && fn != fdl::RequestFn::SrdHigh) return;
   Slave& s = slave(t.da);
   const int idx = m_index[t.da];
   if (!t.dsap) {

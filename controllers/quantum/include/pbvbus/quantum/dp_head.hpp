@@ -20,6 +20,8 @@
 // `silence_bound` before `now`. A lone DP master is never silent longer than one message cycle
 // (request, slot time, retries) or a token pass; the default bound is TTO = 6·TSL + 2·n·TSL
 // (protocol-facts.md §C.4), the silence after which any FDL station takes the token for lost.
+// heard_since(since, now): such a frame STARTED at or after `since` (for the pair's second
+// question: a frame already on the wire at the primary's failure is no sign of life).
 
 #include <cstdint>
 #include <memory>
@@ -71,6 +73,9 @@ class DpHead final : public IoHead, public fdl::InitiatorUser {
   void read_inputs(StateRam& ram) override;
   void write_outputs(const StateRam& ram) override;
   bool hears_active_master(bus::Ticks now) const override;
+  /// A frame with this module's address started at or after `since` (start = the end reported
+  /// by the station minus the frame's octets x 11 bit times).
+  bool heard_since(bus::Ticks since, bus::Ticks now) const override;
 
   // fdl::InitiatorUser (forwarded to the master)
   void on_power_on(bus::Ticks now) override;
@@ -89,6 +94,8 @@ class DpHead final : public IoHead, public fdl::InitiatorUser {
   bus::AttachmentId m_att{};
   HeadRole m_role = HeadRole::Off;
   bus::Ticks m_last_heard = bus::kNever;
+  bus::Ticks m_last_start = bus::kNever;
+  bus::Ticks m_tbit = 0;
   std::vector<std::uint8_t> m_buf;
 };
 

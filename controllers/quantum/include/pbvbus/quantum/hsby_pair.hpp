@@ -113,7 +113,9 @@ struct HsbyPairParams {
   /// A passive head only knows the line has been silent for its own silence bound. When the
   /// transfer due at the primary's scan start is missing and the head still hears the active
   /// master, the standby asks again `line_check_delay` later (set it to the head's bound):
-  /// heard again = the primary lives, the fibre failed (the standby goes Offline); silent = the
+  /// heard again (IoHead::heard_since: a frame that STARTED after the first question, so a frame
+  /// already on the wire at the failure does not count) = the primary lives, the fibre failed
+  /// (the standby goes Offline); silent = the
   /// primary failed less than 2 × line_check_delay before the takeover. A head that is silent
   /// at the due instant means a takeover at once. So every takeover is within
   /// max(scan_time, 2 × line_check_delay) of the failure: within one scan (Q7) while
@@ -269,6 +271,7 @@ class HsbyPair final : public bus::EventTarget {
     std::uint64_t watch_gen = 0;                   ///< the standby's transfer watchdog
     bus::Ticks last_transfer_start = bus::kNever;  ///< as seen by this standby
     bool rechecking = false;  ///< the watchdog asks the head again after line_check_delay
+    bus::Ticks first_check = 0;  ///< when it asked first (the second question: heard since?)
     std::string blocker;  ///< why it last could not join (logged on change)
   };
   struct TransferValue {

@@ -32,6 +32,14 @@ class IoHead {
   /// Passive head: a frame sent by the active master (same address) was heard within the
   /// head's own silence bound before `now`.
   virtual bool hears_active_master(bus::Ticks now) const = 0;
+  /// Passive head: a frame sent by the active master STARTED at or after `since` (the pair's
+  /// second question, docs/quantum-hsby-campaign.md F2: a frame already on the wire when the
+  /// primary failed may end after the first question and must not count as a sign of life).
+  /// Heads that cannot tell answer hears_active_master(now).
+  virtual bool heard_since(bus::Ticks since, bus::Ticks now) const {
+    (void)since;
+    return hears_active_master(now);
+  }
 };
 
 }  // namespace pbvbus::quantum

@@ -248,6 +248,7 @@ void HsbyPair::set_state(int r, CpuState s, std::string_view why) {
   if (m_flight.active && (r == m_flight.from || r == m_flight.to))
     lose_in_flight(hsby_rack_name(r) + " " + std::string(to_string(s)));
   if (s == CpuState::Standby) m_alone_logged = false;
+  if (s == CpuState::Standby && k.state != CpuState::Standby) k.updated = false;
   if (s == CpuState::Primary) {
     k.primary_since = m_sched.now();
     k.scans_as_primary = 0;

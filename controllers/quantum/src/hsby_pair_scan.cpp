@@ -146,6 +146,7 @@ void HsbyPair::transfer_done(std::uint64_t gen, bus::Ticks now) {
   m_flight = InFlight{};
   Rack& p = rk(f.from);
   Rack& s = rk(f.to);
+  s.updated = true;
   for (const auto& v : f.values) {
     switch (v.type) {
       case RefType::Coil0x:
@@ -202,6 +203,19 @@ void HsbyPair::watch(int s, bus::Ticks now) {
         "no transfer from the primary and its I/O head still heard: CHS link failure, the "
         "standby goes offline and the primary runs alone");
     set_state(s, CpuState::Offline, "CHS link failure");
+    reconcile();
+    return;
+  }
+  if (!k.updated) {
+    // A unit that has just joined holds its state RAM from before its own outage until the
+    // first transfer completes: taking control from it would drive the outputs back by every
+    // scan it missed. It is not yet ready to assume control (seed p. 19: the standby LED
+    // steady = "ready to assume"), so it goes Offline and nobody is primary: the slaves go to
+    // their safe state (docs/quantum-hsby-pair.md, "A standby before its first transfer").
+    log(s, PairEventKind::Switchover,
+        "the primary failed before the first transfer to this standby completed: its state RAM "
+        "is from before it joined, it cannot take over and goes offline");
+    set_state(s, CpuState::Offline, "not updated since it joined");
     reconcile();
     return;
   }

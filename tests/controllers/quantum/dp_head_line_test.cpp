@@ -290,7 +290,9 @@ TEST(DpHeadLine, OverrideSwitchoverBothRunBitsZero) {
 // scans it missed (here 5 and more), at the slaves and through Modbus. The seed says nothing
 // about a standby's readiness beyond "the standby indicator is on"; the campaign counts the pair
 // redundant only after a transfer to the new standby completed.
-TEST(DpHeadLine, DISABLED_FindingF1PrimaryFailureBeforeTheFirstTransferToANewStandby) {
+// The pair's answer (docs/quantum-hsby-pair.md "A standby before its first transfer"): such a
+// standby is not ready; it does not take over, so no old value reaches the slaves.
+TEST(DpHeadLine, FindingF1PrimaryFailureBeforeTheFirstTransferToANewStandby) {
   DlRig r;
   r.sys.run_until(307 * kDlMs);
   r.sys.pair().power_off(0);
@@ -300,8 +302,10 @@ TEST(DpHeadLine, DISABLED_FindingF1PrimaryFailureBeforeTheFirstTransferToANewSta
   r.sys.run_until(461 * kDlMs);  // the scan at 460 ms started a transfer due at 465 ms
   r.sys.pair().power_off(1);
   r.sys.run_until(560 * kDlMs);
-  EXPECT_EQ(r.sys.pair().primary(), 0);
-  EXPECT_EQ(r.stale, 0u);  // fails today: the slaves see the counter go back
+  EXPECT_EQ(r.sys.pair().primary(), -1);
+  EXPECT_EQ(r.sys.pair().state(0), CpuState::Offline);
+  EXPECT_TRUE(r.sys.pair().switchovers().size() == 1u);  // only the first one (rack 0's power)
+  EXPECT_EQ(r.stale, 0u);
 }
 
 }  // namespace

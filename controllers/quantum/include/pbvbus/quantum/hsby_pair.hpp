@@ -33,7 +33,9 @@
 //   Offline (Com Err), the primary runs alone; silent -> takeover at that instant (the new
 //   primary's first scan), i.e. within one scan of the failure (Q7). A standby failure: the
 //   primary runs alone. A transfer in flight at a failure is lost (event TransferLost).
-//   (line_check_delay: a second question to the head after its silence bound, see below.) Two
+//   (line_check_delay: a second question to the head after its silence bound, see below.) A
+//   standby that has not received a completed transfer since it joined does not take over: it
+//   goes Offline (its state RAM is from before its outage). Two
 //   primaries (fibre and line silent) meeting again over the fibre: the later goes Offline.
 // - A planned handover ends a scan: a new primary always runs its first scan before it may
 //   hand control back.
@@ -270,7 +272,8 @@ class HsbyPair final : public bus::EventTarget {
     std::uint64_t scans_as_primary = 0;            ///< since it last became Primary
     std::uint64_t watch_gen = 0;                   ///< the standby's transfer watchdog
     bus::Ticks last_transfer_start = bus::kNever;  ///< as seen by this standby
-    bool rechecking = false;  ///< the watchdog asks the head again after line_check_delay
+    bool rechecking = false;
+    bool updated = false;  ///< a transfer completed into it since it last became Standby  ///< the watchdog asks the head again after line_check_delay
     bus::Ticks first_check = 0;  ///< when it asked first (the second question: heard since?)
     std::string blocker;  ///< why it last could not join (logged on change)
   };

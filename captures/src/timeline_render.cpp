@@ -1306,6 +1306,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
       lx = 12;
       ly += 16;
       head("Quantum rack");
+      lx += 8;  // the bold heading is wider than head() reckons
       std::set<int> states;
       for (const HsbyStateSpan& s : tl.hsby_states) states.insert(s.state);
       for (int st : states) sw(hsby_state_colour(st), hsby_state_name(st), false);

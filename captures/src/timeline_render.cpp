@@ -1202,8 +1202,8 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   const CpuRowIndex cpu_rows(tl);
   bool any_mpi = false;
   for (const auto& L : tl.lanes) any_mpi |= !L.mpi.empty();
-  const HsbyRowIndex hsby_rows(tl);
-  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16) + (hsby_rows.row.empty() ? 0 : 16) +
+  const HsbyRowIndex hsby_index(tl);
+  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16) + (hsby_index.row.empty() ? 0 : 16) +
                      (any_mpi ? 16 : 0);
   int y = head_h + kAxisH + kEvH;
   std::vector<int> lane_y;
@@ -1220,7 +1220,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   const int cpu_y = y;
   if (!cpu_rows.row.empty()) y += static_cast<int>(cpu_rows.row.size()) * kRowCpu + kLaneGap;
   const int hsby_y = y;
-  if (!hsby_rows.row.empty()) y += static_cast<int>(hsby_rows.row.size()) * kRowCpu + kLaneGap;
+  if (!hsby_index.row.empty()) y += static_cast<int>(hsby_index.row.size()) * kRowCpu + kLaneGap;
   const int lanes_end = y;
   std::vector<std::string> summary;
   for (const auto& L : tl.lanes) {
@@ -1302,7 +1302,7 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
              "\" font-size=\"12\" fill=\"#68717d\">(lighter: standby)</text>\n";
       lx += 18 * 6.8 + 12;
     }
-    if (!hsby_rows.row.empty()) {
+    if (!hsby_index.row.empty()) {
       lx = 12;
       ly += 16;
       head("Quantum rack");
@@ -1420,9 +1420,9 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
     svg_cpu(c, tl, cpu_rows, cpu_y);
     c.o += "</g>\n";
   }
-  if (!hsby_rows.row.empty()) {
+  if (!hsby_index.row.empty()) {
     c.o += "<g class=\"hsby-rows\">\n";
-    svg_hsby(c, tl, hsby_rows, hsby_y);
+    svg_hsby(c, tl, hsby_index, hsby_y);
     c.o += "</g>\n";
   }
   c.o += "<g class=\"events\" clip-path=\"url(#plotclip)\">\n";

@@ -60,7 +60,7 @@ std::size_t q_count(const std::string& s, const std::string& what) {
   return n;
 }
 
-const char* const kScenario = R"(name: "quantum-rows"
+const char* const kQRowsScenario = R"(name: "quantum-rows"
 seed: 1
 duration: "8s"
 line { name: "rio" baud: "1.5M" }
@@ -98,7 +98,7 @@ const QFiles& q_files() {
     r.dir = fs::path(PBVBUS_BINARY_DIR) / ("timeline_hsby_rows_" + std::to_string(::getpid()));
     fs::create_directories(r.dir);
     const fs::path scenario = r.dir / "q.textproto";
-    std::ofstream(scenario) << kScenario;
+    std::ofstream(scenario) << kQRowsScenario;
     r.capture = r.dir / "q.pcapng";
     r.svg = r.dir / "q.svg";
     r.html = r.dir / "q.html";

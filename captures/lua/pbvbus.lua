@@ -143,6 +143,7 @@ local abort_reasons = {
 }
 local event_categories = {
   [1] = "line", [2] = "station", [3] = "master", [4] = "redundancy", [5] = "cpu", [6] = "note",
+  [7] = "hsby",
 }
 local line_event_codes = {
   [0] = "cable cut", [1] = "cable repaired", [2] = "short circuit", [3] = "short circuit repaired",
@@ -170,6 +171,15 @@ local cpu_reasons = {
   [4] = "standby CPU in STOP", [5] = "redundant link lost", [6] = "comparison error",
   [7] = "one-sided OB 121", [8] = "master/standby swap",
 }
+-- Quantum Hot Standby pair events (captures/include/pbvbus/captures/hsby_event.hpp): code =
+-- kind (quantum::PairEventKind), a = rack (-1 the pair or the fibre), b = the rack's state after
+-- the event (-1 none), value = a switchover's takeover time in ns.
+local hsby_event_kinds = {
+  [0] = "power", [1] = "key", [2] = "state", [3] = "switchover", [4] = "transfer lost",
+  [5] = "logic mismatch", [6] = "duplicate designation", [7] = "fibre", [8] = "update",
+  [9] = "override", [10] = "cpu", [11] = "ignored",
+}
+local hsby_states = { [-1] = "none", [0] = "off", [1] = "offline", [2] = "primary", [3] = "standby" }
 local redundancy_event_codes = {
   [0] = "redundancy loss", [1] = "redundancy restored", [2] = "station failure",
   [3] = "station return", [4] = "master system failure", [5] = "master system return",
@@ -453,6 +463,13 @@ local EV = {
   cpu_event_id = ProtoField.uint16("pbevent.cpu.event_id", "Event ID", base.HEX),
   cpu_from = ProtoField.string("pbevent.cpu.from", "From"),
   cpu_to = ProtoField.string("pbevent.cpu.to", "To"),
+  hsby_kind = ProtoField.uint16("pbevent.hsby.kind", "Hot Standby event", base.DEC, hsby_event_kinds),
+  hsby_rack = ProtoField.int32("pbevent.hsby.rack", "Rack", base.DEC),
+  hsby_state = ProtoField.int32("pbevent.hsby.state", "State after", base.DEC, hsby_states),
+  hsby_kind_name = ProtoField.string("pbevent.hsby.kind_name", "Event"),
+  hsby_state_name = ProtoField.string("pbevent.hsby.state_name", "State after"),
+  hsby_takeover = ProtoField.uint64("pbevent.hsby.takeover_ns", "Takeover time (ns)", base.DEC),
+  hsby_takeover_ms = ProtoField.string("pbevent.hsby.takeover", "Takeover time"),
 }
 ev.fields = {}
 for _, f in pairs(EV) do table.insert(ev.fields, f) end
@@ -1456,6 +1473,7 @@ function ev.dissector(tvb, pinfo, tree)
   if cat == 1 then cname = line_event_codes[code] end
   if cat == 4 then cname = redundancy_event_codes[code] end
   if cat == 5 then cname = cpu_event_kinds[code] end
+  if cat == 7 then cname = hsby_event_kinds[code] end
   if cname then t:add(EV.code_name, tvb(2, 2), cname) end
   t:add_le(EV.line, tvb(4, 4))
   t:add_le(EV.a, tvb(8, 4))
@@ -1487,6 +1505,24 @@ function ev.dissector(tvb, pinfo, tree)
       local to, from = tvb(20, 1):uint(), tvb(21, 1):uint()
       c:add(EV.cpu_from, tvb(21, 1), names[from] or tostring(from))
       c:add(EV.cpu_to, tvb(20, 1), names[to] or tostring(to))
+    end
+  end
+  if cat == 7 then
+    local c = t:add(ev, tvb(2, 22), "Hot Standby event")
+    c:set_text("Hot Standby event: " .. (hsby_event_kinds[code] or ("kind " .. code)))
+    c:add_le(EV.hsby_kind, tvb(2, 2))
+    c:add_le(EV.hsby_rack, tvb(8, 4))
+    c:add_le(EV.hsby_state, tvb(12, 4))
+    c:add(EV.hsby_kind_name, tvb(2, 2), hsby_event_kinds[code] or ("kind " .. code))
+    local st = tvb(12, 4):le_int()
+    c:add(EV.hsby_state_name, tvb(12, 4), hsby_states[st] or ("state " .. st))
+    -- Only a switchover carries a takeover time (0 when the pair filed no switchover record).
+    if code == 3 then
+      local ns = tvb(16, 8):le_uint64()
+      c:add_le(EV.hsby_takeover, tvb(16, 8))
+      -- ms with 6 decimals, from the integer ns (no floating point on 64-bit values).
+      local ms, rest = ns / 1000000, ns % 1000000
+      c:add(EV.hsby_takeover_ms, tvb(16, 8), tostring(ms) .. "." .. string.format("%06d", rest:tonumber()) .. " ms")
     end
   end
   local text = ""

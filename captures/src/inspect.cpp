@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "pbvbus/captures/event_record.hpp"
+#include "pbvbus/captures/hsby_event.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 #include "capture_names.hpp"
@@ -12,6 +13,14 @@
 namespace pbvbus::captures {
 
 namespace {
+
+/// "40.000 ms": a takeover time in ms with µs digits (rounded down), exactly from the ns.
+std::string inspect_ms(std::uint64_t ns) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%llu.%03llu ms", static_cast<unsigned long long>(ns / 1'000'000),
+                static_cast<unsigned long long>(ns % 1'000'000 / 1'000));
+  return buf;
+}
 __extension__ typedef __int128 i128;
 
 using names::is_events_link;
@@ -265,6 +274,12 @@ std::optional<CaptureSummary> summarize(PcapngReader& reader, PcapngError& error
       es.a = e->a;
       es.b = e->b;
       es.value = e->value;
+      if (e->category == EventCategory::Hsby) {
+        ++s.hsby_records;
+        const auto h = hsby_event_fields(*e);
+        if (h && h->kind == HsbyEventKind::Switchover)
+          s.hsby_switchovers.push_back({r.ts_ns, h->rack, h->takeover_ns, h->text});
+      }
       es.text = std::move(e->text);
       s.events.push_back(std::move(es));
     }
@@ -316,6 +331,18 @@ std::string to_text(const CaptureSummary& s) {
     o += "  " + names::format_time_ns(e.ts_ns) + "  [" + e.category + "] " + e.text + "\n";
   if (s.bad_event_records)
     o += "Unreadable event records: " + std::to_string(s.bad_event_records) + "\n";
+  if (s.hsby_records) {
+    o += "Quantum Hot Standby: " + std::to_string(s.hsby_records) + " records, " +
+         std::to_string(s.hsby_switchovers.size()) + " switchovers\n";
+    for (const HsbySwitchoverSummary& w : s.hsby_switchovers) {
+      o += "  " + names::format_time_ns(w.ts_ns) + "  to rack " + std::to_string(w.rack) + ", ";
+      if (w.takeover_ns == 0)
+        o += "no takeover time";
+      else
+        o += "takeover " + inspect_ms(w.takeover_ns);
+      o += ": " + w.text + "\n";
+    }
+  }
   return o;
 }
 
@@ -343,7 +370,14 @@ std::string to_json(const CaptureSummary& s) {
     }
     o += "}";
   }
-  o += "],\"events\":[";
+  o += "],\"hsby\":{\"records\":" + std::to_string(s.hsby_records) + ",\"switchovers\":[";
+  for (std::size_t i = 0; i < s.hsby_switchovers.size(); ++i) {
+    const HsbySwitchoverSummary& w = s.hsby_switchovers[i];
+    o += std::string(i ? "," : "") + "{\"ts_ns\":" + std::to_string(w.ts_ns) +
+         ",\"rack\":" + std::to_string(w.rack) + ",\"takeover_ns\":" + std::to_string(w.takeover_ns) +
+         ",\"text\":\"" + json_escape(w.text) + "\"}";
+  }
+  o += "]},\"events\":[";
   for (std::size_t i = 0; i < s.events.size(); ++i) {
     const EventSummary& e = s.events[i];
     if (i) o += ",";

@@ -10,6 +10,7 @@
 
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/captures/cpu_event.hpp"
+#include "pbvbus/captures/hsby_event.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
 #include "saturate.hpp"
 #include "capture_names.hpp"
@@ -403,6 +404,51 @@ CpuRows cpu_rows(const std::vector<TimelineEvent>& events, std::int64_t end) {
   return out;
 }
 
+struct HsbyRows {
+  std::vector<HsbyStateSpan> spans;
+  std::vector<HsbySwitchoverMark> marks;
+};
+
+/// The Quantum racks' state spans and switchover marks over the whole capture (timeline.hpp
+/// "Quantum Hot Standby rows"); `events` in time order.
+HsbyRows hsby_rows(const std::vector<TimelineEvent>& events, std::int64_t end) {
+  using Key = std::pair<std::string, int>;  // (pair, rack)
+  std::map<Key, std::vector<HsbyStateSpan>> rows;
+  std::map<Key, std::vector<HsbySwitchoverMark>> marks;
+  for (const TimelineEvent& e : events) {
+    if (e.record.category != EventCategory::Hsby) continue;
+    const auto f = hsby_event_fields(e.record);
+    if (!f || f->rack < 0) continue;
+    const Key key{hsby_pair_name(f->text, f->rack), f->rack};
+    if (f->state >= 0) {
+      std::vector<HsbyStateSpan>& row = rows[key];
+      bool add = true;
+      if (!row.empty()) {
+        HsbyStateSpan& cur = row.back();
+        if (cur.state == f->state) {
+          add = false;
+        } else {
+          cur.end_ns = std::max(cur.start_ns, e.ts_ns);
+          if (cur.end_ns == cur.start_ns) row.pop_back();  // replaced at the same instant
+          if (!row.empty() && row.back().state == f->state) add = false;  // back to the one before
+        }
+      }
+      if (add) row.push_back({key.first, f->rack, f->state, e.ts_ns, e.ts_ns});
+    }
+    if (f->kind == HsbyEventKind::Switchover)
+      marks[key].push_back({key.first, f->rack, e.ts_ns, f->takeover_ns, f->text});
+  }
+  HsbyRows out;
+  for (auto& [key, row] : rows) {
+    if (row.empty()) continue;
+    row.back().end_ns = std::max(row.back().start_ns, end);
+    out.spans.insert(out.spans.end(), row.begin(), row.end());
+    const auto m = marks.find(key);
+    if (m != marks.end()) out.marks.insert(out.marks.end(), m->second.begin(), m->second.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string_view to_string(FrameKind k) {
@@ -556,6 +602,13 @@ std::optional<Timeline> build_timeline(PcapngReader& reader, const TimelineOptio
       tl.cpu_states.push_back(std::move(s));
   for (CpuObMark& m : cpu.obs)
     if (m.ts_ns >= tl.from_ns && m.ts_ns < to) tl.cpu_obs.push_back(std::move(m));
+  HsbyRows hsby = hsby_rows(events, tl.last_ns);
+  for (HsbyStateSpan& s : hsby.spans)
+    if (s.start_ns < to &&
+        (s.end_ns > tl.from_ns || (s.end_ns == s.start_ns && s.start_ns >= tl.from_ns)))
+      tl.hsby_states.push_back(std::move(s));
+  for (HsbySwitchoverMark& m : hsby.marks)
+    if (m.ts_ns >= tl.from_ns && m.ts_ns < to) tl.hsby_switchovers.push_back(std::move(m));
   for (LaneWork& w : lanes) {
     finish_lane(w, tl.from_ns, to);
     tl.lanes.push_back(std::move(w.lane));

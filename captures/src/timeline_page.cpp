@@ -54,6 +54,9 @@ const ROW_AC = 14;
 const CPU_STATE_COLOURS = ['#ced4da', '#e03131', '#fab005', '#2f9e44', '#74c0fc', '#1971c2', '#f76707',
   '#9c36b5', '#5c0a0a', '#15aabf'];
 const ROW_CPU = 22, OB_COLOUR = '#212529';
+// Quantum Hot Standby rows (docs/quantum-hsby.md): off, offline, primary, standby, as the SVG's.
+const HSBY_STATE_COLOURS = ['#ced4da', '#fab005', '#2f9e44', '#1971c2'];
+const SWITCHOVER_COLOUR = '#c2255c';
 const LABEL_W = 210, AXIS_H = 34, EV_H = 46, PAD_R = 18;
 const ROW_FRAMES = 30, ROW_TOKEN = 18, ROW_RULER = 20, ROW_DX = 14, LANE_GAP = 18, ROW_MPI = 16;
 const MIN_SPAN = 100;  // ns: a few bit times even at 12 Mbit/s
@@ -159,6 +162,13 @@ function cpuStateColour(n) { return CPU_STATE_COLOURS[n] || '#868e96'; }
 function cpuTextColour(n) { return n === 0 || n === 2 || n === 4 ? '#1d2126' : '#fff'; }
 function cpuLabel(sp) { return cpuStateName(sp[2]) + (sp[3] === 0 ? '' : ' ' + cpuRoleName(sp[3])); }
 let cpuY = 0;
+// Quantum rows: label, pair, rack, spans [start, end, state], switchovers [t, takeover ns, text].
+const HSBY = D.hsby || { states: [], rows: [] };
+const hsbyRows = HSBY.rows;
+function hsbyStateName(n) { return HSBY.states[n] !== undefined ? HSBY.states[n] : 'state ' + n; }
+function hsbyStateColour(n) { return HSBY_STATE_COLOURS[n] || '#868e96'; }
+function hsbyTextColour(n) { return n === 0 || n === 1 ? '#1d2126' : '#fff'; }
+let hsbyY = 0;
 
 // ---- view -------------------------------------------------------------------------------
 const full = [D.span[0], D.span[1]];
@@ -213,6 +223,8 @@ function layout() {
   if (acRows.length) y += acRows.length * ROW_AC + LANE_GAP;
   cpuY = y;
   if (cpuRows.length) y += cpuRows.length * ROW_CPU + LANE_GAP;
+  hsbyY = y;
+  if (hsbyRows.length) y += hsbyRows.length * ROW_CPU + LANE_GAP;
   totalH = y;
 }
 layout();
@@ -524,6 +536,45 @@ function drawCpu(s) {
   s.push('</g>');
 }
 
+function hsbySpanText(R, sp) {
+  return `${R.label.toUpperCase()}   ${hsbyStateName(sp[2])}\nfrom ${fmtAbs(sp[0], 9)}\nto   ${fmtAbs(sp[1], 9)}\nfor  ${fmtDur(sp[1] - sp[0])}`;
+}
+function switchoverText(R, m) {
+  const take = m[1] ? 'takeover ' + fmtDur(m[1]) : 'no takeover time';
+  return `${fmtAbs(m[0], 9)}  ${R.label}: switchover to rack ${R.r}, ${take}\n${m[2]}`;
+}
+let drawnHsbySpans = 0, drawnSwitchovers = 0;
+function drawHsby(s) {
+  if (!hsbyRows.length) return;
+  s.push('<g class="hsby-rows">');
+  s.push(`<rect x="0" y="${hsbyY - 6}" width="${LABEL_W - 8}" height="${hsbyRows.length * ROW_CPU + 12}" fill="#f7f8fa"/>`);
+  hsbyRows.forEach((R, j) => {
+    const y = hsbyY + j * ROW_CPU;
+    s.push(`<g class="hsby-row" data-pair="${esc(R.pair)}" data-rack="${R.r}">`);
+    s.push(`<text x="${LABEL_W - 12}" y="${y + 12}" text-anchor="end" font-size="11" fill="#495057">${esc(R.label)}</text>`);
+    s.push(`<g clip-path="url(#plotclip)"><rect x="${plotX}" y="${y}" width="${plotW}" height="${ROW_CPU - 1}" fill="${j % 2 ? '#fbfbfc' : '#f4f6f8'}"/>`);
+    for (const sp of R.s) {
+      if (sp[1] < v0 || sp[0] > v1) continue;
+      const xa = Math.max(plotX, X(sp[0])), xb = Math.min(plotX + plotW, X(sp[1]));
+      const w = Math.max(1, xb - xa);
+      const label = hsbyStateName(sp[2]);
+      s.push(`<rect class="hsby-span" data-state="${esc(label)}" x="${xa.toFixed(2)}" y="${y + 1}" width="${w.toFixed(2)}" height="13" fill="${hsbyStateColour(sp[2])}"/>`);
+      if (w > label.length * 6.2 + 8)
+        s.push(`<text x="${(xa + 4).toFixed(2)}" y="${y + 11}" font-size="10" fill="${hsbyTextColour(sp[2])}">${esc(label)}</text>`);
+      drawnHsbySpans++;
+    }
+    for (const m of R.sw) {
+      if (m[0] < v0 || m[0] > v1) continue;
+      const x = X(m[0]);
+      s.push(`<g class="hsby-switchover" data-takeover-ns="${m[1]}"><line x1="${x.toFixed(2)}" y1="${y}" x2="${x.toFixed(2)}" y2="${y + ROW_CPU - 2}" stroke="${SWITCHOVER_COLOUR}" stroke-width="2"/>` +
+        `<path d="M${(x - 4).toFixed(2)} ${y}h8l-4 5z" fill="${SWITCHOVER_COLOUR}"/></g>`);
+      drawnSwitchovers++;
+    }
+    s.push('</g></g>');
+  });
+  s.push('</g>');
+}
+
 function drawEvents(s) {
   const i0 = lowerBound(evTimes, v0), i1 = lowerBound(evTimes, v1 + 1e-9);
   // Group events closer than 4 px; stagger the labels over three rows.
@@ -569,6 +620,8 @@ function render() {
   drawActive(s);
   drawnCpuSpans = 0; drawnObs = 0;
   drawCpu(s);
+  drawnHsbySpans = 0; drawnSwitchovers = 0;
+  drawHsby(s);
   s.push('<g class="events" clip-path="url(#plotclip)">');
   drawEvents(s);
   s.push('</g>');
@@ -585,6 +638,9 @@ function render() {
   document.body.dataset.cpuRows = String(cpuRows.length);
   document.body.dataset.cpuSpansDrawn = String(drawnCpuSpans);
   document.body.dataset.cpuObsDrawn = String(drawnObs);
+  document.body.dataset.hsbyRows = String(hsbyRows.length);
+  document.body.dataset.hsbySpansDrawn = String(drawnHsbySpans);
+  document.body.dataset.hsbySwitchoversDrawn = String(drawnSwitchovers);
   document.body.dataset.mpiRows = String(lanes.reduce((n, L) => n + L.mpi.length, 0));
   document.body.dataset.mpiMarksDrawn = String(drawnMpiMarks);
   if (history.replaceState) history.replaceState(null, '', '#v=' + Math.round(v0) + ',' + Math.round(v1));
@@ -651,6 +707,13 @@ function hitTest(x, y) {
     const near = R.ob.filter(m => Math.abs(m[0] - t) <= tol);
     if (near.length) return near.slice(0, 20).map(m => obText(R, m)).join('\n');
     for (const sp of R.s) if (t >= sp[0] - tol && t <= sp[1] + tol) return cpuSpanText(R, sp);
+    return null;
+  }
+  if (hsbyRows.length && y >= hsbyY && y < hsbyY + hsbyRows.length * ROW_CPU) {
+    const R = hsbyRows[Math.floor((y - hsbyY) / ROW_CPU)];
+    const near = R.sw.filter(m => Math.abs(m[0] - t) <= tol);
+    if (near.length) return near.slice(0, 20).map(m => switchoverText(R, m)).join('\n');
+    for (const sp of R.s) if (t >= sp[0] - tol && t <= sp[1] + tol) return hsbySpanText(R, sp);
     return null;
   }
   for (const L of lanes) {
@@ -802,6 +865,13 @@ window.addEventListener('resize', schedule);
     Array.from(states).sort((a, b) => a - b).forEach(n => parts.push(`<span><span class="sw" style="background:${cpuStateColour(n)}"></span>${esc(cpuStateName(n))}</span>`));
     parts.push(`<span><span class="vl" style="background:${OB_COLOUR}"></span>OB</span>`);
     parts.push('<span>(lighter: standby)</span>');
+  }
+  if (hsbyRows.length) {
+    parts.push('<span><b>Quantum rack</b></span>');
+    const states = new Set();
+    hsbyRows.forEach(R => R.s.forEach(sp => states.add(sp[2])));
+    Array.from(states).sort((a, b) => a - b).forEach(n => parts.push(`<span><span class="sw" style="background:${hsbyStateColour(n)}"></span>${esc(hsbyStateName(n))}</span>`));
+    parts.push(`<span><span class="vl" style="background:${SWITCHOVER_COLOUR}"></span>switchover</span>`);
   }
   if (lanes.some(L => L.mpi.length)) {
     parts.push('<span><b>MPI connection</b></span>');

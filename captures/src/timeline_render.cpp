@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "pbvbus/captures/cpu_event.hpp"
+#include "pbvbus/captures/hsby_event.hpp"
 #include "timeline_page.hpp"
 
 namespace pbvbus::captures {
@@ -236,6 +237,14 @@ const char* cpu_text_colour(int state) {
   return state == 0 || state == 2 || state == 4 ? "#1d2126" : "#fff";
 }
 constexpr const char* kObColour = "#212529";
+/// Quantum rack states (hsby_event.hpp numbers; as the page's HSBY_STATE_COLOURS): off grey,
+/// offline amber, primary green, standby blue; others grey.
+const char* const kHsbyStateColour[] = {"#ced4da", "#fab005", "#2f9e44", "#1971c2"};
+const char* hsby_state_colour(int state) {
+  return state >= 0 && state < kHsbyRackStates ? kHsbyStateColour[state] : "#868e96";
+}
+const char* hsby_text_colour(int state) { return state == 0 || state == 1 ? "#1d2126" : "#fff"; }
+constexpr const char* kSwitchoverColour = "#c2255c";
 
 // MPI connection rows (timeline.hpp "MPI connections").
 const char* mpi_span_colour(MpiState s) {
@@ -282,6 +291,30 @@ struct CpuRowIndex {
   std::string label(const std::string& system, int rack) const {
     const std::string cpu = "CPU " + std::to_string(rack) + " (rack " + std::to_string(rack) + ")";
     return several_systems && !system.empty() ? sanitize_utf8(system) + ": " + cpu : cpu;
+  }
+};
+
+/// The Quantum rows of a Timeline: (pair, rack) in the order of hsby_states (by pair, then
+/// rack); a label names the pair only when several pairs share the picture.
+struct HsbyRowIndex {
+  std::map<std::pair<std::string, int>, int> row;
+  bool several_pairs = false;
+  explicit HsbyRowIndex(const Timeline& tl) {
+    std::set<std::pair<std::string, int>> keys;
+    std::set<std::string> pairs;
+    for (const HsbyStateSpan& s : tl.hsby_states) keys.emplace(s.pair, s.rack);
+    for (const HsbySwitchoverMark& m : tl.hsby_switchovers) keys.emplace(m.pair, m.rack);
+    int i = 0;
+    for (const auto& k : keys) {
+      row.emplace(k, i++);
+      pairs.insert(k.first);
+    }
+    several_pairs = pairs.size() > 1;
+  }
+  int of(const std::string& pair, int rack) const { return row.at({pair, rack}); }
+  std::string label(const std::string& pair, int rack) const {
+    const std::string r = "Quantum rack " + std::to_string(rack);
+    return several_pairs && !pair.empty() ? sanitize_utf8(pair) + ": " + r : r;
   }
 };
 
@@ -499,12 +532,41 @@ std::string page_json(const Timeline& tl, std::int64_t origin, std::int64_t view
     }
   }
   cpu += "]}";
+  // Quantum rows (timeline.hpp "Quantum Hot Standby rows"): per row its label, pair and rack,
+  // spans [start, end, state] and switchovers [time, takeover ns, text] in page time; the state
+  // names once. Left out (the page takes no rows) when the capture has no Quantum pair.
+  std::string hsby = "{\"states\":[";
+  for (int k = 0; k < kHsbyRackStates; ++k) hsby += std::string(k ? "," : "") + json_str(hsby_state_name(k));
+  hsby += "],\"rows\":[";
+  {
+    const HsbyRowIndex rows(tl);
+    std::vector<std::string> spans(rows.row.size()), sws(rows.row.size());
+    for (const HsbyStateSpan& s : tl.hsby_states) {
+      std::string& o = spans[static_cast<std::size_t>(rows.of(s.pair, s.rack))];
+      o += std::string(o.empty() ? "" : ",") + "[" + std::to_string(rel(s.start_ns, origin)) + "," +
+           std::to_string(rel(s.end_ns, origin)) + "," + std::to_string(s.state) + "]";
+    }
+    for (const HsbySwitchoverMark& m : tl.hsby_switchovers) {
+      std::string& o = sws[static_cast<std::size_t>(rows.of(m.pair, m.rack))];
+      o += std::string(o.empty() ? "" : ",") + "[" + std::to_string(rel(m.ts_ns, origin)) + "," +
+           std::to_string(m.takeover_ns) + "," + json_str(m.text) + "]";
+    }
+    bool first = true;
+    for (const auto& [key, i] : rows.row) {
+      const auto u = static_cast<std::size_t>(i);
+      hsby += std::string(first ? "" : ",") + "{\"label\":" + json_str(rows.label(key.first, key.second)) +
+              ",\"pair\":" + json_str(key.first) + ",\"r\":" + std::to_string(key.second) +
+              ",\"s\":[" + spans[u] + "],\"sw\":[" + sws[u] + "]}";
+      first = false;
+    }
+  }
+  hsby += "]}";
   std::string o = "{\"v\":1,\"origin\":\"" + std::to_string(origin) + "\",\"span\":[" +
                   std::to_string(rel(tl.from_ns, origin)) + "," + std::to_string(rel(tl.to_ns, origin)) +
                   "],\"view\":[" + std::to_string(rel(view_from, origin)) + "," +
                   std::to_string(rel(view_to, origin)) + "],";
   tables.write(o);
-  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + ",\"cpu\":" + cpu + ",\"ac\":" + ac + "}";
+  o += ",\"lanes\":" + lanes + ",\"ev\":" + ev + ",\"cpu\":" + cpu + ",\"ac\":" + ac + (tl.hsby_states.empty() && tl.hsby_switchovers.empty() ? std::string() : ",\"hsby\":" + hsby) + "}";
   return o;
 }
 
@@ -928,6 +990,63 @@ void svg_cpu(SvgCtx& c, const Timeline& tl, const CpuRowIndex& rows, int y0) {
   }
 }
 
+/// "takeover 40.000 ms" or "no takeover time" (value 0).
+std::string takeover_text(std::uint64_t ns) {
+  constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
+  if (ns == 0) return "no takeover time";
+  return "takeover " + fmt_dur(ns > static_cast<std::uint64_t>(kMax) ? kMax : static_cast<std::int64_t>(ns));
+}
+
+/// One row per Quantum rack from y0 (timeline.hpp "Quantum Hot Standby rows"): spans coloured
+/// by state and labelled with it; switchovers as ticks with the takeover time in the tooltip.
+void svg_hsby(SvgCtx& c, const Timeline& tl, const HsbyRowIndex& rows, int y0) {
+  std::vector<std::string> body(rows.row.size());
+  for (const HsbyStateSpan& s : tl.hsby_states) {
+    const int row = rows.of(s.pair, s.rack);
+    const int yr = y0 + row * kRowCpu;
+    std::string& o = body[static_cast<std::size_t>(row)];
+    const double xa = c.clampx(c.x(s.start_ns)), xb = c.clampx(c.x(s.end_ns));
+    const double w = std::max(1.0, xb - xa);
+    const std::string label = hsby_state_name(s.state);
+    const std::string title = rows.label(s.pair, s.rack) + ": " + label + "\nfrom " +
+                              fmt_abs(s.start_ns, 9) + "\nto " + fmt_abs(s.end_ns, 9) + " (" +
+                              fmt_dur(diff(s.start_ns, s.end_ns)) + ")";
+    o += "<rect class=\"hsby-span\" data-state=\"" + xml(label) + "\" x=\"" + num(xa) + "\" y=\"" +
+         std::to_string(yr + 1) + "\" width=\"" + num(w) + "\" height=\"13\" fill=\"" +
+         hsby_state_colour(s.state) + "\"><title>" + xml(title) + "</title></rect>\n";
+    if (w > static_cast<double>(label.size()) * 6.2 + 8)
+      o += "<text x=\"" + num(xa + 4) + "\" y=\"" + std::to_string(yr + 11) +
+           "\" font-size=\"10\" fill=\"" + hsby_text_colour(s.state) + "\">" + xml(label) +
+           "</text>\n";
+  }
+  for (const HsbySwitchoverMark& m : tl.hsby_switchovers) {
+    const int row = rows.of(m.pair, m.rack);
+    const int yr = y0 + row * kRowCpu;
+    const double x = c.x(m.ts_ns);
+    const std::string title = fmt_abs(m.ts_ns, 9) + " switchover to rack " + std::to_string(m.rack) +
+                              ", " + takeover_text(m.takeover_ns) + "\n" + m.text;
+    body[static_cast<std::size_t>(row)] +=
+        "<g class=\"hsby-switchover\" data-takeover-ns=\"" + std::to_string(m.takeover_ns) +
+        "\"><line x1=\"" + num(x) + "\" y1=\"" + std::to_string(yr) + "\" x2=\"" + num(x) +
+        "\" y2=\"" + std::to_string(yr + kRowCpu - 2) + "\" stroke=\"" + kSwitchoverColour +
+        "\" stroke-width=\"2\"/><path d=\"M" + num(x - 4) + " " + std::to_string(yr) + "h8l-4 5z\" fill=\"" +
+        kSwitchoverColour + "\"/><title>" + xml(title) + "</title></g>\n";
+  }
+  for (const auto& [key, row] : rows.row) {
+    const int yr = y0 + row * kRowCpu;
+    c.o += "<g class=\"hsby-row\" data-pair=\"" + xml(key.first) + "\" data-rack=\"" +
+           std::to_string(key.second) + "\">\n<text x=\"" + std::to_string(kLabelW - 12) +
+           "\" y=\"" + std::to_string(yr + 12) +
+           "\" text-anchor=\"end\" font-size=\"11\" fill=\"#495057\">" +
+           xml(rows.label(key.first, key.second)) + "</text>\n<g clip-path=\"url(#plotclip)\">\n";
+    c.o += "<rect x=\"" + num(c.plot_x) + "\" y=\"" + std::to_string(yr) + "\" width=\"" +
+           num(c.plot_w) + "\" height=\"" + std::to_string(kRowCpu - 1) + "\" fill=\"" +
+           (row % 2 ? "#fbfbfc" : "#f4f6f8") + "\"/>\n";
+    c.o += body[static_cast<std::size_t>(row)];
+    c.o += "</g></g>\n";
+  }
+}
+
 std::string cycle_text(const SlaveCycles& S, std::uint64_t speed) {
   std::set<int> masters;
   for (const DxPoll& p : S.polls) masters.insert(p.master);
@@ -1083,7 +1202,9 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   const CpuRowIndex cpu_rows(tl);
   bool any_mpi = false;
   for (const auto& L : tl.lanes) any_mpi |= !L.mpi.empty();
-  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16) + (any_mpi ? 16 : 0);
+  const HsbyRowIndex hsby_index(tl);
+  const int head_h = kHeadH + (cpu_rows.row.empty() ? 0 : 16) + (hsby_index.row.empty() ? 0 : 16) +
+                     (any_mpi ? 16 : 0);
   int y = head_h + kAxisH + kEvH;
   std::vector<int> lane_y;
   for (const auto& L : tl.lanes) {
@@ -1098,6 +1219,8 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   if (ac_rows) y += ac_rows * kRowAc + kLaneGap;
   const int cpu_y = y;
   if (!cpu_rows.row.empty()) y += static_cast<int>(cpu_rows.row.size()) * kRowCpu + kLaneGap;
+  const int hsby_y = y;
+  if (!hsby_index.row.empty()) y += static_cast<int>(hsby_index.row.size()) * kRowCpu + kLaneGap;
   const int lanes_end = y;
   std::vector<std::string> summary;
   for (const auto& L : tl.lanes) {
@@ -1178,6 +1301,16 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
       c.o += "<text x=\"" + num(lx) + "\" y=\"" + std::to_string(ly) +
              "\" font-size=\"12\" fill=\"#68717d\">(lighter: standby)</text>\n";
       lx += 18 * 6.8 + 12;
+    }
+    if (!hsby_index.row.empty()) {
+      lx = 12;
+      ly += 16;
+      head("Quantum rack");
+      lx += 8;  // the bold heading is wider than head() reckons
+      std::set<int> states;
+      for (const HsbyStateSpan& s : tl.hsby_states) states.insert(s.state);
+      for (int st : states) sw(hsby_state_colour(st), hsby_state_name(st), false);
+      sw(kSwitchoverColour, "switchover", true);
     }
     if (any_mpi) {
       lx = 12;
@@ -1285,6 +1418,11 @@ std::string to_svg(const Timeline& tl, const TimelineSvgOptions& opts) {
   if (!cpu_rows.row.empty()) {
     c.o += "<g class=\"cpu-rows\">\n";
     svg_cpu(c, tl, cpu_rows, cpu_y);
+    c.o += "</g>\n";
+  }
+  if (!hsby_index.row.empty()) {
+    c.o += "<g class=\"hsby-rows\">\n";
+    svg_hsby(c, tl, hsby_index, hsby_y);
     c.o += "</g>\n";
   }
   c.o += "<g class=\"events\" clip-path=\"url(#plotclip)\">\n";

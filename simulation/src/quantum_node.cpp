@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "pbvbus/captures/event_record.hpp"
+#include "pbvbus/captures/hsby_event.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/gateways/modbus_rtu_port.hpp"
 #include "pbvbus/gateways/modbus_tcp_server.hpp"
@@ -171,13 +172,24 @@ void QuantumNode::start() {
   }
 }
 
+// The capture's Hsby records (captures/hsby_event.hpp) carry quantum's numbers.
+static_assert(static_cast<int>(quantum::PairEventKind::Power) == static_cast<int>(captures::HsbyEventKind::Power));
+static_assert(static_cast<int>(quantum::PairEventKind::Switchover) ==
+              static_cast<int>(captures::HsbyEventKind::Switchover));
+static_assert(static_cast<int>(quantum::PairEventKind::Fibre) == static_cast<int>(captures::HsbyEventKind::Fibre));
+static_assert(static_cast<int>(quantum::PairEventKind::Ignored) == static_cast<int>(captures::HsbyEventKind::Ignored));
+static_assert(static_cast<int>(quantum::CpuState::Off) == static_cast<int>(captures::HsbyRackState::Off));
+static_assert(static_cast<int>(quantum::CpuState::Offline) == static_cast<int>(captures::HsbyRackState::Offline));
+static_assert(static_cast<int>(quantum::CpuState::Primary) == static_cast<int>(captures::HsbyRackState::Primary));
+static_assert(static_cast<int>(quantum::CpuState::Standby) == static_cast<int>(captures::HsbyRackState::Standby));
+
 void QuantumNode::on_event(const quantum::PairEvent& e) {
-  captures::EventRecord r;
-  r.category = captures::EventCategory::Hsby;
-  r.code = static_cast<std::uint16_t>(e.kind);
-  r.a = e.rack;
-  r.b = e.rack >= 0 ? static_cast<std::int32_t>(e.state) : -1;
-  r.text = plan().name + ": " + (e.rack >= 0 ? "rack " + std::to_string(e.rack) + ": " : "") + e.text;
+  captures::HsbyEventFields f;
+  f.kind = static_cast<captures::HsbyEventKind>(e.kind);
+  f.rack = e.rack;
+  f.state = e.rack >= 0 ? static_cast<int>(e.state) : -1;
+  f.text = plan().name + ": " + (e.rack >= 0 ? "rack " + std::to_string(e.rack) + ": " : "") + e.text;
+  captures::EventRecord r = captures::hsby_event_record(f);
   if (e.kind != quantum::PairEventKind::Switchover) {
     if (m_capture != nullptr) m_capture->write_event(e.time, r);
     return;

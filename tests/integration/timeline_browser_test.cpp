@@ -4,7 +4,8 @@
 // DP cycle table, the fault marker); opened at a window of 150 µs through the URL fragment, the
 // page shows a bit-time axis, which it does not at the wide first view. The page of a
 // switched-io run (10 s) draws one active-channel row per switched station (docs/redundancy.md), and the
-// page of the built-in default scenario (an H system) one row per CPU (docs/h-system.md).
+// page of the built-in default scenario (an H system) one row per CPU (docs/h-system.md), and the
+// page of a Quantum Hot Standby run one row per rack (docs/quantum-hsby.md).
 //
 // Skipped, with the reason, when no Chromium is installed (Debian: apt-get install chromium);
 // PBVBUS_CHROMIUM may name the browser binary.
@@ -309,6 +310,53 @@ TEST_F(TimelineBrowserH, ScriptDrawsTheCpuRows) {
   // OB 72 at F5 (CPU 0) and F1 (CPU 1).
   EXPECT_EQ(count(svg, "<g class=\"cpu-ob\" data-ob=\"72\">"), 2u);
   EXPECT_NE(dom.find("<b>CPU state</b>"), std::string::npos);
+}
+
+/// The page of a Quantum Hot Standby pair (rack 0 loses power at 2 s; rack 1 takes over).
+class TimelineBrowserQ : public TimelineBrowser {
+ protected:
+  void SetUp() override {
+    if (!start()) GTEST_SKIP() << kNoChromium;
+    const std::string scenario = (m_dir / "q.textproto").string();
+    std::ofstream(scenario)
+        << "name: \"q\"\nseed: 1\nduration: \"4s\"\nline { name: \"rio\" baud: \"1.5M\" }\n"
+           "dp_master { address: 1 line: \"rio\" watchdog: \"300ms\" }\n"
+           "dp_slave { address: 3 line: \"rio\" gsd: \"" PBVBUS_SOURCE_DIR "/examples/gsd/PBVB0A01.gsd\" master: 1 }\n"
+           "quantum_hot_standby { name: \"Quantum\" cpu: CPU_434_12 logic_time: \"20ms\"\n"
+           "  rack { designation: A power_on_at: \"0s\" } rack { designation: B power_on_at: \"100ms\" }\n"
+           "  dp { line: \"rio\" address: 1 map { slave: 3 inputs: \"300001\" outputs: \"400100\" } } }\n"
+           "fault { at: \"2s\" repair_at: \"3s\" quantum_power_loss { rack: 0 } }\n";
+    const std::string capture = (m_dir / "q.pcapng").string();
+    std::ostringstream out, err;
+    ASSERT_EQ(cmd_run({scenario, "--fast", "--capture", capture, "--quiet"}, out, err), 0) << err.str();
+    m_html = (m_dir / "q.html").string();
+    ASSERT_EQ(cmd_timeline({capture, "-o", m_html}, out, err), 0) << err.str();
+  }
+};
+
+TEST_F(TimelineBrowserQ, ScriptDrawsTheQuantumRows) {
+  const auto [rc, dom] = chromium("--dump-dom", "file://" + m_html);
+  ASSERT_EQ(rc, 0);
+  EXPECT_NE(dom.find("data-rendered=\"1\""), std::string::npos) << "the page script did not run";
+  EXPECT_NE(dom.find("data-hsby-rows=\"2\""), std::string::npos);
+  const std::string svg = svg_of(dom);
+  ASSERT_NE(svg, "");
+  for (const char* rack : {"0", "1"}) {
+    EXPECT_NE(svg.find(std::string("<g class=\"hsby-row\" data-pair=\"Quantum\" data-rack=\"") + rack + "\">"),
+              std::string::npos)
+        << rack;
+    EXPECT_NE(svg.find(std::string(">Quantum rack ") + rack + "</text>"), std::string::npos) << rack;
+  }
+  // The first view is the whole run: every span and the switchover are drawn and counted.
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(dom, m, std::regex("data-hsby-spans-drawn=\"(\\d+)\"")));
+  const std::size_t spans = std::stoul(m[1].str());
+  EXPECT_GE(spans, 4u);  // rack 0: primary, off, ...; rack 1: standby, primary
+  EXPECT_EQ(count(svg, "class=\"hsby-span\""), spans);
+  EXPECT_GE(count(svg, "class=\"hsby-span\" data-state=\"primary\""), 2u);  // both racks, in turn
+  EXPECT_NE(dom.find("data-hsby-switchovers-drawn=\"1\""), std::string::npos);
+  EXPECT_EQ(count(svg, "<g class=\"hsby-switchover\" data-takeover-ns=\"40000000\">"), 1u);
+  EXPECT_NE(dom.find("<b>Quantum rack</b>"), std::string::npos);
 }
 
 }  // namespace

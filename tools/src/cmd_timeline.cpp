@@ -168,7 +168,7 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
     const captures::PageWindow pw = captures::page_window(*tl, from, to, max_frames);
     if (pw.cut) {
       // A long capture: the frames of the window only; the overview (events, active channels,
-      // CPU rows) and the page's span stay whole (timeline_window.hpp).
+      // CPU rows, Quantum rows) and the page's span stay whole (timeline_window.hpp).
       ho.note = captures::page_window_note(*tl, pw, max_frames);
       captures::TimelineOptions wo;
       wo.from_ns = pw.from_ns;
@@ -184,6 +184,8 @@ int cmd_timeline(const Args& args, std::ostream& out, std::ostream& err) {
       part->active_channels = std::move(tl->active_channels);
       part->cpu_states = std::move(tl->cpu_states);
       part->cpu_obs = std::move(tl->cpu_obs);
+      part->hsby_states = std::move(tl->hsby_states);
+      part->hsby_switchovers = std::move(tl->hsby_switchovers);
       tl = std::move(part);
       err << "pbvbus timeline: " << ho.note << "\n";
     }

@@ -18,6 +18,10 @@
 //    MPI (the dissector's rule, captures/README.md "MPI and S7") counts as its MPI PDU instead.
 //  - Interfaces of other link types (S7 upper-PDU records, 252, among them) are counted
 //    (records, octets, time span) and not decoded.
+//  - Quantum Hot Standby pair events (category 7, hsby_event.hpp) are counted apart and their
+//    switchovers listed with the takeover time the record carries (docs/quantum-hsby.md
+//    "Captures and timeline"); the text report shows that part only when the capture has such
+//    records, the JSON always ("hsby": {"records": 0, "switchovers": []}).
 
 #include <cstdint>
 #include <map>
@@ -63,6 +67,14 @@ struct EventSummary {
   std::string text;
 };
 
+/// A switchover of a Quantum Hot Standby pair (an Hsby record of kind switchover).
+struct HsbySwitchoverSummary {
+  std::int64_t ts_ns = 0;
+  int rack = -1;                  ///< the new primary (a)
+  std::uint64_t takeover_ns = 0;  ///< 0 = none given
+  std::string text;
+};
+
 struct CaptureSummary {
   std::uint64_t records = 0;
   std::optional<std::int64_t> first_ns;
@@ -70,6 +82,8 @@ struct CaptureSummary {
   std::vector<InterfaceSummary> interfaces;
   std::vector<EventSummary> events;
   std::uint64_t bad_event_records = 0;  ///< USER1 packets that are no valid event record
+  std::uint64_t hsby_records = 0;       ///< events of category Hsby (7)
+  std::vector<HsbySwitchoverSummary> hsby_switchovers;  ///< in file order
 };
 
 /// Reads everything `reader` still has. On a read error returns nullopt and sets `error`.

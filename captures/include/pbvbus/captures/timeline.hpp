@@ -100,6 +100,16 @@
 //    repeats by the FDL layer included (the wire's view). Rows are worked out on the whole
 //    capture and cut to the window like the DX rows; every row is kept, also without spans or
 //    marks in the window.
+//  - Quantum Hot Standby rows (docs/quantum-hsby.md "Captures and timeline"): from the Hsby
+//    event records (category 7, hsby_event.hpp). A rack gets a row if it has at least one record
+//    with a >= 0 and b >= 0 (every such record carries the rack's state after the event, whatever
+//    its kind); a row is (pair, rack), the pair being the name before ": rack <rack>: " in the
+//    text (hsby_pair_name(); pbvbus writes "Q: rack 0: offline -> primary (power on)"). The row
+//    starts at the rack's first such record; each sets state = b; spans merge and drop as the CPU
+//    rows' do, and the last lasts to last_ns. Records of the pair or the fibre (a = -1) make no
+//    span. Switchover marks: every record of kind switchover (3) of a rack with a row, on that
+//    rack's row (the new primary's; "two primaries meet again" names the unit that goes
+//    offline), with the takeover time from the value (0: none given). By pair, rack, then time.
 //  - Window [from_ns, to_ns): frames, token spans, active-channel spans and CPU state spans that
 //    overlap it, polls, events and OB marks that start in it. Without a window: from the earliest record to 1 ns
 //    after the end of the latest frame or event (so that what happens last is inside; to_ns
@@ -278,6 +288,25 @@ struct CpuObMark {
   std::string text;           ///< the record's text
 };
 
+/// A time in which one rack of a Quantum Hot Standby pair was in one state (hsby_event.hpp:
+/// 0 off, 1 offline, 2 primary, 3 standby; hsby_state_name()).
+struct HsbyStateSpan {
+  std::string pair;  ///< the pair's name from the record texts ("" if none)
+  int rack = 0;
+  int state = 0;
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+};
+
+/// A switchover of a Quantum pair, drawn as a marker on the rack's row.
+struct HsbySwitchoverMark {
+  std::string pair;
+  int rack = 0;  ///< the new primary
+  std::int64_t ts_ns = 0;
+  std::uint64_t takeover_ns = 0;  ///< from the failure or request to the first scan; 0 = none given
+  std::string text;               ///< the record's text
+};
+
 struct Timeline {
   std::int64_t from_ns = 0;  ///< the window
   std::int64_t to_ns = 0;
@@ -291,6 +320,10 @@ struct Timeline {
   std::vector<CpuStateSpan> cpu_states;
   /// In the window, by system, rack, then time.
   std::vector<CpuObMark> cpu_obs;
+  /// Quantum Hot Standby rows: in the window, by pair, rack, then start time.
+  std::vector<HsbyStateSpan> hsby_states;
+  /// In the window, by pair, rack, then time.
+  std::vector<HsbySwitchoverMark> hsby_switchovers;
   std::uint64_t records = 0;
   std::uint64_t bad_event_records = 0;
   std::uint64_t skipped_interfaces = 0;

@@ -18,9 +18,10 @@
 //    The window is never empty: it is at least 1 ns long.
 //  - Only what comes with the frames is cut to the window: frames, token spans, DP polls (cycle
 //    times and token holders are still worked out on the whole capture, timeline.hpp, so they
-//    are the same as in a page of everything). The events, the active channels and the CPU rows
-//    of the whole capture stay, and the page spans the whole capture: they are few, and they are
-//    the overview a reader of a long run looks at first to find the stretch worth the frames.
+//    are the same as in a page of everything). The events, the active channels, the CPU rows and
+//    the Quantum rows of the whole capture stay, and the page spans the whole capture: they are
+//    few, and they are the overview a reader of a long run looks at first to find the stretch
+//    worth the frames.
 //    So the first view without --from/--to is still the whole run, with frames in the window
 //    only.
 //  - What was left out is said in the page (a note under the header) and by the command on

@@ -106,6 +106,8 @@ class QuantumPlanner {
     plan_transfer(i, q, p);
     p.keyswitch_override = q.keyswitch_override();
     p.standby_stays_on_logic_mismatch = q.standby_stays_on_logic_mismatch();
+    p.allow_different_firmware = q.allow_different_firmware();
+    p.exec_upgrade_while_running = q.exec_upgrade_while_running();
     plan_racks(i, q, p);
     plan_dp(i, q, p);
     plan_modbus(i, q, p);
@@ -207,6 +209,7 @@ class QuantumPlanner {
       if (!e.power_on_at().empty())
         if (auto t = duration(i, {{"rack", r}, {"power_on_at", -1}}, e.power_on_at())) rp.power_on_at = *t;
       if (e.has_logic_checksum()) rp.logic_checksum = e.logic_checksum();
+      if (e.has_firmware()) rp.firmware = e.firmware();
       if (e.local_io_size() > 0)
         error(i, {{"rack", r}, {"local_io", 0}},
               "local I/O \"" + e.local_io(0) + "\" in a Hot Standby rack: only remote I/O is supported, "

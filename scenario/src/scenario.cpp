@@ -1065,6 +1065,12 @@ class Planner {
         pf.checksum = f.quantum_logic_change().logic_checksum();
         repair = false;
         break;
+      case FK::kQuantumExecUpgrade:
+        pf.kind = K::QuantumExecUpgrade; field = "quantum_exec_upgrade"; name = f.quantum_exec_upgrade().quantum();
+        if (f.quantum_exec_upgrade().has_rack()) rack = f.quantum_exec_upgrade().rack();
+        pf.checksum = f.quantum_exec_upgrade().firmware();
+        repair = false;
+        break;
       default: return false;
     }
     pf.line = -1;
@@ -1185,6 +1191,7 @@ class Planner {
         case FK::kQuantumFibre:
         case FK::kQuantumCommand:
         case FK::kQuantumLogicChange:
+        case FK::kQuantumExecUpgrade:
           if (plan_quantum_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::KIND_NOT_SET:
@@ -1367,6 +1374,7 @@ bool is_quantum_fault(PlanFault::Kind k) {
     case K::QuantumFibre:
     case K::QuantumCommand:
     case K::QuantumLogicChange:
+    case K::QuantumExecUpgrade:
       return true;
     default:
       return false;
@@ -1386,6 +1394,7 @@ std::string quantum_fault_description(const PlanFault& f) {
       return std::string("command register written: keyswitch override ") + (f.keyswitch_override ? "on" : "off") +
              ", run A " + (f.run_a ? "1" : "0") + ", run B " + (f.run_b ? "1" : "0");
     case K::QuantumLogicChange: return rack + " gets program " + std::to_string(f.checksum);
+    case K::QuantumExecUpgrade: return rack + "'s executive upgraded to " + std::to_string(f.checksum);
     default: return "?";
   }
 }

@@ -60,6 +60,7 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   p.command_register = q.command_register;
   p.keyswitch_override = q.keyswitch_override;
   p.standby_stays_on_logic_mismatch = q.standby_stays_on_logic_mismatch;
+  p.allow_different_firmware = q.allow_different_firmware;
   p.scan_time = q.scan_time;
   // The CHS → CHS copy over the fibre while the primary solves its logic (scan_time.hpp): the
   // state RAM sent every scan (0x/1x one bit each, 3x/4x two octets) at 10 Mbit/s, within the
@@ -78,6 +79,7 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
              : rp.key == QuantumRackPlan::Key::Xfer  ? quantum::KeySwitch::Xfer
                                                      : quantum::KeySwitch::Run;
     rk.logic_checksum = rp.logic_checksum;
+    rk.firmware = rp.firmware;
   }
   std::array<quantum::IoHead*, 2> heads{nullptr, nullptr};
   if (q.dp_master >= 0) {
@@ -103,6 +105,7 @@ QuantumNode::QuantumNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   c.keyswitch_override = q.keyswitch_override;
   c.run_a = c.run_b = true;
   c.standby_stays_on_logic_mismatch = q.standby_stays_on_logic_mismatch;
+  c.exec_upgrade_while_running = q.exec_upgrade_while_running;
   for (const QuantumModbusPortPlan& mp : q.modbus)
     c.swap_disabled[static_cast<std::size_t>(mp.port - 1)] = mp.no_swap;
   for (int r = 0; r < 2; ++r) m_pair->ram(r).set_holding(q.command_register, quantum::encode_command(c));
@@ -332,6 +335,10 @@ void QuantumNode::apply(const PlanFault& f, bool on) {
     }
     case K::QuantumLogicChange:
       q.load_program(f.rack, f.checksum, [this](quantum::StateRam& ram, bus::Ticks) { logic(ram); });
+      break;
+    case K::QuantumExecUpgrade:
+      if (std::string why = q.upgrade_executive(f.rack, f.checksum); !why.empty())
+        m_faults.back().second += " — refused: " + why;
       break;
     default: break;
   }

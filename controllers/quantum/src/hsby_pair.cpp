@@ -38,6 +38,7 @@ HsbyPair::HsbyPair(bus::Scheduler& sched, HsbyPairParams params, std::array<IoHe
     k.slide = rp.designation;
     k.designation = rp.designation;
     k.checksum = rp.logic_checksum;
+    k.firmware = rp.firmware;
     k.ram = StateRam(m_p.sizes);
     k.head = heads[static_cast<std::size_t>(r)];
   }
@@ -63,6 +64,32 @@ void HsbyPair::load_program(int r, std::uint32_t checksum, UserLogic logic) {
       logic_match() ? "program loaded: logic matches the other unit"
                     : "program loaded: logic mismatch with the other unit");
   reconcile();
+}
+
+std::string HsbyPair::upgrade_executive(int r, std::uint32_t version) {
+  if (!valid(r)) return "no such rack";
+  Rack& k = rk(r);
+  const int p = primary();
+  const StateRam& cmd_ram = p >= 0 ? rk(p).ram : k.ram;
+  const bool while_running = decode_command(cmd_ram.holding(m_p.command_register)).exec_upgrade_while_running;
+  std::string why;
+  if (!k.powered)
+    why = "the rack has no power";
+  else if (k.state == CpuState::Primary)
+    why = "the unit is primary: hand control over first";
+  else if (!while_running && p >= 0)
+    why = "the command register allows an exec upgrade only after the application stops, and rack " +
+          std::to_string(p) + " runs it";
+  if (!why.empty()) {
+    log(r, PairEventKind::Ignored, "executive upgrade to " + std::to_string(version) + " refused: " + why);
+    return why;
+  }
+  log(r, PairEventKind::Cpu, "executive upgraded from " + std::to_string(k.firmware) + " to " + std::to_string(version));
+  k.firmware = version;
+  if (k.state == CpuState::Standby) set_state(r, CpuState::Offline, "executive upgrade");
+  reconcile();
+  join_on_own_event(r);
+  return "";
 }
 
 // ---- operations ----------------------------------------------------------------------------
@@ -285,6 +312,10 @@ std::string HsbyPair::join_blocker(int r) const {
     return "same designation " + std::string(to_string(k.designation)) + " as the primary";
   if (k.checksum != o.checksum && !m_p.standby_stays_on_logic_mismatch)
     return "logic mismatch with the primary";
+  // Seed p. 96: by default "the Standby controller would not go online while having a newer
+  // or older firmware version than the one on the Primary controller".
+  if (k.firmware != o.firmware && !m_p.allow_different_firmware)
+    return "executive " + std::to_string(k.firmware) + " differs from the primary's " + std::to_string(o.firmware);
   return "";
 }
 
@@ -489,6 +520,8 @@ KeySwitch HsbyPair::key(int r) const {
 Designation HsbyPair::designation(int r) const {
   return valid(r) ? rk(r).designation : Designation::A;
 }
+std::uint32_t HsbyPair::firmware(int r) const { return valid(r) ? rk(r).firmware : 0; }
+
 std::uint32_t HsbyPair::logic_checksum(int r) const {
   return valid(r) ? rk(r).checksum : 0;
 }

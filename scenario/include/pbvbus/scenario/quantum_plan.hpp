@@ -54,6 +54,7 @@ struct QuantumRackPlan {
   Key key = Key::Run;
   bus::Ticks power_on_at = 0;
   std::uint32_t logic_checksum = 1;
+  std::uint32_t firmware = 1;
 };
 
 /// Where one DP slave's data lives in state RAM.
@@ -92,6 +93,8 @@ struct QuantumPlan {
   std::uint32_t command_register = 0;  ///< 0-based 4x index
   bool keyswitch_override = false;
   bool standby_stays_on_logic_mismatch = false;
+  bool allow_different_firmware = false;
+  bool exec_upgrade_while_running = false;
   bus::Ticks logic_time = 20 * bus::kTicksPerMs;
   bus::Ticks scan_time = 0;  ///< configured or estimated
   bool scan_time_estimated = false;

@@ -157,6 +157,7 @@ struct PlanFault {
     QuantumFibre,         ///< the CHS fibre cut (`fibre` 0) or Tx/Rx not crossed (`fibre` 1); repair: mended
     QuantumCommand,       ///< a host writes the command register's run bits `run_a`, `run_b`
     QuantumLogicChange,   ///< a program with identity `checksum` is loaded into `rack`
+    QuantumExecUpgrade,   ///< `rack`'s executive upgraded to version `checksum`
   };
   Kind kind = Kind::CableCut;
   bus::Ticks at = 0;

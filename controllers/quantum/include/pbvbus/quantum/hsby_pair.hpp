@@ -94,6 +94,7 @@ struct RackParams {
   Designation designation = Designation::A;  ///< the slide switch (read at power-on)
   KeySwitch key = KeySwitch::Run;            ///< the keyswitch's initial position
   std::uint32_t logic_checksum = 0;          ///< program identity: equal = logic match
+  std::uint32_t firmware = 1;                ///< the CPU's executive version
 };
 
 struct HsbyPairParams {
@@ -106,6 +107,9 @@ struct HsbyPairParams {
   /// online on a logic mismatch.
   bool keyswitch_override = false;
   bool standby_stays_on_logic_mismatch = false;
+  /// "Advanced Options" (seed p. 96): a standby may go online with an executive (firmware)
+  /// version other than the primary's; by default it may not.
+  bool allow_different_firmware = false;
   bus::Ticks scan_time = 100 * bus::kTicksPerMs;  ///< the primary's scan, start to start
   /// Fibre transfer duration (CHS -> CHS while the primary solves logic); 0 = scan_time / 4.
   /// Must be <= scan_time.
@@ -191,6 +195,15 @@ class HsbyPair final : public bus::EventTarget {
   /// Loads a different program on one rack (program identity `checksum`), e.g. to make a
   /// mismatch; the pair reconciles (a mismatching standby goes Offline by default).
   void load_program(int rack, std::uint32_t checksum, UserLogic logic);
+  /// Executive (firmware) upgrade of one rack's CPU (seed pp. 30, 86, 96). The command
+  /// register's exec-upgrade bit (read from the primary's state RAM, command_register.hpp):
+  /// 0 "only after application stops" — refused while any unit is Primary; 1 "without
+  /// stopping application" — allowed on a unit that is not Primary (a Standby goes Offline for
+  /// the download and rejoins at once: the download's duration is not modelled). The primary is
+  /// never upgraded in place (hand control over first). Afterwards the unit rejoins only if its
+  /// executive equals the primary's or allow_different_firmware is set. Returns "" when done,
+  /// else the refusal (also logged).
+  std::string upgrade_executive(int rack, std::uint32_t version);
 
   // ---- operations (at scheduler.now(), then reconciliation) ----
   void power_on(int rack);
@@ -219,6 +232,7 @@ class HsbyPair final : public bus::EventTarget {
   /// The designation read at the last power-on (the slide switch's position if never powered).
   Designation designation(int rack) const;
   std::uint32_t logic_checksum(int rack) const;
+  std::uint32_t firmware(int rack) const;
   bool logic_match() const;
   FibreState fibre() const { return m_fibre; }
   UpdatePhase update_phase(int rack) const;
@@ -255,6 +269,7 @@ class HsbyPair final : public bus::EventTarget {
     Designation slide = Designation::A;
     Designation designation = Designation::A;
     std::uint32_t checksum = 0;
+    std::uint32_t firmware = 1;
     UserLogic logic;
     StateRam ram;
     IoHead* head = nullptr;

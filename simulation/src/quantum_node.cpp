@@ -376,7 +376,11 @@ QuantumReport QuantumNode::report() const {
     rr.com_err = qn_led(l.com_err);
     rr.standby = qn_led(l.standby);
     const quantum::HeadRole h = q.head_role(k);
-    rr.dp_head = h == quantum::HeadRole::Active ? "active" : h == quantum::HeadRole::Passive ? "passive" : "off";
+    // Without `dp` the pair has no DP master modules: the role it would give them means nothing.
+    rr.dp_head = !m_heads[0]                     ? "none"
+                 : h == quantum::HeadRole::Active  ? "active"
+                 : h == quantum::HeadRole::Passive ? "passive"
+                                                   : "off";
   }
   r.fibre = std::string(quantum::to_string(q.fibre()));
   r.transfers_completed = q.transfers_completed();

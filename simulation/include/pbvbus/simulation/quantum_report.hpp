@@ -12,7 +12,7 @@
 //     "racks": [ { "rack": int, "designation": "A"|"B", "state": "off"|"offline"|"primary"|"standby",
 //                  "key": "Off Line"|"Xfer"|"Run", "logic_checksum": int, "scans": int,
 //                  "leds": { "ready","com_act","primary","com_err","standby": "off"|"on"|"blinking" },
-//                  "dp_head": "off"|"passive"|"active" } ],            // 2 entries
+//                  "dp_head": "off"|"passive"|"active"|"none" } ],     // 2 entries; none: no `dp`
 //     "fibre": "ok"|"cut"|"Tx/Rx not crossed",
 //     "transfers_completed","transfers_lost": int,
 //     "switchovers": [ { "at_ns": int, "cause_ns": int, "cause": str, "from": int, "to": int,

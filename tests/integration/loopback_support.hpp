@@ -1,15 +1,18 @@
 #pragma once
 // What the end-to-end tests that run the real `pbvbus` binary beside outside clients share: a
 // shell command's exit status and output, a file's text, a free loopback TCP port, and whether
-// a port accepts connections.
+// a port accepts connections, and how a child run is ended.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <thread>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -64,6 +67,23 @@ inline bool can_connect(std::uint16_t port) {
   const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
   ::close(s);
   return ok;
+}
+
+/// Ends a child process: SIGINT first if `interrupt` (a paced `pbvbus run` then writes its
+/// report), then waits for it at most `limit`, SIGKILL after that. Nothing for pid <= 0.
+inline void end_child(pid_t pid, bool interrupt, std::chrono::milliseconds limit) {
+  if (pid <= 0) return;
+  if (interrupt) ::kill(pid, SIGINT);
+  int status = 0;
+  const auto deadline = std::chrono::steady_clock::now() + limit;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > deadline) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
 }
 
 }  // namespace pbvbus::test

@@ -139,20 +139,8 @@ class QcRun {
   /// Ends the run with SIGINT if `interrupt`, waits for its end (30 s at most) and returns its
   /// JSON report.
   std::string wait_report(bool interrupt = false) {
-    if (m_pid > 0) {
-      if (interrupt) ::kill(m_pid, SIGINT);
-      int status = 0;
-      const auto deadline = std::chrono::steady_clock::now() + 30s;
-      while (::waitpid(m_pid, &status, WNOHANG) == 0) {
-        if (std::chrono::steady_clock::now() > deadline) {
-          ::kill(m_pid, SIGKILL);
-          ::waitpid(m_pid, &status, 0);
-          break;
-        }
-        std::this_thread::sleep_for(20ms);
-      }
-      m_pid = -1;
-    }
+    pbvbus::test::end_child(m_pid, interrupt, 30s);
+    m_pid = -1;
     return read_file(dir + "/report.json");
   }
   std::string stderr_text() const { return read_file(dir + "/stderr.txt"); }

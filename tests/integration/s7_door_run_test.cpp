@@ -135,18 +135,7 @@ class PbvbusRun {
 
   /// Ends the run (SIGINT); the report is then in report.json, the capture in capture.pcapng.
   void stop() {
-    if (m_pid <= 0) return;
-    ::kill(m_pid, SIGINT);
-    int status = 0;
-    const auto deadline = std::chrono::steady_clock::now() + 20s;
-    while (::waitpid(m_pid, &status, WNOHANG) == 0) {
-      if (std::chrono::steady_clock::now() > deadline) {
-        ::kill(m_pid, SIGKILL);
-        ::waitpid(m_pid, &status, 0);
-        break;
-      }
-      std::this_thread::sleep_for(20ms);
-    }
+    pbvbus::test::end_child(m_pid, true, 20s);
     m_pid = -1;
   }
 

@@ -16,10 +16,10 @@ const HCpuLimits& h_cpu_limits(scenario::HCpuPair::CpuType type) {
   // 001 §13.1 (414-4H): X1 max. 32 slaves L12001, X2 max. 96 L12054, process image 8 KB/8 KB
   // settable L11664-11665, default 256/256 L11666. §13.2 (417-4H): X1 32 L12762, X2 125
   // L12816, 16 KB/16 KB L12405, default 1024/1024 L12407.
-  static const HCpuLimits k414{"CPU 414-4H", 32, 96, 8192, 256,
-                               "S7-400H manual 001 L12001, L12054, L11664-11666"};
-  static const HCpuLimits k417{"CPU 417-4H", 32, 125, 16384, 1024,
-                               "S7-400H manual 001 L12762, L12816, L12405-12407; 000 L1724"};
+  static const HCpuLimits k414{"CPU 414-4H", 32, 96, 8192, 256, "S7-400H manual 001 L12001, L12054",
+                               "S7-400H manual 001 L11664-11666"};
+  static const HCpuLimits k417{"CPU 417-4H", 32, 125, 16384, 1024, "S7-400H manual 001 L12762, L12816; 000 L1724",
+                               "S7-400H manual 001 L12405-12407"};
   return type == scenario::HCpuPair::CPU_414_4H ? k414 : k417;
 }
 
@@ -106,7 +106,7 @@ class RuleChecker {
         error_at(m_hlocate(hp.source, {{"cpu"}, {field}}),
                  "h_system \"" + hp.name + "\": a process image of " + std::to_string(n) + " octets of " +
                      what + " is more than a " + lim.name + " has (" + std::to_string(lim.process_image_max) +
-                     " octets; " + lim.source + ", C4)");
+                     " octets; " + lim.pi_source + ", C4)");
         sizes_ok = false;
       }
     if (sizes_ok && hp.runtime) check_process_image(hp, pi);
@@ -198,7 +198,7 @@ class RuleChecker {
                      (p.interface == Place::CP_443_5_EXT ? std::string("a CP 443-5 Extended")
                                                          : std::string(lim.name) + "'s " + interface_name(p.interface)) +
                      " serves at most " + std::to_string(max) + " (" +
-                     (p.interface == Place::CP_443_5_EXT ? std::string("S7-400H manual 000 L1724") : std::string(lim.source)) +
+                     (p.interface == Place::CP_443_5_EXT ? std::string("S7-400H manual 000 L1724") : std::string(lim.slaves_source)) +
                      ", D5)");
       }
       for (const DpSlavePlan* sl : slaves)
@@ -356,7 +356,7 @@ class RuleChecker {
       }
       if (p[0].interface == Place::X1_MPI_DP && h.has_cpu() && h.cpu().has_mpi())
         error_at(at(0), sys + ": X1 is the CPUs' MPI interface (cpu.mpi), so it cannot also be a DP master: "
-                              "the MPI/DP interface runs as MPI or as DP (S7-400H manual 001 L11940-12010, S10)");
+                              "the MPI/DP interface runs as MPI or as DP (S7-400H manual 001 L11943, L11963, S10)");
     }
   }
 

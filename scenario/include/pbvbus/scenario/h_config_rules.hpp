@@ -35,7 +35,8 @@ struct HCpuLimits {
   std::size_t dp_slaves;          ///< X2
   std::size_t process_image_max;  ///< octets per direction (the settable maximum)
   std::size_t process_image_default;
-  const char* source;             ///< the manual lines of the figures
+  const char* slaves_source;      ///< the manual lines of the slave limits
+  const char* pi_source;          ///< the manual lines of the process-image sizes
 };
 const HCpuLimits& h_cpu_limits(scenario::HCpuPair::CpuType type);
 

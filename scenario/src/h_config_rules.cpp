@@ -315,6 +315,8 @@ class RuleChecker {
         const bool given = side == 0 ? r.has_place_a() : r.has_place_b();
         return m_locate("redundant_master_system", rs.source, given ? field[side] : "name", -1);
       };
+      // The pair's error goes to place_b, or to place_a when only that one is given.
+      auto pair_at = [&] { return at(r.has_place_b() || !r.has_place_a() ? 1 : 0); };
       bool ok = true;
       for (int side = 0; side < 2; ++side) {
         if (p[side].rack > 1) {
@@ -330,13 +332,13 @@ class RuleChecker {
       }
       if (!ok) continue;
       if (p[0].rack == p[1].rack) {
-        error_at(at(1), sys + ": both DP masters in rack " + std::to_string(p[0].rack) +
+        error_at(pair_at(), sys + ": both DP masters in rack " + std::to_string(p[0].rack) +
                             ": a redundant DP master system has one master in each central rack (S7-400H manual "
                             "000 L2362-2364, S10)");
         continue;
       }
       if (p[0].interface != p[1].interface || p[0].slot != p[1].slot) {
-        error_at(at(1), sys + ": asymmetric placement: line A's master at " + p[0].str() + ", line B's at " +
+        error_at(pair_at(), sys + ": asymmetric placement: line A's master at " + p[0].str() + ", line B's at " +
                             p[1].str() + "; both masters sit at the same interface in the same slot (S7-400H "
                             "manual 000 L1782-1785, L2362-2364; 001 L5580-5587, S10)");
         continue;

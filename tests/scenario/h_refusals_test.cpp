@@ -304,6 +304,16 @@ TEST(HRefusals, S10_AsymmetricMasterPlacementIsRefused) {
                    "at rack 0 X2 (DP) in slot 3, line B's at rack 1 CP 443-5 Extended in slot 5; both masters sit "
                    "at the same interface in the same slot (S7-400H manual 000 L1782-1785, L2362-2364; 001 "
                    "L5580-5587, S10)"}));
+  // Only place_a given (a CP), place_b the default X2: the error is at place_a, line 8 column
+  // head.size() + 1.
+  const auto one = errors(head + "place_a { interface: CP_443_5_EXT slot: 5 } }\n" + h());
+  ASSERT_EQ(one.size(), 1u) << all(one);
+  EXPECT_EQ(one[0].rfind("h.textproto:8:" + std::to_string(head.size() + 1) +
+                             ": redundant_master_system \"H-DP 1\" of h_system \"H\": asymmetric placement: line A's "
+                             "master at rack 0 CP 443-5 Extended in slot 5, line B's at rack 1 X2 (DP) in slot 3",
+                         0),
+            0u)
+      << one[0];
   // Two CPs in slot 5 load, as two X2 do.
   const auto r = load(rms("place_a { interface: CP_443_5_EXT slot: 5 } place_b { interface: CP_443_5_EXT slot: 5 }") + h());
   ASSERT_TRUE(r.ok()) << r.errors[0].str();

@@ -5,6 +5,7 @@
 #include <exception>
 #include <map>
 
+#include "pbvbus/scenario/h_config_rules.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 #include "pbvbus/scenario/timing_plan.hpp"
 
@@ -421,6 +422,7 @@ class HPlanner {
 void plan_h(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
             std::vector<Diagnostic>& errors) {
   HPlanner(plan, locate, hlocate, errors).run();
+  check_h_config_rules(plan, locate, hlocate, errors);  // what the real S7-400H refuses
 }
 
 devices::UpdatePlanInput h_update_input(const ScenarioPlan& plan, const HSystemPlan& h) {

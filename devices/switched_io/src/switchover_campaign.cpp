@@ -255,6 +255,13 @@ void Campaign::build() {
     SwitchedStationOptions so;
     so.address = m_sw[k].address;
     so.bus_params = m_bp;
+    if (m_o.im_time) {
+      // The GSD's T_SLAVE_UM (Slave_Max_Switch_Over_Time × 10 ms), as SwitchedStationModel reads it.
+      const auto& red = gsd_of(k).redundancy();
+      if (auto ms = red.switch_over_time_ms())
+        so.redundancy.im_switchover_bound = bus::Ticks{*ms} * bus::kTicksPerMs;
+      so.redundancy.im_seed = m_o.seed * 0x100000001B3ull + m_sw[k].address;
+    }
     auto b = SwitchedStationModel::build(gsd_of(k), switched_modules(), so);
     if (!b.ok())
       throw std::runtime_error("campaign: switched station: " +

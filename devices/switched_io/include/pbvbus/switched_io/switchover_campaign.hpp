@@ -112,6 +112,11 @@ struct CampaignOptions {
   bus::Ticks recognition = 50 * bus::kTicksPerMs;  ///< window for a fault's events
   bus::Ticks startup = 2000 * bus::kTicksPerMs;    ///< window for a repair's events
   bus::Ticks recover_limit = 5000 * bus::kTicksPerMs;
+  /// S5: the stations take their IM's own switchover time (the GSD's T_SLAVE_UM, drawn in
+  /// [T/2, T] per switchover from `seed` and the address; redundant_slave.hpp). The windows
+  /// above are for the S7 events (OB 70/86), which the IM's time does not delay: a switchover's
+  /// end is no S7 event, and the no-pulse sampler covers the longer hold.
+  bool im_time = false;
   CampaignTamper tamper;
 };
 

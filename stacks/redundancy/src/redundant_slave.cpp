@@ -343,7 +343,8 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
 void RedundantSlave::start_im(int i, bus::Ticks now) {
   Iface& f = m_if[i];
   if (f.im_ready_at != bus::kNever) return;  // this switchover has its time already
-  if (!m_decided) {  // start-up: the first Primary_Request is not a switchover
+  if (!m_decided || m_p.im_switchover_bound <= 0) {
+    // Start-up (the first Primary_Request is not a switchover), or no IM time: nothing drawn.
     f.im_ready_at = now;
     return;
   }

@@ -158,7 +158,7 @@ struct RedundantSlaveParams {
 struct ImSwitchover {
   int iface = 0;              ///< the interface that becomes PRIMARY
   bus::Ticks trigger = 0;     ///< PrmCmd Primary_Request, take-over or partner loss
-  bus::Ticks drawn = 0;       ///< the IM's time drawn for it (0 without a bound)
+  bus::Ticks drawn = 0;       ///< the IM's time drawn for it (none recorded without a bound)
   bus::Ticks primary_at = bus::kNever;  ///< when it became PRIMARY (kNever: not (yet))
 };
 

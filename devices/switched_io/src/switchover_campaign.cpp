@@ -185,6 +185,7 @@ class Campaign {
   void wait_recovered();
   void check_active();
   void match_all(CampaignResult& r);
+  void check_im_times();
 
   // Fault cycles.
   void cycle(CampaignFault f);
@@ -719,6 +720,26 @@ void Campaign::count_alarms() {
   }
 }
 
+void Campaign::check_im_times() {
+  // S5: no IM takes longer than its bound T_SLAVE_UM from its trigger to PRIMARY (the link
+  // steps run inside it; a silent partner costs at most the switch timeout).
+  for (const auto& sw : m_sw) {
+    const auto& rs = sw.model->redundant_slave();
+    const bus::Ticks limit =
+        std::max(rs.params().im_switchover_bound, rs.params().switch_timeout);
+    for (const auto& im : rs.im_switchovers()) {
+      ++m_r.im_switchovers;
+      if (im.primary_at == bus::kNever) continue;  // abandoned (the interface failed meanwhile)
+      const bus::Ticks took = im.primary_at - im.trigger;
+      m_r.max_im_switchover = std::max(m_r.max_im_switchover, took);
+      if (took > limit)
+        m_r.mismatches.push_back(fmt_time(im.trigger) + ": station " +
+                                 std::to_string(sw.address) + " IM switchover late: " +
+                                 fmt_time(took) + " > " + fmt_time(limit));
+    }
+  }
+}
+
 void Campaign::match_all(CampaignResult& r) {
   std::vector<SystemEvent> ev;
   for (const auto& e : m_sys->system().events())
@@ -810,6 +831,7 @@ CampaignResult Campaign::run() {
   match_all(m_r);
   count_alarms();
   m_r.switchovers = m_sys->system().switchovers();
+  check_im_times();
   m_r.events = campaign::zero_event_counts();
   for (const auto& e : m_sys->system().events())
     if (e.s7()) campaign::count_event(m_r.events, e.code());

@@ -78,6 +78,11 @@ TEST(SwitchoverCampaign, ReducedCampaignWithTheImsOwnTime) {
   EXPECT_GT(r.switchovers, 0u);
   EXPECT_EQ(r.alarms_lost, 0);
   EXPECT_EQ(r.alarms_duplicated, 0);
+  // Every IM switchover within its bound (a later one is a mismatch, above); the slow station
+  // (PBVB0A11, 820 ms) switched at least once, so the longest is in [410 ms, 820 ms].
+  EXPECT_GT(r.im_switchovers, 0u);
+  EXPECT_GE(r.max_im_switchover, 410 * bus::kTicksPerMs);
+  EXPECT_LE(r.max_im_switchover, 820 * bus::kTicksPerMs);
 }
 
 // The observer is not told about one fault (a passive interface failure and its repair): the

@@ -126,6 +126,10 @@ struct CampaignResult {
   int repairs = 0;                     ///< repair injections
   std::uint64_t switchovers = 0;       ///< MasterSystem::switchovers()
   std::uint64_t station_switches = 0;  ///< primary-interface changes seen on the stations
+  /// With im_time: switchovers that drew an IM time, and the longest trigger → PRIMARY. One
+  /// that took longer than max(T_SLAVE_UM, the 10 ms switch timeout) is a mismatch ("late").
+  std::uint64_t im_switchovers = 0;
+  bus::Ticks max_im_switchover = 0;
   /// S7 events raised by the MasterSystem, by code (0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3,
   /// 0x38C3), and the ones the observer expected.
   std::array<std::pair<std::uint16_t, int>, 6> events{};

@@ -700,5 +700,30 @@ TEST(RedundantSlaveImTime, ASlowImLikeADpPaLinkDominates) {
   EXPECT_EQ(r.rs.im_switchovers()[1].iface, 0);
 }
 
+TEST(RedundantSlaveImTime, AutonomousHandOverAtTheWatchdogThenTheImTime) {
+  Rig r(im_params(30 * kMs, 5));
+  redundant_start(r, 100);
+  bus::Ticks t = 1000 * kMs;
+  for (int k = 0; k < 10; ++k, t += 10 * kMs) r.cycle(t, 0x21);
+  // Master 1 stops after its cycle at 1090 ms: interface 0's watchdog (1 s) expires at 2090 ms,
+  // it hands over (BACKUP, take-over sent); the take-over arrives at 2091 ms: the trigger.
+  r.line_up[0] = false;
+  for (; t < 2200 * kMs; t += 10 * kMs) r.cycle(t, 0x31);
+  ASSERT_EQ(r.rs.im_switchovers().size(), 1u);
+  const ImSwitchover im = r.rs.im_switchovers()[0];
+  EXPECT_EQ(im.iface, 1);
+  EXPECT_EQ(im.trigger, 2091 * kMs);
+  ASSERT_GE(im.drawn, 15 * kMs);
+  ASSERT_LE(im.drawn, 30 * kMs);
+  EXPECT_EQ(im.primary_at, 2091 * kMs + im.drawn);
+  // Outputs frozen at 0x21 until the first Data_Exchange after primary_at (cycles every 10 ms
+  // from 1100 ms: the first at or after primary_at + 0.1 ms on line B).
+  const auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_FALSE(fresh.empty());
+  EXPECT_GE(fresh.back().at, im.primary_at);
+  EXPECT_LT(fresh.back().at, im.primary_at + 10 * kMs + kMs / 10 + 1);
+  EXPECT_EQ(r.rs.outputs()[0], 0x31);
+}
+
 }  // namespace
 }  // namespace pbvbus::redundancy

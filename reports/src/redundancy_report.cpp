@@ -53,8 +53,9 @@ void write_redundancy_text(const std::vector<RedundancyReport>& reports, std::os
          << (w.system_level ? " (system-level)" : "") << ": ";
       if (w.measured) {
         os << "measured " << ms(*w.measured) << " (fault at " << bus::format_duration(w.fault_at)
-           << ", fresh outputs at " << bus::format_duration(*w.fresh) << "), bound " << ms(w.bound)
-           << (w.exceeded ? "  ** EXCEEDS THE BOUND **" : "");
+           << ", fresh outputs at " << bus::format_duration(*w.fresh) << ")";
+        if (w.im_time) os << ", IM " << ms(*w.im_time);
+        os << ", bound " << ms(w.bound) << (w.exceeded ? "  ** EXCEEDS THE BOUND **" : "");
       } else {
         os << "no fresh outputs on the new channel (station lost), bound " << ms(w.bound);
       }
@@ -118,6 +119,9 @@ void write_redundancy_json(const std::vector<RedundancyReport>& reports, std::os
       else os << "null";
       os << ",\"measured_ns\":";
       if (w.measured) os << bus::ticks_to_ns(*w.measured);
+      else os << "null";
+      os << ",\"im_ns\":";
+      if (w.im_time) os << bus::ticks_to_ns(*w.im_time);
       else os << "null";
       os << ",\"bound_ns\":" << bus::ticks_to_ns(w.bound) << ",\"exceeded\":"
          << (w.exceeded ? "true" : "false") << "}";

@@ -23,7 +23,8 @@ std::string code_text(std::uint16_t code) {
 }  // namespace
 
 RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
-                                         const fdl::BusParams params[2])
+                                         const fdl::BusParams params[2],
+                                         std::optional<std::uint64_t> seed)
     : m_plan(plan), m_system(system) {
   const RedundancyPlan& rp = this->plan();
   devices::RedundantMasterSystemOptions o;
@@ -81,6 +82,11 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
     so.address = swp.address;
     so.bus_params = params[0];
     if (sp.tsdr != 0) so.tsdr = sp.tsdr;
+    // S5: the IM takes its own switchover time, drawn within T_SLAVE_UM (GSD or scenario);
+    // the draws are reproducible from the run's seed and the station address
+    // (docs/switchover-timing.md "The IM's own time").
+    so.redundancy.im_switchover_bound = swp.t_slave_um.value_or(0);
+    so.redundancy.im_seed = seed.value_or(plan.seed) * 0x100000001B3ull + swp.address;
     std::vector<devices::ModuleChoice> mods;
     for (std::size_t i : sp.gsd_modules) mods.push_back(devices::ModuleChoice::at(i));
     auto b = devices::SwitchedStationModel::build(*sp.gsd, mods, so);
@@ -275,6 +281,14 @@ RedundancyReport RedundantSystemNode::report() const {
         if (re.kind == redundancy::RedEvent::Kind::FreshOutputs && re.iface == e.line &&
             re.at >= e.time) {
           x.fresh = re.at;
+          break;
+        }
+      // The IM's time: the first draw for the new interface triggered at or after the command
+      // (a PrmCmd reaches the IM after the command; an autonomous switch may come before the
+      // fresh outputs) and not after them.
+      for (const auto& im : m->redundant_slave().im_switchovers())
+        if (im.iface == e.line && im.trigger >= x.fault_at && (!x.fresh || im.trigger <= *x.fresh)) {
+          x.im_time = im.drawn;
           break;
         }
     }

@@ -90,7 +90,8 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
     const RedundancyPlan& rp = m_plan.redundant_systems[k];
     const fdl::BusParams params[2] = {m_plan.lines.at(static_cast<std::size_t>(rp.line[0])).params,
                                       m_plan.lines.at(static_cast<std::size_t>(rp.line[1])).params};
-    m_redundant.push_back(std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params));
+    m_redundant.push_back(
+        std::make_unique<RedundantSystemNode>(m_plan, static_cast<int>(k), params, m_seed));
   }
   for (const auto& c : m_plan.s7.cpus)
     m_s7_cpus.push_back(std::make_unique<S7CpuNode>(

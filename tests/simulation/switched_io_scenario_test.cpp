@@ -169,8 +169,29 @@ TEST(SwitchedIoScenario, FaultScriptGivesTheS7EventsAndEverySwitchoverStaysInIts
     EXPECT_GT(*s.measured, 0);
     EXPECT_LE(*s.measured, want_sw[i].bound);
     EXPECT_FALSE(s.exceeded);
+    // S5: the IM's own time, drawn in [T_SLAVE_UM / 2, T_SLAVE_UM] (30 ms; station 6 820 ms),
+    // is part of every measured switchover.
+    const bus::Ticks t_slave_um = (s.station == 6 ? 820 : 30) * kMs;
+    ASSERT_TRUE(s.im_time.has_value());
+    EXPECT_GE(*s.im_time, t_slave_um / 2);
+    EXPECT_LE(*s.im_time, t_slave_um);
+    EXPECT_GE(*s.measured, *s.im_time);
   }
   EXPECT_EQ(red.exceeded, 0u);
+  // The whole-line switchovers (F14 short at 5 s, F9 master failure at 6.5 s, F14 master stop
+  // at 8.5 s) end with the slow station 6: at least 410 ms, its IM dominates.
+  for (std::size_t first : {3u, 6u, 10u}) {
+    const std::size_t n = first == 3u ? 3u : 4u;
+    bus::Ticks longest = 0;
+    int who = 0;
+    for (std::size_t k = first; k < first + n; ++k)
+      if (*red.switchovers[k].measured > longest) {
+        longest = *red.switchovers[k].measured;
+        who = red.switchovers[k].station;
+      }
+    EXPECT_EQ(who, 6) << first;
+    EXPECT_GE(longest, 410 * kMs) << first;
+  }
   // The end: after the master stop on DP_B everything runs on DP_A again, redundantly.
   for (const auto& s : red.stations) {
     EXPECT_EQ(s.active, "DP_A") << int(s.address);

@@ -127,5 +127,37 @@ TEST(HTimingCmd, BrokenEntriesAreLoaderErrorsWithPositions) {
   EXPECT_TRUE(has(r.err, "bad duration \"three\"")) << r.err;
 }
 
+// Reliability (docs/h-timing.md "Reliability"; 000 L3979, L3991): the manual's defaults CPU
+// MTBF 15 y = 131 400 h, dc 0.95, MDT 4 h → 131 400² / (8 + 13 140) = 1 313 200.487 h = 149.91 y,
+// 9.994 × 1oo1; V_1oo2 = 1 − 4 / 1 313 204.487 = 99.999695 %, (1 − V)·8 760 h = 1.60 min a year;
+// V_1oo1 = 131 400 / 131 404 = 99.996956 %, 16.00 min.
+TEST(HTimingCmd, ReliabilityWithTheManualsDefaults) {
+  const Result r = timing({kExample});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  for (const char* line :
+       {"MTBF_1oo1 15.00 y (131400 h), dc 0.950, MDT 4.00 h", "= 149.91 y (1313200 h), 9.994 x",
+        "1oo2 99.999695 % (1.60 min down a year), 1oo1 99.996956 % (16.00 min)"})
+    EXPECT_TRUE(has(r.out, line)) << line << "\n" << r.out;
+  const Result j = timing({kExample, "--json"});
+  ASSERT_EQ(j.rc, 0) << j.err;
+  EXPECT_TRUE(has(j.out, "\"mtbf_1oo2_h\": 1313200.487")) << j.out;
+}
+
+// --mtbf-years 50 (an I/O module) --dc 1 --mdt-hours 4.75: 438 000² / 9.5 =
+// 20 194 105 263.158 h = 2 305 263.16 y; --dc 0.9 --mtbf-years 15: 131 400² / (8 + 26 280) =
+// 656 800.061 h = 74.98 y.
+TEST(HTimingCmd, ReliabilityOptionsAndBadValues) {
+  Result r = timing({kExample, "--mtbf-years", "50", "--dc", "1", "--mdt-hours", "4.75"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "= 2305263.16 y (20194105263 h)")) << r.out;
+  r = timing({kExample, "--dc", "0.9"});
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_TRUE(has(r.out, "= 74.98 y (656800 h)")) << r.out;
+  EXPECT_EQ(timing({kExample, "--dc", "1.5"}).rc, 2);
+  EXPECT_EQ(timing({kExample, "--dc"}).rc, 2);
+  EXPECT_EQ(timing({kExample, "--mtbf-years", "x"}).rc, 2);
+  EXPECT_EQ(timing({kExample, "--mdt-hours", "-1"}).rc, 2);
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -49,6 +49,10 @@
 //       "line": LINE,
 //       "notes": [ str ] } ],
 //     "h_systems": [ ... ],         // h_system entries (print_h_json below)
+//     "reliability": {              // only with h_systems: their CPU pair as a 1oo2 system
+//       "mtbf_1oo1_h": num, "dc": num, "mdt_h": num,  // the inputs (--mtbf-years, --dc, --mdt-hours)
+//       "mtbf_1oo2_h": num, "factor": num,             // MTBF_1oo2 and MTBF_1oo2 / MTBF_1oo1
+//       "availability_1oo1": num, "availability_1oo2": num },  // fractions
 //     "quantum": [ {                // quantum_hot_standby entries, in file order
 //       "name": str, "cpu": "x13"|"424 02"|"434 12" (also the 534 14), "iec": bool,
 //       "logic_time_ns": int,                   // the standalone scan (logic_time)
@@ -107,6 +111,7 @@
 #include "pbvbus/scenario/h_plan.hpp"
 #include "pbvbus/scenario/quantum_plan.hpp"
 #include "pbvbus/quantum/reference.hpp"
+#include "timing_reliability.hpp"
 
 namespace pbvbus::tools {
 
@@ -117,7 +122,7 @@ using redundancy::LinePlan;
 using redundancy::SwitchoverPlan;
 
 constexpr const char* kTimingUsage =
-    "usage: pbvbus timing SCENARIO [--json]\n"
+    "usage: pbvbus timing SCENARIO [--json] [--mtbf-years Y] [--dc F] [--mdt-hours H]\n"
     "\n"
     "Plans the DP rotation and switchover times of a scenario (docs/switchover-timing.md).\n"
     "For every redundant_master_system: per line the target rotation time T_TR with its parts\n"
@@ -129,6 +134,7 @@ constexpr const char* kTimingUsage =
     "every quantum_hot_standby: the seed's scan-time model (docs/quantum-hsby.md).\n"
     "\n"
     "  --json    print the same as one JSON object (schema pbvbus.timing/1)\n"
+    "For every h_system also its reliability as a 1oo2 system (docs/h-timing.md):\n"
     "  --help    this text\n"
     "\n"
     "Exit status: 0 success, 2 bad usage or a broken scenario (FILE:LINE:COLUMN: reason on\n"
@@ -728,9 +734,18 @@ void print_quantum_json(const ScenarioPlan& plan, std::ostream& out) {
 int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
   bool json = false;
   std::string file;
-  for (const auto& a : args) {
+  ReliabilityOptions rel;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    bool matched = false;
+    std::string rel_error;
+    if (!parse_reliability_option(args, k, rel, matched, rel_error)) {
+      err << "pbvbus timing: " << rel_error << "\n" << kTimingUsage << kReliabilityUsage;
+      return 2;
+    }
+    if (matched) continue;
     if (a == "--help" || a == "-h") {
-      out << kTimingUsage;
+      out << kTimingUsage << kReliabilityUsage;
       return 0;
     }
     if (a == "--json") {
@@ -788,6 +803,13 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
     err << "pbvbus timing: " << plan.file << ": " << e.what() << "\n";
     return 2;
   }
+  const devices::ReliabilityInput rel_in{rel.mtbf_years * devices::kHoursPerYear, rel.dc,
+                                         rel.mdt_hours};
+  if (const std::string why = devices::check_reliability_input(rel_in); !why.empty()) {
+    err << "pbvbus timing: " << why << "\n";
+    return 2;
+  }
+  const devices::ReliabilityResult reliability = *devices::plan_reliability(rel_in);
   std::vector<HTiming> hs;
   try {
     for (const auto& hp : plan.h_systems) {
@@ -807,6 +829,10 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
   if (json) {
     print_json(plan, systems, masters, out);
     print_h_json(hs, out);
+    if (!hs.empty()) {
+      out << ",\n ";
+      print_reliability_json(reliability, out);  // the same for every h_system (its CPU pair)
+    }
     print_quantum_json(plan, out);
     out << "}\n";
     return 0;
@@ -819,7 +845,10 @@ int cmd_timing(const Args& args, std::ostream& out, std::ostream& err) {
   }
   for (const auto& s : systems) print_system_text(plan, s, out);
   for (const auto& m : masters) print_master_text(m, out);
-  for (const auto& h : hs) print_h_text(h, out);
+  for (const auto& h : hs) {
+    print_h_text(h, out);
+    print_reliability_text(reliability, out);
+  }
   for (const auto& q : plan.quantum) print_quantum_text(plan, q, out);
   return 0;
 }

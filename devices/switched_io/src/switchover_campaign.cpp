@@ -185,6 +185,7 @@ class Campaign {
   void wait_recovered();
   void check_active();
   void match_all(CampaignResult& r);
+  void check_im_times();
 
   // Fault cycles.
   void cycle(CampaignFault f);
@@ -255,6 +256,13 @@ void Campaign::build() {
     SwitchedStationOptions so;
     so.address = m_sw[k].address;
     so.bus_params = m_bp;
+    if (m_o.im_time) {
+      // The GSD's T_SLAVE_UM (Slave_Max_Switch_Over_Time × 10 ms), as SwitchedStationModel reads it.
+      const auto& red = gsd_of(k).redundancy();
+      if (auto ms = red.switch_over_time_ms())
+        so.redundancy.im_switchover_bound = bus::Ticks{*ms} * bus::kTicksPerMs;
+      so.redundancy.im_seed = m_o.seed * 0x100000001B3ull + m_sw[k].address;
+    }
     auto b = SwitchedStationModel::build(gsd_of(k), switched_modules(), so);
     if (!b.ok())
       throw std::runtime_error("campaign: switched station: " +
@@ -712,6 +720,26 @@ void Campaign::count_alarms() {
   }
 }
 
+void Campaign::check_im_times() {
+  // S5: no IM takes longer than its bound T_SLAVE_UM from its trigger to PRIMARY (the link
+  // steps run inside it; a silent partner costs at most the switch timeout).
+  for (const auto& sw : m_sw) {
+    const auto& rs = sw.model->redundant_slave();
+    const bus::Ticks limit =
+        std::max(rs.params().im_switchover_bound, rs.params().switch_timeout);
+    for (const auto& im : rs.im_switchovers()) {
+      ++m_r.im_switchovers;
+      if (im.primary_at == bus::kNever) continue;  // abandoned (the interface failed meanwhile)
+      const bus::Ticks took = im.primary_at - im.trigger;
+      m_r.max_im_switchover = std::max(m_r.max_im_switchover, took);
+      if (took > limit)
+        m_r.mismatches.push_back(fmt_time(im.trigger) + ": station " +
+                                 std::to_string(sw.address) + " IM switchover late: " +
+                                 fmt_time(took) + " > " + fmt_time(limit));
+    }
+  }
+}
+
 void Campaign::match_all(CampaignResult& r) {
   std::vector<SystemEvent> ev;
   for (const auto& e : m_sys->system().events())
@@ -803,6 +831,7 @@ CampaignResult Campaign::run() {
   match_all(m_r);
   count_alarms();
   m_r.switchovers = m_sys->system().switchovers();
+  check_im_times();
   m_r.events = campaign::zero_event_counts();
   for (const auto& e : m_sys->system().events())
     if (e.s7()) campaign::count_event(m_r.events, e.code());

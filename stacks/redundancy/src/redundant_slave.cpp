@@ -21,6 +21,18 @@ std::string_view to_string(Role r) {
   return "?";
 }
 
+bus::Ticks draw_im_time(std::uint64_t seed, std::uint64_t n, bus::Ticks bound) {
+  if (bound <= 0) return 0;
+  // splitmix64 of (seed, n): portable, unlike the std distributions.
+  std::uint64_t z = seed + (n + 1) * 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  const bus::Ticks lo = bound / 2;
+  const auto span = static_cast<std::uint64_t>(bound - lo) + 1;
+  return lo + static_cast<bus::Ticks>(z % span);
+}
+
 std::string_view to_string(RedundancyMode m) {
   return m == RedundancyMode::Flying ? "flying" : "system";
 }
@@ -131,6 +143,9 @@ void RedundantSlave::power_on(bus::Ticks now) {
     f.baudrate_found = f.master_state_clear = f.was_data_exch = f.ack_pending = false;
     f.cmd_spec = f.cmd_function = 0;
     f.switch_deadline = bus::kNever;
+    f.im_ready_at = bus::kNever;
+    f.im_wait = false;
+    f.im_index = -1;
     f.last_heard = now;
     f.next_heartbeat = now;
     f.partner_lost = false;
@@ -177,6 +192,7 @@ bus::Ticks RedundantSlave::next_deadline() const {
     t = std::min(t, f.engine->next_deadline());
     if (f.role == Role::Failed) continue;
     if (f.role == Role::BpSwitchover) t = std::min(t, f.switch_deadline);
+    if (f.role == Role::BpSwitchover && f.im_wait) t = std::min(t, f.im_ready_at);
     t = std::min(t, f.next_heartbeat);
     if (!f.partner_lost) t = std::min(t, f.last_heard + m_p.supervision);
   }
@@ -209,7 +225,8 @@ void RedundantSlave::on_time(bus::Ticks now) {
         emit(RedEvent::Kind::PartnerLost, f.last_heard + m_p.supervision, i);
         if (f.role == Role::Backup || f.role == Role::BpSwitchover) {
           if (f.role == Role::BpSwitchover) f.ack_pending = true;
-          set_role(i, Role::Primary, t);
+          start_im(i, f.last_heard + m_p.supervision);
+          become_primary(i, t);
         }
       }
       if (f.role == Role::BpSwitchover && f.switch_deadline <= t) {
@@ -221,8 +238,9 @@ void RedundantSlave::on_time(bus::Ticks now) {
           emit(RedEvent::Kind::PartnerLost, t, i);
         }
         f.ack_pending = true;
-        set_role(i, Role::Primary, t);
+        become_primary(i, t);
       }
+      if (f.role == Role::BpSwitchover && f.im_wait && f.im_ready_at <= t) become_primary(i, t);
     }
     if (m_alternate_at <= t) {
       for (int i = 0; i < 2; ++i) {
@@ -275,7 +293,10 @@ void RedundantSlave::deliver(const LinkMsg& m, bus::Ticks now) {
       }
       break;
     case Msg::TakeOver:
-      if (f.role == Role::Backup || f.role == Role::BpSwitchover) set_role(i, Role::Primary, now);
+      if (f.role == Role::Backup || f.role == Role::BpSwitchover) {
+        start_im(i, now);  // an autonomous hand-over starts here; a commanded one has started
+        become_primary(i, now);
+      }
       break;
     case Msg::BecomeBackup:
       if (f.role != Role::Primary) set_role(i, Role::Backup, now);
@@ -291,6 +312,13 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
   if (from == r) return;
   f.role = r;
   f.switch_deadline = r == Role::BpSwitchover ? now + m_p.switch_timeout : bus::kNever;
+  if (r != Role::BpSwitchover) {  // the switchover is over (PRIMARY) or abandoned
+    if (r == Role::Primary && f.im_index >= 0)
+      m_im[static_cast<std::size_t>(f.im_index)].primary_at = now;
+    f.im_ready_at = bus::kNever;
+    f.im_wait = false;
+    f.im_index = -1;
+  }
   bool swapped = false;
   if (from == Role::Primary) lose_primary(now);
   if (r == Role::Primary) {
@@ -310,6 +338,33 @@ void RedundantSlave::set_role(int i, Role r, bus::Ticks now) {
   emit(RedEvent::Kind::RoleChanged, now, i, from, r);
   if (swapped) emit(RedEvent::Kind::AddressSwap, now, i);
   refresh_status();
+}
+
+void RedundantSlave::start_im(int i, bus::Ticks now) {
+  Iface& f = m_if[i];
+  if (f.im_ready_at != bus::kNever) return;  // this switchover has its time already
+  if (!m_decided || m_p.im_switchover_bound <= 0) {
+    // Start-up (the first Primary_Request is not a switchover), or no IM time: nothing drawn.
+    f.im_ready_at = now;
+    return;
+  }
+  const bus::Ticks d = draw_im_time(m_p.im_seed, m_im.size(), m_p.im_switchover_bound);
+  f.im_ready_at = now + d;
+  f.im_index = static_cast<int>(m_im.size());
+  m_im.push_back({i, now, d, bus::kNever});
+}
+
+void RedundantSlave::become_primary(int i, bus::Ticks now) {
+  Iface& f = m_if[i];
+  if (f.im_ready_at != bus::kNever && now < f.im_ready_at) {
+    // The link steps are done; the IM needs the rest of its time: BP_SWITCHOVER (Red_State
+    // Backup), outputs held, no Prm_Cmd_Ack yet.
+    set_role(i, Role::BpSwitchover, now);
+    f.switch_deadline = bus::kNever;
+    f.im_wait = true;
+    return;
+  }
+  set_role(i, Role::Primary, now);
 }
 
 void RedundantSlave::lose_primary(bus::Ticks now) {
@@ -391,11 +446,12 @@ dp::PrmCmdResult RedundantSlave::handle_prm_cmd(int i, const dp::PrmCmdView& v) 
         // gets no answer and takes over after switch_timeout.
         const Iface& partner = m_if[1 - i];
         const Role believed = partner.role == Role::Failed ? partner.failed_from : partner.role;
+        start_im(i, v.now);
         if (!f.partner_lost && believed == Role::Primary) {
           set_role(i, Role::BpSwitchover, v.now);
           send(i, Msg::SwitchReq, v.now);
         } else {
-          set_role(i, Role::Primary, v.now);
+          become_primary(i, v.now);
         }
         break;
       }

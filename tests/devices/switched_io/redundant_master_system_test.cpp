@@ -20,6 +20,7 @@
 #include "pbvbus/switched_io/redundant_master_system.hpp"
 #include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/switched_io/switched_station.hpp"
+#include "pbvbus/redundancy/switchover_timing.hpp"
 
 namespace pbvbus::devices {
 namespace {
@@ -57,7 +58,9 @@ struct System {
   std::uint16_t counter = 0;
   std::vector<std::pair<int, dp::MasterEvent>> master_events;
 
-  System() {
+  /// im_time: the stations take their IM's own switchover time (T_SLAVE_UM 30 ms / 820 ms,
+  /// drawn in [T/2, T] with the seed `seed` ^ address).
+  explicit System(bool im_time = false, std::uint64_t seed = 0) {
     bp.hsa = 12;
     const GsdFile fast = load("PBVB0A10.gsd");
     const GsdFile slow = load("PBVB0A11.gsd");
@@ -98,6 +101,10 @@ struct System {
       SwitchedStationOptions so;
       so.address = a;
       so.bus_params = bp;
+      if (im_time) {
+        so.redundancy.im_switchover_bound = (a == kFast ? 30 : 820) * kMs;
+        so.redundancy.im_seed = seed ^ a;
+      }
       auto b = SwitchedStationModel::build(*gsd, switched_modules(), so);
       EXPECT_TRUE(b.ok()) << (b.errors.empty() ? "" : b.errors[0]);
       st[k] = std::move(b.model);
@@ -638,6 +645,115 @@ TEST(RedundantMasterSystem, SoloSideReachesEverySwitchedStation) {
   }
   EXPECT_EQ(r73, 2);
   EXPECT_EQ(r39, 1);
+}
+
+// --- S5: the IM's own switchover time -------------------------------------------------------------
+// seeds-digest §2 (L105) / 000 L1832: switchover time = DP error recognition + DP switchover time
+// + the DP slave interface's (IM's) own time; a whole line's switchover is dominated by the
+// slowest IM. The stations here draw their IM time in [T_SLAVE_UM / 2, T_SLAVE_UM].
+
+/// The first FreshOutputs of station `a` on interface `iface` at or after `t`.
+bus::Ticks fresh_at(System& s, std::uint8_t a, int iface, bus::Ticks t) {
+  for (const auto& e : s.station(a).events())
+    if (e.kind == redundancy::RedEvent::Kind::FreshOutputs && e.iface == iface && e.at >= t)
+      return e.at;
+  return bus::kNever;
+}
+
+/// The planner's bounds for this system (redundancy::plan_switchover; its own golden test is
+/// tests/stacks/redundancy/switchover_timing_test.cpp): here only the consistency check that
+/// every measured switchover stays inside them.
+redundancy::SwitchoverPlan plan_of(System& s) {
+  std::vector<redundancy::PlannedSlave> ps;
+  for (std::uint8_t a : {kFast, kSlow}) {
+    redundancy::PlannedSlave p;
+    p.address = a;
+    p.in_len = p.out_len = 2;
+    p.max_diag_len = 32;
+    p.switched = true;
+    p.t_slave_um = (a == kFast ? 30 : 820) * kMs;
+    ps.push_back(p);
+  }
+  for (int l = 0; l < 2; ++l) {
+    redundancy::PlannedSlave p;
+    p.address = l == 0 ? kOneA : kOneB;
+    p.in_len = p.out_len = 2;
+    p.line = l;
+    ps.push_back(p);
+  }
+  return redundancy::plan_switchover(s.bp, ps);
+}
+
+TEST(RedundantMasterSystemImTime, AStationSwitchoverTakesItsImTimeWithinTheBound) {
+  System s(true, 5);
+  Sampler smp(s);
+  s.line[0].add_tap(smp);
+  s.line[1].add_tap(smp);
+  s.start();
+  s.run_until(150 * kMs);
+  const bus::Ticks fault = s.sched.now();
+  s.station(kFast).fail_interface(0);
+  s.run_until(400 * kMs);
+  const auto& im = s.station(kFast).redundant_slave().im_switchovers();
+  ASSERT_EQ(im.size(), 1u);
+  EXPECT_EQ(im[0].iface, 1);
+  ASSERT_GE(im[0].drawn, 15 * kMs);  // [30 ms / 2, 30 ms]
+  ASSERT_LE(im[0].drawn, 30 * kMs);
+  const bus::Ticks fresh = fresh_at(s, kFast, 1, fault);
+  ASSERT_NE(fresh, bus::kNever);
+  const bus::Ticks measured = fresh - fault;
+  // At least the IM's time; at most T_SLAVE_UM + the DP parts (recognition ≈ 2.6 ms and
+  // T_DP_UM ≈ 4.3 ms at 1.5 Mbit/s with three slaves a line, docs/switchover-timing.md's worked
+  // example: together < 10 ms), and within the planner's station bound.
+  EXPECT_GE(measured, im[0].drawn);
+  EXPECT_LE(measured, 30 * kMs + 10 * kMs);
+  EXPECT_LE(measured, plan_of(s).stations[0].bound[0]);
+  // The command reached the IM after the recognition: the IM's time starts there.
+  EXPECT_GT(im[0].trigger, fault);
+  EXPECT_GE(fresh, im[0].primary_at);
+  smp.expect_no_pulse(0, 0);
+  smp.expect_no_pulse(1, 0);
+  EXPECT_EQ(s.station(kSlow).primary(), 0);  // untouched
+  EXPECT_TRUE(s.station(kSlow).redundant_slave().im_switchovers().empty());
+}
+
+TEST(RedundantMasterSystemImTime, AWholeLineSwitchoverIsDominatedByTheSlowestIm) {
+  System s(true, 9);
+  Sampler smp(s);
+  s.line[0].add_tap(smp);
+  s.line[1].add_tap(smp);
+  s.start();
+  s.run_until(150 * kMs);
+  const bus::Ticks fault = s.sched.now();
+  s.sys->stop_master(0);  // master stop on line A: known at once
+  s.run_until(1200 * kMs);
+  const auto plan = plan_of(s);
+  bus::Ticks fresh[2] = {0, 0};
+  bus::Ticks drawn[2] = {0, 0};
+  int k = 0;
+  for (std::uint8_t a : {kFast, kSlow}) {
+    const auto& im = s.station(a).redundant_slave().im_switchovers();
+    ASSERT_EQ(im.size(), 1u) << int(a);
+    drawn[k] = im[0].drawn;
+    fresh[k] = fresh_at(s, a, 1, fault);
+    ASSERT_NE(fresh[k], bus::kNever) << int(a);
+    EXPECT_GE(fresh[k] - fault, drawn[k]) << int(a);
+    ++k;
+  }
+  ASSERT_GE(drawn[0], 15 * kMs);
+  ASSERT_LE(drawn[0], 30 * kMs);
+  ASSERT_GE(drawn[1], 410 * kMs);  // [820 ms / 2, 820 ms]
+  ASSERT_LE(drawn[1], 820 * kMs);
+  // The whole line is switched when the slow station has its fresh outputs: at least its IM's
+  // time (≥ 410 ms), at most 820 ms + T_DP_UM_system (< 10 ms here) and the planner's bound.
+  const bus::Ticks whole = std::max(fresh[0], fresh[1]) - fault;
+  EXPECT_EQ(whole, fresh[1] - fault);  // the slow IM dominates
+  EXPECT_GE(whole, 410 * kMs);
+  EXPECT_LE(whole, 820 * kMs + 10 * kMs);
+  EXPECT_LE(whole, plan.system_bound_master_stop[0]);
+  EXPECT_LE(fresh[0] - fault, 30 * kMs + 10 * kMs);
+  smp.expect_no_pulse(0, 0);  // outputs frozen (Output_Hold_Time 1 s > 820 ms)
+  smp.expect_no_pulse(1, 0);
 }
 
 }  // namespace

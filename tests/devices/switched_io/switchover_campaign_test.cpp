@@ -65,6 +65,26 @@ TEST(SwitchoverCampaign, ReducedCampaignHasNoPulseAndNoMismatch) {
   EXPECT_EQ(r.alarms_delivered, r.alarms_raised);
 }
 
+// S5: the same campaign with the stations taking their IM's own switchover time (30 ms / 820 ms
+// GSD bounds, drawn per switchover): still no pulse, no mismatch, every alarm once.
+TEST(SwitchoverCampaign, ReducedCampaignWithTheImsOwnTime) {
+  CampaignOptions o = reduced(7, 80);
+  o.im_time = true;
+  const CampaignResult r = run_campaign(o);
+  print(r);
+  EXPECT_GE(r.injections(), 80);
+  EXPECT_EQ(r.pulses, 0u);
+  for (const auto& m : r.mismatches) ADD_FAILURE() << m;
+  EXPECT_GT(r.switchovers, 0u);
+  EXPECT_EQ(r.alarms_lost, 0);
+  EXPECT_EQ(r.alarms_duplicated, 0);
+  // Every IM switchover within its bound (a later one is a mismatch, above); the slow station
+  // (PBVB0A11, 820 ms) switched at least once, so the longest is in [410 ms, 820 ms].
+  EXPECT_GT(r.im_switchovers, 0u);
+  EXPECT_GE(r.max_im_switchover, 410 * bus::kTicksPerMs);
+  EXPECT_LE(r.max_im_switchover, 820 * bus::kTicksPerMs);
+}
+
 // The observer is not told about one fault (a passive interface failure and its repair): the
 // 73A3 and 72A3 it causes are unexpected events.
 TEST(SwitchoverCampaign, ObserverCatchesAFaultItWasNotToldAbout) {

@@ -553,5 +553,177 @@ TEST(RedundantSlave, MalformedPrmCmdIsAPrmFault) {
   EXPECT_EQ(hex(r.diag(0, 2 * kMs)).substr(0, 17), "42 05 00 FF 12 34");
 }
 
+
+// --- the IM's own switchover time (seeds-digest §2 S5; 000 L1832) ------------------------------
+// With im_switchover_bound = T_SLAVE_UM every switchover after start-up ends no earlier than a
+// time drawn uniformly in [T_SLAVE_UM / 2, T_SLAVE_UM] after its trigger; until then the new
+// interface is BP_SWITCHOVER (Red_State Backup), answers Data_Exchange, and the backplane holds.
+
+TEST(RedundantSlaveImTime, DrawIsWithinHalfTheBoundAndTheBoundAndReproducible) {
+  const bus::Ticks bound = 30 * kMs;  // an IM 153-2-like 30 ms
+  bus::Ticks lo = bound, hi = 0;
+  for (std::uint64_t n = 0; n < 400; ++n) {
+    const bus::Ticks d = draw_im_time(42, n, bound);
+    ASSERT_GE(d, 15 * kMs) << n;
+    ASSERT_LE(d, 30 * kMs) << n;
+    EXPECT_EQ(d, draw_im_time(42, n, bound));  // same seed and count: same time
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  }
+  // Spread over the whole interval: 400 uniform draws come within 5 % of either end.
+  EXPECT_LT(lo, 16500 * bus::kTicksPerUs);
+  EXPECT_GT(hi, 28500 * bus::kTicksPerUs);
+  EXPECT_NE(draw_im_time(1, 0, bound), draw_im_time(2, 0, bound));
+  EXPECT_EQ(draw_im_time(42, 0, 0), 0);  // no bound: no IM time
+  EXPECT_EQ(draw_im_time(42, 0, 1), 1);  // [0, 1] in ticks, bound/2 = 0: 0 or 1
+}
+
+/// A rig whose IM needs up to `bound` for a switchover.
+RedundantSlaveParams im_params(bus::Ticks bound, std::uint64_t seed) {
+  RedundantSlaveParams p;
+  p.im_switchover_bound = bound;
+  p.im_seed = seed;
+  return p;
+}
+
+/// The Seq_Nr of the Prm_Cmd_Ack block (08 9E 00 <Seq_Nr << 3> ..., §G.3) in a diagnosis, or -1.
+int prm_cmd_ack_seq(std::span<const std::uint8_t> diag) {
+  for (std::size_t k = 0; k + 3 < diag.size(); ++k)
+    if (diag[k] == 0x08 && diag[k + 1] == 0x9E) return diag[k + 3] >> 3;
+  return -1;
+}
+
+TEST(RedundantSlaveImTime, CommandedSwitchoverTakesTheDrawnImTimeWithOutputsFrozen) {
+  Rig r(im_params(30 * kMs, 7));
+  redundant_start(r, 100);  // Output_Hold_Time 1 s
+  // The first Primary_Request after power-on is no switchover: PRIMARY at once, nothing drawn.
+  EXPECT_TRUE(r.rs.im_switchovers().empty());
+  bus::Ticks t = 1000 * kMs;
+  for (int k = 0; k < 10; ++k, t += 10 * kMs) r.cycle(t, 0x11);
+  ASSERT_EQ(r.rs.outputs()[0], 0x11);
+  const bus::Ticks tc = t + 5 * kMs;  // 1105 ms: master 2 commands interface 1
+  EXPECT_EQ(r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100)), Bytes{0xE5});
+  ASSERT_EQ(r.rs.im_switchovers().size(), 1u);
+  const ImSwitchover im = r.rs.im_switchovers()[0];
+  EXPECT_EQ(im.iface, 1);
+  EXPECT_EQ(im.trigger, tc);
+  // T_SLAVE_UM 30 ms: the IM's time lies in [15 ms, 30 ms].
+  ASSERT_GE(im.drawn, 15 * kMs);
+  ASSERT_LE(im.drawn, 30 * kMs);
+  // The link steps end at tc + 2 ms (the old primary is BACKUP at tc + 1 ms), the IM is not
+  // ready: interface 1 stays BP_SWITCHOVER, Red_State Backup (bit 0), no Prm_Cmd_Ack yet.
+  r.run_to(tc + 2 * kMs);
+  EXPECT_EQ(r.rs.role(0), Role::Backup);
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  EXPECT_EQ(r.rs.primary(), -1);
+  EXPECT_TRUE(r.rs.red_state(1).backup);
+  EXPECT_FALSE(r.rs.red_state(1).primary);
+  EXPECT_TRUE(r.rs.outputs_held());
+  // Both masters keep polling with new values every 5 ms: the backplane keeps 0x11 (S1), and
+  // interface 1 keeps answering Data_Exchange on line B.
+  bus::Ticks p = tc + 3 * kMs;
+  for (; p < tc + im.drawn; p += 5 * kMs) {
+    r.req(0, p, std::nullopt, {0x22});
+    r.req(1, p + kMs / 10, std::nullopt, {0x22});
+    EXPECT_EQ(r.last.kind, fdl::Reply::Kind::Data) << p;
+    EXPECT_EQ(r.rs.outputs()[0], 0x11) << p;
+    EXPECT_EQ(prm_cmd_ack_seq(r.rs.engine(1).current_diag()), 1) << p;  // start-up's
+  }
+  r.run_to(tc + im.drawn - 1);
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  r.run_to(tc + im.drawn);  // the IM's time is over: PRIMARY, Prm_Cmd_Ack
+  EXPECT_EQ(r.rs.primary(), 1);
+  EXPECT_EQ(r.rs.im_switchovers()[0].primary_at, tc + im.drawn);
+  EXPECT_EQ(prm_cmd_ack_seq(r.rs.engine(1).current_diag()), 2);  // this command's
+  // Its next accepted Data_Exchange ends the hold: switchover (command → fresh outputs) =
+  // drawn + the wait for the next poll (< 5 ms), within T_SLAVE_UM + one poll.
+  r.req(1, p + kMs / 10, std::nullopt, {0x33});
+  EXPECT_EQ(r.rs.outputs()[0], 0x33);
+  const auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_FALSE(fresh.empty());
+  EXPECT_EQ(fresh.back().iface, 1);
+  EXPECT_GE(fresh.back().at - tc, im.drawn);
+  EXPECT_LE(fresh.back().at - tc, 30 * kMs + 5 * kMs);
+}
+
+TEST(RedundantSlaveImTime, PartnerLostByTheSupervisionThenTheImTime) {
+  Rig r(im_params(30 * kMs, 11));
+  redundant_start(r, 100);
+  for (bus::Ticks t = 1000 * kMs; t < 1100 * kMs; t += 10 * kMs) r.cycle(t, 0x44);
+  // Interface 0 (PRIMARY) fails silently at 1095 ms; its last heartbeat left at 1000 ms and
+  // arrived at 1001 ms: interface 1 counts it lost at 1301 ms, then needs its IM's time.
+  r.rs.fail_interface(0, 1095 * kMs);
+  r.line_up[0] = false;
+  r.run_to(1301 * kMs);
+  ASSERT_EQ(r.rs.im_switchovers().size(), 1u);
+  const ImSwitchover im = r.rs.im_switchovers()[0];
+  EXPECT_EQ(im.trigger, 1301 * kMs);
+  ASSERT_GE(im.drawn, 15 * kMs);
+  ASSERT_LE(im.drawn, 30 * kMs);
+  EXPECT_EQ(r.rs.role(1), Role::BpSwitchover);
+  for (bus::Ticks t = 1305 * kMs; t < 1301 * kMs + im.drawn; t += 5 * kMs) {
+    r.cycle(t, 0x55);
+    EXPECT_EQ(r.rs.outputs()[0], 0x44) << t;  // frozen, no pulse (hold 1 s)
+  }
+  r.run_to(1301 * kMs + im.drawn);
+  EXPECT_EQ(r.rs.primary(), 1);
+  r.cycle(1340 * kMs, 0x55);
+  EXPECT_EQ(r.rs.outputs()[0], 0x55);
+}
+
+TEST(RedundantSlaveImTime, ASlowImLikeADpPaLinkDominates) {
+  // A DP/PA-link-like IM: 820 ms maximum (protocol-facts.md §G.5), in [410 ms, 820 ms].
+  Rig r(im_params(820 * kMs, 3));
+  redundant_start(r, 100);  // hold 1 s > 820 ms: frozen for the whole switchover
+  for (bus::Ticks t = 1000 * kMs; t < 1100 * kMs; t += 10 * kMs) r.cycle(t, 0x66);
+  const bus::Ticks tc = 1105 * kMs;
+  r.req(1, tc, dp::kSapSetPrm, set_prm(2, kFnPrimaryRequest, 100));
+  ASSERT_EQ(r.rs.im_switchovers().size(), 1u);
+  const bus::Ticks d = r.rs.im_switchovers()[0].drawn;
+  ASSERT_GE(d, 410 * kMs);
+  ASSERT_LE(d, 820 * kMs);
+  bus::Ticks t = tc + 5 * kMs;
+  for (; t < tc + d; t += 10 * kMs) {
+    r.cycle(t, 0x77);
+    ASSERT_EQ(r.rs.outputs()[0], 0x66) << t;
+    ASSERT_EQ(r.rs.primary(), -1) << t;
+  }
+  r.cycle(t, 0x77);
+  EXPECT_EQ(r.rs.primary(), 1);
+  EXPECT_EQ(r.rs.outputs()[0], 0x77);
+  EXPECT_TRUE(of_kind(r, RedEvent::Kind::OutputHoldExpired).empty());
+  // A second switchover draws the next time of the same sequence (count 1).
+  const bus::Ticks tc2 = t + 100 * kMs;
+  r.req(0, tc2, dp::kSapSetPrm, set_prm(3, kFnPrimaryRequest, 100));
+  ASSERT_EQ(r.rs.im_switchovers().size(), 2u);
+  EXPECT_EQ(r.rs.im_switchovers()[1].drawn, draw_im_time(3, 1, 820 * kMs));
+  EXPECT_EQ(r.rs.im_switchovers()[1].iface, 0);
+}
+
+TEST(RedundantSlaveImTime, AutonomousHandOverAtTheWatchdogThenTheImTime) {
+  Rig r(im_params(30 * kMs, 5));
+  redundant_start(r, 100);
+  bus::Ticks t = 1000 * kMs;
+  for (int k = 0; k < 10; ++k, t += 10 * kMs) r.cycle(t, 0x21);
+  // Master 1 stops after its cycle at 1090 ms: interface 0's watchdog (1 s) expires at 2090 ms,
+  // it hands over (BACKUP, take-over sent); the take-over arrives at 2091 ms: the trigger.
+  r.line_up[0] = false;
+  for (; t < 2200 * kMs; t += 10 * kMs) r.cycle(t, 0x31);
+  ASSERT_EQ(r.rs.im_switchovers().size(), 1u);
+  const ImSwitchover im = r.rs.im_switchovers()[0];
+  EXPECT_EQ(im.iface, 1);
+  EXPECT_EQ(im.trigger, 2091 * kMs);
+  ASSERT_GE(im.drawn, 15 * kMs);
+  ASSERT_LE(im.drawn, 30 * kMs);
+  EXPECT_EQ(im.primary_at, 2091 * kMs + im.drawn);
+  // Outputs frozen at 0x21 until the first Data_Exchange after primary_at (cycles every 10 ms
+  // from 1100 ms: the first at or after primary_at + 0.1 ms on line B).
+  const auto fresh = of_kind(r, RedEvent::Kind::FreshOutputs);
+  ASSERT_FALSE(fresh.empty());
+  EXPECT_GE(fresh.back().at, im.primary_at);
+  EXPECT_LT(fresh.back().at, im.primary_at + 10 * kMs + kMs / 10 + 1);
+  EXPECT_EQ(r.rs.outputs()[0], 0x31);
+}
+
 }  // namespace
 }  // namespace pbvbus::redundancy

@@ -62,6 +62,9 @@ struct SwitchoverReport {
   std::optional<bus::Ticks> measured;  ///< fresh − fault_at
   bus::Ticks bound = 0;
   bool exceeded = false;
+  /// The IM's own switchover time drawn for this switchover (S5; nullopt: none drawn, e.g. no
+  /// T_SLAVE_UM known or the station lost).
+  std::optional<bus::Ticks> im_time;
 };
 
 struct SwitchedStationReport {
@@ -97,7 +100,8 @@ class RedundantSystemNode {
  public:
   /// `params[l]` = the effective bus parameters of the system's line l. Throws
   /// std::runtime_error if a model cannot be built (the loader checks the same).
-  RedundantSystemNode(const ScenarioPlan& plan, int system, const fdl::BusParams params[2]);
+  RedundantSystemNode(const ScenarioPlan& plan, int system, const fdl::BusParams params[2],
+                      std::optional<std::uint64_t> seed = std::nullopt);
   ~RedundantSystemNode();
   RedundantSystemNode(const RedundantSystemNode&) = delete;
   RedundantSystemNode& operator=(const RedundantSystemNode&) = delete;

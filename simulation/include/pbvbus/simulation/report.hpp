@@ -107,7 +107,8 @@
 //       "switchovers": [ { "station": int, "from": str|null, "to": str, "cause": str,
 //                          "system_level": bool, "fault": str, "fault_ns": int,
 //                          "commanded_ns": int, "fresh_ns": int|null,
-//                          "measured_ns": int|null, "bound_ns": int, "exceeded": bool } ],
+//                          "measured_ns": int|null, "im_ns": int|null,  // the IM's drawn time (S5)
+//                          "bound_ns": int, "exceeded": bool } ],
 //       "exceeded": int } ],
 //     "h_systems_run": [ {          // every simulated h_system (docs/h-scenarios.md, h_report.hpp)
 //       "name","profile","system_mode": str,

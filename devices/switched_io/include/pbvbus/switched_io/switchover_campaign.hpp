@@ -112,6 +112,11 @@ struct CampaignOptions {
   bus::Ticks recognition = 50 * bus::kTicksPerMs;  ///< window for a fault's events
   bus::Ticks startup = 2000 * bus::kTicksPerMs;    ///< window for a repair's events
   bus::Ticks recover_limit = 5000 * bus::kTicksPerMs;
+  /// S5: the stations take their IM's own switchover time (the GSD's T_SLAVE_UM, drawn in
+  /// [T/2, T] per switchover from `seed` and the address; redundant_slave.hpp). The windows
+  /// above are for the S7 events (OB 70/86), which the IM's time does not delay: a switchover's
+  /// end is no S7 event, and the no-pulse sampler covers the longer hold.
+  bool im_time = false;
   CampaignTamper tamper;
 };
 
@@ -121,6 +126,10 @@ struct CampaignResult {
   int repairs = 0;                     ///< repair injections
   std::uint64_t switchovers = 0;       ///< MasterSystem::switchovers()
   std::uint64_t station_switches = 0;  ///< primary-interface changes seen on the stations
+  /// With im_time: switchovers that drew an IM time, and the longest trigger → PRIMARY. One
+  /// that took longer than max(T_SLAVE_UM, the 10 ms switch timeout) is a mismatch ("late").
+  std::uint64_t im_switchovers = 0;
+  bus::Ticks max_im_switchover = 0;
   /// S7 events raised by the MasterSystem, by code (0x73A3, 0x72A3, 0x39C4, 0x38C4, 0x39C3,
   /// 0x38C3), and the ones the observer expected.
   std::array<std::pair<std::uint16_t, int>, 6> events{};

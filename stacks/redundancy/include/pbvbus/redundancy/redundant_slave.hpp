@@ -39,6 +39,17 @@
 //   partner's is in Data_Exch, it becomes BACKUP and sends take-over (1 × link_delay); when the
 //   BACKUP notices its partner lost it becomes PRIMARY at once. No switch back after a repair:
 //   a repaired interface starts in S_WAITING and the primary tells it to become BACKUP.
+// - The IM's own switchover time (seeds-digest §2 S5, 000 L1832: the switchover time includes
+//   "the changeover time of the DP slave interface"): with params.im_switchover_bound > 0, every
+//   switchover after start-up (a PRIMARY existed since power-on) draws a time d uniformly in
+//   [bound/2, bound] (draw_im_time(im_seed, n, bound), n = the station's switchover count) at its
+//   trigger: the Primary_Request to a non-primary interface, the take-over of an autonomous
+//   hand-over, or the backup counting the primary lost. The interface becomes PRIMARY at
+//   max(the link steps above, trigger + d): until then it stays BP_SWITCHOVER (Red_State
+//   Backup, §G.4 BP_* states), keeps answering Data_Exchange on its line, but its outputs do not
+//   reach the backplane, which holds the last value (§G.1 "inputs and outputs are frozen during
+//   the switchover"; S1), and no Prm_Cmd_Ack yet. The first Primary_Request after power-on is
+//   not a switchover: at once, as before. im_switchovers() lists the draws.
 // - Backplane outputs: only the PRIMARY interface's accepted Data_Exchange outputs (after its
 //   engine applied them: Clear_Data and fail-safe zeros included) reach the backplane. When the
 //   primary role is lost the outputs keep their last value until the new PRIMARY accepts its
@@ -135,7 +146,25 @@ struct RedundantSlaveParams {
   /// BP_SWITCHOVER without the partner's take-over for this long → PRIMARY (> 2 × link_delay).
   bus::Ticks switch_timeout = 10 * bus::kTicksPerMs;
   bool autonomous_switchover = true;
+  /// The IM's own switchover time T_SLAVE_UM (seeds-digest §2 S5; GSD
+  /// Slave_Max_Switch_Over_Time): a switchover after start-up ends no earlier than a time drawn,
+  /// per switchover, uniformly in [bound/2, bound] after its trigger (docs/switchover-timing.md
+  /// "The IM's own time"). 0 = no IM time: the link steps only.
+  bus::Ticks im_switchover_bound = 0;
+  std::uint64_t im_seed = 0;  ///< seed of the draws (the scenario's seed and the address)
 };
+
+/// One switchover's IM time (RedundantSlave::im_switchovers()).
+struct ImSwitchover {
+  int iface = 0;              ///< the interface that becomes PRIMARY
+  bus::Ticks trigger = 0;     ///< PrmCmd Primary_Request, take-over or partner loss
+  bus::Ticks drawn = 0;       ///< the IM's time drawn for it (none recorded without a bound)
+  bus::Ticks primary_at = bus::kNever;  ///< when it became PRIMARY (kNever: not (yet))
+};
+
+/// The IM time of the n-th switchover (n from 0) for `seed`: uniform in [bound/2, bound], tick
+/// exact (splitmix64, the same on every platform).
+bus::Ticks draw_im_time(std::uint64_t seed, std::uint64_t n, bus::Ticks bound);
 
 struct RedEvent {
   enum class Kind : std::uint8_t {
@@ -183,6 +212,8 @@ class RedundantSlave {
   std::span<const std::uint8_t> outputs() const { return m_out; }
   /// True while outputs are held across a switchover (no fresh outputs yet).
   bool outputs_held() const { return m_hold_deadline != bus::kNever; }
+  /// The switchovers since construction with their drawn IM times, in trigger order.
+  const std::vector<ImSwitchover>& im_switchovers() const { return m_im; }
   bus::Ticks output_hold_time() const { return m_hold_time; }
 
   void on_event(std::function<void(const RedEvent&)> cb) { m_cb = std::move(cb); }
@@ -237,6 +268,9 @@ class RedundantSlave {
     bus::Ticks switch_deadline = bus::kNever;  ///< BP_SWITCHOVER: give up waiting for take-over
     Role failed_from = Role::SWaiting;  ///< the role before fail_interface(): what the partner
                                         ///< believes until it counts this interface lost
+    bus::Ticks im_ready_at = bus::kNever;  ///< a switchover runs: PRIMARY no earlier than this
+    bool im_wait = false;  ///< BP_SWITCHOVER only for the IM's time (take-over done)
+    int im_index = -1;     ///< its entry in m_im
   };
   /// An alarm the station keeps until the PRIMARY's master acknowledges it.
   struct StationAlarm {
@@ -256,6 +290,10 @@ class RedundantSlave {
   void send(int from, Msg m, bus::Ticks now);
   void deliver(const LinkMsg& m, bus::Ticks now);
   void set_role(int i, Role r, bus::Ticks now);
+  /// A switchover to interface i starts at `now` (the IM's time is drawn once per switchover).
+  void start_im(int i, bus::Ticks now);
+  /// PRIMARY now, or BP_SWITCHOVER until the IM's time is over.
+  void become_primary(int i, bus::Ticks now);
   void check_primary_lost_master(bus::Ticks now);
   void lose_primary(bus::Ticks now);  ///< backplane: start the hold
   void take_outputs(int i, bus::Ticks now);  ///< FreshOutputs when it ends a hold/start-up
@@ -286,6 +324,7 @@ class RedundantSlave {
   std::uint64_t m_alarms_acked = 0;
   bool m_withdrawing = false;  ///< an internal Alarm_Ack is running: not the master's
   bool m_swapped = false;  ///< Flying: interface 1 at A, interface 0 at A + 64
+  std::vector<ImSwitchover> m_im;
   std::function<void(const RedEvent&)> m_cb;
 };
 

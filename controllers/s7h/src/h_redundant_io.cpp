@@ -198,7 +198,7 @@ void RedundantIo::run_di(bus::Ticks now, std::size_t i, std::span<std::uint8_t> 
   const std::span<const std::uint8_t> raw[2] = {raw_l, raw_h};
   const std::uint32_t bits = s.length * 8;
 
-  // Pass 1 (both modules active): the discrepancy analysis, 001 L5930-5959.
+  // Pass 1 (both modules active): the discrepancy analysis, 001 L5928-5959.
   if (!st.passivated[0] && !st.passivated[1]) {
     std::optional<RedModule> to_passivate;
     std::uint32_t localized_bit = 0;
@@ -213,7 +213,7 @@ void RedundantIo::run_di(bus::Ticks now, std::size_t i, std::span<std::uint8_t> 
         t.differing = true;  // first seen: mark it and start the discrepancy time
         t.since = now;
       } else if (!t.reported && l == h) {
-        // Equal again within the discrepancy time: the analysis simply goes on (L5937-5939).
+        // Equal again within the discrepancy time: the analysis simply goes on (L5936-5938).
         t = Track{};
         set_bit(w.last_valid, b, l);
         continue;
@@ -266,7 +266,7 @@ void RedundantIo::run_di(bus::Ticks now, std::size_t i, std::span<std::uint8_t> 
       } else {
         st.discrepant = true;
         st.expired = st.expired || t.reported;
-        // During the time: the last agreeing value (L5933-5936); after the expiry, until the
+        // During the time: the last agreeing value (L5934-5936); after the expiry, until the
         // next change: the configured reaction (L5953-5954).
         v = t.reported && s.di_reaction == DiReaction::Value1 ? true : get_bit(w.last_valid, b);
       }
@@ -312,7 +312,7 @@ void RedundantIo::run_ai(bus::Ticks now, std::size_t i, std::span<std::uint8_t> 
       const std::int32_t a = get_word(raw_l, c), b = get_word(raw_h, c);
       const std::int64_t diff = a > b ? a - b : b - a;
       if (diff * 1000 <= window_x1000) {
-        t = Track{};  // inside: the analysis goes on (L6179-6180)
+        t = Track{};  // inside: the analysis goes on (L6178-6179)
         continue;
       }
       if (!t.differing) {
@@ -347,7 +347,7 @@ void RedundantIo::run_ai(bus::Ticks now, std::size_t i, std::span<std::uint8_t> 
         set_word(w.last_valid, c, v);
       } else {
         st.discrepant = true;
-        v = get_word(w.last_valid, c);  // the last valid value (L6165-6167)
+        v = get_word(w.last_valid, c);  // the last valid value (L6166-6168)
       }
     }
     set_word(low, c, v);

@@ -96,7 +96,7 @@ TEST(HRedundantIoDi, ReactionValue1GivesOneAfterTheExpiry) {
   EXPECT_FALSE(io.passivated(0, RedModule::H));
 }
 
-// Agreeing again within the discrepancy time: no error, the analysis goes on (L5937-5939).
+// Agreeing again within the discrepancy time: no error, the analysis goes on (L5936-5938).
 TEST(HRedundantIoDi, AgreeingWithinTheTimeRaisesNothing) {
   RedundantIo io({di_pair()});
   EXPECT_EQ(read_di(io, 0, 0, 0), 0);

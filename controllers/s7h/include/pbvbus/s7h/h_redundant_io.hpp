@@ -22,7 +22,7 @@
 // output at both addresses.
 //
 // Digital values are bit-wise (one discrepancy timer per bit, "время рассогласования бита",
-// 001 L5945); analog values are S7 words, big-endian, signed, one per channel (2 octets).
+// 001 L5938); analog values are S7 words, big-endian, signed, one per channel (2 octets).
 // Passivation is per module (the manual passivates "the module", 001 L5957-5959, L6170-6176).
 #include <cstdint>
 #include <optional>
@@ -43,7 +43,7 @@ enum class DiReaction : std::uint8_t {
   Value1,          ///< 1
 };
 
-/// HW Config "accepted value" of an AI pair (001 L6150-6152, L6170-6176).
+/// HW Config "accepted value" of an AI pair (001 L6156-6158, L6170-6176).
 enum class AiAcceptedValue : std::uint8_t { Max, Min };
 
 struct RedIoPairSpec {

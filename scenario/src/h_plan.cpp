@@ -129,6 +129,8 @@ class HPlanner {
     if (!h.has_cpu() && (h.cp_size() > 0 || h.connection_size() > 0))
       error(i, h.cp_size() > 0 ? "cp" : "connection",
             "h_system \"" + hp.name + "\": cp and connection entries need a cpu part (the simulated pair)");
+    if (!h.has_cpu() && h.redundant_io_size() > 0)
+      error(i, "redundant_io", "h_system \"" + hp.name + "\": redundant_io needs a cpu part (the simulated pair)");
     if (!h.has_cpu() && h.expansion_rack_size() > 0)
       error(i, "expansion_rack",
             "h_system \"" + hp.name + "\": expansion racks need a cpu part (the simulated pair)");
@@ -192,6 +194,9 @@ class HPlanner {
     if (h.has_program()) plan_program(i, h.program(), rt.program);
     plan_comms(i, rt);  // F4 connections
     for (int k = 0; k < h.expansion_rack_size(); ++k) plan_rack(i, k, rt.racks);
+    plan_redundant_io(m_plan, i, rt, [&](std::vector<HPathStep> path, std::string msg) {
+      error_at(i, path, std::move(msg));
+    });
     if (!c.max_cycle_time().empty())
       if (auto t = ticks(i, {{"cpu"}, {"max_cycle_time"}}, c.max_cycle_time(), true))
         rt.max_cycle_time = *t;

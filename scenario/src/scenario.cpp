@@ -634,6 +634,7 @@ class Planner {
                                       : pf.kind == K::SlaveStop   ? f.slave_stop()
                                       : pf.kind == K::ChannelDiag ? f.channel_diag()
                                       : pf.kind == K::ModulePull  ? f.module_pull()
+                                      : pf.kind == K::ChannelStuck ? f.channel_stuck()
                                                                   : f.process_alarm();
     const std::string& ln = plan.lines[static_cast<std::size_t>(li)].name;
     if (!s.has_address()) {
@@ -731,6 +732,11 @@ class Planner {
                          ") on channel " + std::to_string(s.channel()) + " of " + mod + " of " + who;
         break;
       case K::ModulePull: pf.description = "pulled " + mod + " of " + who; break;
+      case K::ChannelStuck:  // redundant I/O (docs/h-redundant-io.md)
+        pf.stuck_value = s.stuck_value();
+        pf.description = "inputs of " + mod + " of " + who + " stuck at " +
+                         std::to_string(s.stuck_value());
+        break;
       default: pf.description = "process alarm of " + mod + " of " + who; break;
     }
     return true;
@@ -824,6 +830,7 @@ class Planner {
         info = {K::ExpansionRackFailure, "expansion_rack_failure", true};
         break;
       case FK::kCycleOverload: info = {K::CycleOverload, "cycle_overload", false}; break;
+      case FK::kRedDepa: info = {K::RedDepa, "red_depa", false}; break;  // redundant I/O
       default: return false;
     }
     pf.kind = info.kind;
@@ -845,6 +852,7 @@ class Planner {
         break;
       case FK::kExpansionRackFailure: h_name = f.expansion_rack_failure().h_system(); break;
       case FK::kCycleOverload: h_name = f.cycle_overload().h_system(); break;
+      case FK::kRedDepa: h_name = f.red_depa().h_system(); break;
       case FK::kFibreCut:
         h_name = f.fibre_cut().h_system();
         if (f.fibre_cut().has_fibre()) fibre = f.fibre_cut().fibre();
@@ -1160,6 +1168,7 @@ class Planner {
         case FK::kModulePull: pf.kind = K::ModulePull; line_name = f.module_pull().line(); kind_field = "module_pull"; break;
         case FK::kProcessAlarm: pf.kind = K::ProcessAlarm; line_name = f.process_alarm().line(); kind_field = "process_alarm"; break;
         case FK::kSlaveStop: pf.kind = K::SlaveStop; line_name = f.slave_stop().line(); kind_field = "slave_stop"; break;
+        case FK::kChannelStuck: pf.kind = K::ChannelStuck; line_name = f.channel_stuck().line(); kind_field = "channel_stuck"; break;
         case FK::kInterfaceFailure: pf.kind = K::InterfaceFailure; line_name = f.interface_failure().line(); kind_field = "interface_failure"; break;
         case FK::kStationPowerLoss: pf.kind = K::StationPowerLoss; line_name = f.station_power_loss().line(); kind_field = "station_power_loss"; break;
         case FK::kMasterFailure: pf.kind = K::MasterFailure; line_name = f.master_failure().line(); kind_field = "master_failure"; break;
@@ -1182,6 +1191,7 @@ class Planner {
         case FK::kCpFailure:
         case FK::kExpansionRackFailure:
         case FK::kCycleOverload:
+        case FK::kRedDepa:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::kQuantumPowerLoss:
@@ -1267,6 +1277,7 @@ class Planner {
         case K::ChannelDiag:
         case K::ModulePull:
         case K::ProcessAlarm:
+        case K::ChannelStuck:
           if (!plan_slave_fault(plan, f, kw, kd, kind_field, li, pf)) continue;
           break;
         case K::InterfaceFailure:
@@ -1360,6 +1371,7 @@ std::string h_fault_description(const PlanFault& f) {
              (us % 1000 == 0 ? std::to_string(us / 1000) + " ms" : std::to_string(us) + " us") +
              " longer";
     }
+    case K::RedDepa: return "FC 451 RED_DEPA (depassivation of the redundant I/O)";
     default: return {};
   }
 }
@@ -1420,6 +1432,7 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::CpFailure: return true;
     case K::ExpansionRackFailure:
     case K::CycleOverload: return true;
+    case K::RedDepa: return true;
     default: return false;
   }
 }

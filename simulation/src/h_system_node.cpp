@@ -75,6 +75,17 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
     m_model->set_max_cycle_time(rt.max_cycle_time);
     if (has_networks(rt.program)) m_model->set_program(rt.program);
+    if (!rt.redundant_io.empty()) {  // docs/h-redundant-io.md
+      std::vector<devices::HSystemModel::RedIoPair> pairs;
+      for (const HRedIoPlan& x : rt.redundant_io) {
+        devices::HSystemModel::RedIoPair p;
+        p.spec = x.spec;
+        p.a = {x.system[0], x.station[0], x.module[0]};
+        p.b = {x.system[1], x.station[1], x.module[1]};
+        pairs.push_back(p);
+      }
+      m_model->set_redundant_io(pairs);
+    }
     // F4 connections: checked by the planner already; an error here is a planner bug.
     for (const devices::CpConfig& c : rt.cps)
       if (std::string e = m_model->add_cp(c); !e.empty()) throw std::invalid_argument(e);
@@ -187,6 +198,9 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
         text += on ? ": off already, nothing happens" : ": on already, nothing happens";
       break;
     case K::CycleOverload: m.cycle_overload(f.extra); break;
+    case K::RedDepa:  // FC 451 (docs/h-redundant-io.md)
+      if (!m.red_depa()) text += ": nothing passivated, refused";
+      break;
     default: break;
   }
   m_faults.back().second = text;  // with what the pair answered ("refused", ...)

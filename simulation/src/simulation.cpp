@@ -507,6 +507,7 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
     case K::ChannelDiag:
     case K::ModulePull:
     case K::ProcessAlarm: apply_slave_fault(f, on); break;
+    case K::ChannelStuck: apply_channel_stuck(f, on); break;
     case K::InterfaceFailure:
     case K::StationPowerLoss:
     case K::MasterFailure:
@@ -564,6 +565,40 @@ void Simulation::apply_slave_fault(const PlanFault& f, bool on) {
   }
   // Slave faults are no line events: the report lists them with the line's faults.
   if (std::string why = node->model().apply(sf); !why.empty()) text += " (refused: " + why + ")";
+  ls.stats.faults.push_back({m_sched.now(), std::move(text)});
+}
+
+// channel_stuck (docs/h-redundant-io.md): the module's inputs become a constant; the repair
+// gives the module the behaviours of its plan again.
+void Simulation::apply_channel_stuck(const PlanFault& f, bool on) {
+  LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
+  DpSlaveNode* node = nullptr;
+  for (auto& s : ls.stations)
+    if (s.dp_slave && s.address == f.slave) node = s.dp_slave.get();
+  if (node == nullptr) return;  // the loader checked it
+  devices::SlaveModel& model = node->model();
+  std::string text = on ? f.description : f.description + ": repaired";
+  std::string why;
+  if (on) {
+    const std::size_t n = model.application().module(f.module).in_len;
+    std::vector<std::uint8_t> v(n, 0);
+    devices::put_big_endian(static_cast<std::int64_t>(f.stuck_value), v.begin(), n);
+    why = model.set_behaviour(f.module, devices::IoBehaviour::constant_value(std::move(v)));
+  } else {
+    for (const DpSlavePlan& p : m_plan.dp_slaves) {
+      if (p.switched >= 0 || p.line != f.line || p.address != f.slave) continue;
+      apply_io_plan(
+          p, model.application(),
+          [&](std::size_t m, devices::IoBehaviour beh) {
+            return m == f.module ? model.set_behaviour(m, std::move(beh)) : std::string();
+          },
+          [&](std::size_t m, std::size_t off, std::size_t w, devices::IoBehaviour beh) {
+            return m == f.module ? model.add_channel_behaviour(m, off, w, std::move(beh))
+                                 : std::string();
+          });
+    }
+  }
+  if (!why.empty()) text += " (refused: " + why + ")";
   ls.stats.faults.push_back({m_sched.now(), std::move(text)});
 }
 

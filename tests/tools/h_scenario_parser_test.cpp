@@ -342,5 +342,42 @@ TEST(HScenarioParser, PbvbusTimingPlansTheExample) {
   EXPECT_NE(out.str().find("H-DP 1"), std::string::npos) << out.str();
 }
 
+// Redundant I/O (docs/h-redundant-io.md "In a scenario"): bad redundant_io entries and the
+// faults channel_stuck / red_depa are refused with a message and never crash (this file also
+// runs under ASan+UBSan).
+bool redio_has(const std::vector<std::string>& errs, const std::string& text) {
+  for (const auto& e : errs)
+    if (e.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(HScenarioParser, RedundantIoRefusals) {
+  const std::string no_cpu = R"(name: "h"
+h_system { name: "T" redundant_io { kind: DI } }
+)";
+  EXPECT_TRUE(redio_has(errors_of(no_cpu), "redundant_io needs a cpu part"));
+  auto pair = [](const std::string& body) {
+    return R"(name: "h"
+h_system { name: "H" cpu { } redundant_io { )" + body + R"( } }
+)";
+  };
+  EXPECT_TRUE(redio_has(errors_of(pair("kind: AI")), "redundant_io needs two modules"));
+  EXPECT_TRUE(redio_has(
+      errors_of(pair(R"(module_a { system: "X" } module_b { system: "" address: 4000000000 })")),
+      "\"X\" is not a redundant_master_system this h_system drives"));
+  EXPECT_TRUE(redio_has(errors_of(pair(R"(kind: AI module_a { } module_b { } tolerance_permille: 4294967295 end_value: -2147483648 discrepancy_time: "-1ms")")),
+                         "tolerance_permille 4294967295 is above 1000"));
+  EXPECT_TRUE(redio_has(errors_of(pair(R"(kind: DI module_a { } module_b { } discrepancy_time: "soon")")),
+                         "bad duration \"soon\" for discrepancy_time"));
+  const std::string faults = R"(name: "h"
+h_system { name: "H" cpu { } }
+fault { at: "1s" channel_stuck { line: "nowhere" address: 255 module_index: 4294967295 stuck_value: 18446744073709551615 } }
+fault { at: "1s" repair_at: "2s" red_depa { } }
+)";
+  const auto e = errors_of(faults);
+  EXPECT_GE(e.size(), 2u);
+  EXPECT_TRUE(redio_has(e, "red_depa")) << (e.empty() ? "" : e.back());
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -290,8 +290,9 @@ void HSystemModel::scan(bus::Ticks now) {
   }
   ++m_scans;
   m_map.read_inputs(m_systems, m_pii);
+  red_io_in(now);
   m_program(m_pii, m_piq, now);
-  m_map.write_outputs(m_systems, m_piq);
+  m_map.write_outputs(m_systems, red_io_out(m_piq));
   write_racks();
 }
 
@@ -307,11 +308,15 @@ void insert_sorted(std::vector<HSystemEvent>& v, HSystemEvent e) {
 
 void HSystemModel::add_event(HSystemEvent e) {
   if (m_handler) m_handler(e);
+  if (!m_red_io) return insert_sorted(m_events, std::move(e));
+  const HSystemEvent copy = e;
   insert_sorted(m_events, std::move(e));
+  red_io_on_event(copy);  // OB 82/85 of a paired module: RED_DIAG (h_system_redundant_io.cpp)
 }
 
 void HSystemModel::on_pair_event(const HEvent& e) {
   if (m_pair_handler) m_pair_handler(e);
+  if (m_red_io) red_io_on_pair_event(e);  // OB 100 / OB 72 Redundant: depassivation
   if (e.kind != HEvent::Kind::Ob) return;
   HSystemEvent h;
   h.time = e.at;

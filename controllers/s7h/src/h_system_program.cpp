@@ -33,6 +33,7 @@ bool HSystemModel::inject_divergence(int rack, Area area, std::uint32_t offset,
 void HSystemModel::scan_execution(bus::Ticks now) {
   // The sync point: the master's reading of the I/O goes into both PIIs.
   m_map.read_inputs(m_systems, m_pii);
+  red_io_in(now);  // FB 450 RED_IN (h_system_redundant_io.cpp)
   const std::array<bool, 2> running{m_pair.dp_master_operate(0), m_pair.dp_master_operate(1)};
   if (running[0] || running[1]) {
     // Direct access (L PIB / T PQB): OB 122 for unreachable modules, their bytes read 0.
@@ -57,7 +58,7 @@ void HSystemModel::scan_execution(bus::Ticks now) {
       std::array<bool, 2> one{r == 0, r == 1};
       ScanResult res = m_exec->scan(now, one, r);
       for (const auto& e : res.events) on_program_event(e, one);
-      m_map.write_outputs(m_systems, m_exec->image(r).piq(), r);
+      m_map.write_outputs(m_systems, red_io_out(m_exec->image(r).piq()), r);
       if (res.output_rack) out = res.output_rack;
     }
   } else {
@@ -84,7 +85,8 @@ void HSystemModel::scan_execution(bus::Ticks now) {
       after_op();
     }
   }
-  if (out && !m_split_outputs) m_map.write_outputs(m_systems, m_exec->image(*out).piq());
+  if (out && !m_split_outputs)
+    m_map.write_outputs(m_systems, red_io_out(m_exec->image(*out).piq()));
   const auto piq = m_exec->image(out.value_or(m_pair.master() >= 0 ? m_pair.master() : 0)).piq();
   std::copy(piq.begin(), piq.end(), m_piq.begin());
 }

@@ -36,6 +36,7 @@
 #include "pbvbus/s7h/h_cpu_pair.hpp"
 #include "pbvbus/s7h/h_expansion_rack.hpp"
 #include "pbvbus/s7h/h_program_spec.hpp"
+#include "pbvbus/s7h/h_redundant_io.hpp"
 #include "pbvbus/s7h/h_update_timing.hpp"
 #include "pbvbus/scenario/dp_plan.hpp"
 #include "scenario.pb.h"
@@ -47,6 +48,16 @@ struct HDpSystemPlan {
   int system = -1;  ///< index into ScenarioPlan::redundant_systems, or -1 (figures given)
   std::optional<devices::Us> t_tr, t_dp_um, t_slave_um;
   devices::Us t_pto = 0;
+};
+
+/// A redundant_io pair (docs/h-redundant-io.md "In a scenario"): the spec (addresses and length
+/// are resolved by the model from its I/O map) and the two modules by model system index
+/// (position in HRuntimePlan::systems), station address and module index.
+struct HRedIoPlan {
+  devices::RedIoPairSpec spec;
+  int system[2] = {-1, -1};
+  std::uint8_t station[2] = {0, 0};
+  std::size_t module[2] = {0, 0};
 };
 
 /// What the Simulation needs to run an h_system's CPU pair.
@@ -65,6 +76,7 @@ struct HRuntimePlan {
   // OB 80's maximum cycle time (HCpuPair.max_cycle_time, default 150 ms).
   std::vector<devices::HExpansionRack> racks;
   bus::Ticks max_cycle_time = 150 * bus::kTicksPerMs;
+  std::vector<HRedIoPlan> redundant_io;  ///< plan_redundant_io
 };
 
 struct HSystemPlan {
@@ -97,6 +109,12 @@ void plan_program_spec(const scenario::HProgram& program, devices::ProgramSpec& 
                        const ProgramError& error);
 
 struct ScenarioPlan;
+/// h_system[i].redundant_io -> rt.redundant_io (h_redundant_io_plan.cpp): each module a station
+/// of a system the pair drives (a switched_station, or a dp_slave of one of its masters) and a
+/// module of it, two different modules; inputs need a discrepancy_time; tolerance_permille
+/// <= 1000; end_value > 0. The two modules' lengths are checked when the model is built.
+void plan_redundant_io(const ScenarioPlan& plan, int i, HRuntimePlan& rt,
+                       const ProgramError& error);
 /// Plans the h_system entries (after plan_dp: they refer to redundant_master_systems).
 void plan_h(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
             std::vector<Diagnostic>& errors);

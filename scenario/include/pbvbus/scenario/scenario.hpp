@@ -149,6 +149,9 @@ struct PlanFault {
     // F8 expansion racks, OB 80
     ExpansionRackFailure,  ///< F8, `rack_number` (`rack` = its CPU); repair: power back
     CycleOverload,         ///< the next OB 1 lasts scan_time + `extra` (OB 80)
+    // Redundant I/O (docs/h-redundant-io.md)
+    ChannelStuck,  ///< DP slave `slave` module `module`'s inputs stick at `stuck_value`; repair: behaviours again
+    RedDepa,       ///< H fault: FC 451 RED_DEPA on `h_system`
     // Quantum Hot Standby (quantum_plan.hpp): `quantum`, and `rack` where the kind names one.
     QuantumPowerLoss,     ///< the rack's power fails; repair: power back
     QuantumCpuStop,       ///< the rack's CPU stops; repair: started again
@@ -188,6 +191,7 @@ struct PlanFault {
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change
   int rack_number = 0;   ///< expansion_rack_failure: the expansion rack (1..21)
   bus::Ticks extra = 0;  ///< cycle_overload: how much longer the next OB 1 lasts
+  std::uint64_t stuck_value = 0;  ///< channel_stuck: big-endian over the module's input octets
   int quantum = -1;      ///< Quantum faults: index into ScenarioPlan::quantum
   int key = 0;           ///< quantum_key: 1 Off Line, 2 Xfer
   bool run_a = false, run_b = false;  ///< quantum_command

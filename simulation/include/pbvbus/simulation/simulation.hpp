@@ -173,6 +173,7 @@ class Simulation {
   void set_h_mpi_power(int plan_index, int rack, bool on);
   void apply_fault(const PlanFault& f, bool on);
   void apply_slave_fault(const PlanFault& f, bool on);
+  void apply_channel_stuck(const PlanFault& f, bool on);  ///< redundant I/O (h-redundant-io.md)
   void make_link(const std::string& target, const std::string& link);
 
   ScenarioPlan m_plan;

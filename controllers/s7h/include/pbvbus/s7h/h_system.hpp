@@ -103,6 +103,7 @@
 #include "pbvbus/s7h/h_program_spec.hpp"
 #include "pbvbus/s7cpu/cpu_memory.hpp"
 #include "pbvbus/s7h/h_redundant_execution.hpp"
+#include "pbvbus/s7h/h_redundant_io.hpp"
 #include "pbvbus/s7h/h_s7_memory.hpp"
 #include "pbvbus/s7h/h_s7_session.hpp"
 #include "pbvbus/s7h/h_ssl.hpp"
@@ -582,6 +583,44 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<std::pair<std::uint32_t, S7SessionPtr>> m_s7_sessions;
   std::uint32_t m_s7_next = 1;
   // ---- end S7 communication ----
+
+  // ---- redundant I/O ---- (h_system_redundant_io.cpp; docs/h-redundant-io.md "In the
+  // H-system model"). Module pairs of the I/O map run through RedundantIo at every OB 1:
+  // RED_IN on the PII after the inputs are read, RED_OUT on what goes to the outputs (the
+  // program's PIQ is unchanged). OB 82 / OB 85 of a paired module (events()) -> RED_DIAG;
+  // a CPU entering STARTUP (OB 100) and the system entering Redundant (OB 72) request a
+  // depassivation; red_depa() is FC 451. Its entries (796x) go into both powered CPUs'
+  // buffers and into events() (source Program, ob 0) as the program's 7960 does.
+ public:
+  /// One module of a pair, by its place in the I/O map.
+  struct RedIoModule {
+    int system = 0;
+    std::uint8_t station = 0;
+    std::size_t module = 0;
+  };
+  struct RedIoPair {
+    RedIoPairSpec spec;  ///< kind, times, window, reactions; addresses and length are resolved
+    RedIoModule a, b;    ///< the two modules (module_L is the one at the lower address)
+  };
+  /// Before the run. Throws std::invalid_argument("redundant I/O: " + the first problem): an
+  /// unknown module, no inputs (DI/AI) or outputs (DO/AO), different lengths, RedundantIo's
+  /// validate(); the model is then unchanged.
+  void set_redundant_io(const std::vector<RedIoPair>& pairs);
+  /// nullptr without pairs.
+  const RedundantIo* redundant_io() const { return m_red_io.get(); }
+  /// FC 451 RED_DEPA (false: no pairs, or nothing passivated).
+  bool red_depa();
+
+ private:
+  void red_io_in(bus::Ticks now);
+  std::span<const std::uint8_t> red_io_out(std::span<const std::uint8_t> piq);
+  void red_io_on_event(const HSystemEvent& e);
+  void red_io_on_pair_event(const HEvent& e);
+  void red_io_flush();
+  std::unique_ptr<RedundantIo> m_red_io;
+  std::vector<std::uint8_t> m_red_io_out;
+  std::size_t m_red_io_seen = 0;  ///< RedundantIo events already in events()
+  // ---- end redundant I/O ----
 };
 
 }  // namespace pbvbus::devices

@@ -149,6 +149,8 @@ struct PlanFault {
     // F8 expansion racks, OB 80
     ExpansionRackFailure,  ///< F8, `rack_number` (`rack` = its CPU); repair: power back
     CycleOverload,         ///< the next OB 1 lasts scan_time + `extra` (OB 80)
+    ChecksumError,         ///< `rack`: a checksum error in the cyclic self-test (001 Table 5-6)
+    PsFailure,             ///< F1, `rack`, `half` of its PS 407 10A R; repair: that half replaced
     // Quantum Hot Standby (quantum_plan.hpp): `quantum`, and `rack` where the kind names one.
     QuantumPowerLoss,     ///< the rack's power fails; repair: power back
     QuantumCpuStop,       ///< the rack's CPU stops; repair: started again
@@ -183,6 +185,7 @@ struct PlanFault {
   int h_system = -1;   ///< H faults: index into ScenarioPlan::h_systems (one with a runtime)
   int rack = -1;       ///< H faults: 0 or 1 where the kind names a CPU
   int fibre = -1;      ///< fibre_cut: 0 = upper, 1 = lower
+  int half = -1;       ///< ps_failure: 0 or 1, the PS of the rack's PS 407 10A R pair
   int cp = -1;         ///< cp_failure: the CP's index in `rack`
   std::uint32_t kb = 0;  ///< update_load: KB the next update copies
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change

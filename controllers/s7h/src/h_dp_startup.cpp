@@ -2,6 +2,7 @@
 #include "pbvbus/s7h/h_dp_startup.hpp"
 
 #include <string>
+#include <utility>
 
 namespace pbvbus::devices {
 
@@ -14,11 +15,19 @@ std::vector<std::uint8_t> late_stations(bus::Ticks start, std::uint32_t units_10
   return late;
 }
 
-HDpStartupMonitor::HDpStartupMonitor(HCpuPair& pair, std::uint32_t units_100ms,
+HDpStartupMonitor::HDpStartupMonitor(Sink sink, std::uint32_t units_100ms,
                                      std::vector<std::uint8_t> stations)
-    : m_pair(pair), m_units(units_100ms) {
+    : m_sink(std::move(sink)), m_units(units_100ms) {
   for (auto a : stations) m_st.push_back(HStationStart{a, std::nullopt});
 }
+
+HDpStartupMonitor::HDpStartupMonitor(HCpuPair& pair, std::uint32_t units_100ms,
+                                     std::vector<std::uint8_t> stations)
+    : HDpStartupMonitor(
+          [&pair](int r, bus::Ticks at, std::string t, std::uint16_t code) {
+            if (pair.state(r) != CpuState::Off) pair.log_entry(r, at, std::move(t), code);
+          },
+          units_100ms, std::move(stations)) {}
 
 void HDpStartupMonitor::start(int rack, bus::Ticks now) {
   on_time(now);
@@ -40,10 +49,10 @@ void HDpStartupMonitor::on_time(bus::Ticks now) {
   const bus::Ticks at = m_deadline;
   m_deadline = bus::kNever;
   m_late = late_stations(m_start, m_units, m_st);
-  if (m_late.empty() || m_pair.state(m_rack) == CpuState::Off) return;
+  if (m_late.empty() || !m_sink) return;
   std::string t = "transfer of parameters to modules: monitoring time exceeded, stations";
   for (auto a : m_late) t += " " + std::to_string(a);
-  m_pair.log_entry(m_rack, at, t, kParamTransferExceeded);
+  m_sink(m_rack, at, std::move(t), kParamTransferExceeded);
 }
 
 }  // namespace pbvbus::devices

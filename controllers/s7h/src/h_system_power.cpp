@@ -2,6 +2,7 @@
 // error of the cyclic self-test (001 Table 5-6) and the PS 407 10A R halves of F1 (000 L2517,
 // 001 L8387-8390).
 #include <string>
+#include <utility>
 
 #include "pbvbus/s7h/h_rack_power.hpp"
 #include "pbvbus/s7h/h_system.hpp"
@@ -13,6 +14,12 @@ bool HSystemModel::checksum_error(int rack) {
   const bool ok = m_pair.checksum_error(rack, HChecksumContext::Cyclic, m_sched.now());
   after_op();
   return ok;
+}
+
+void HSystemModel::log_entry(int rack, std::string text, std::uint16_t code) {
+  if (!valid_rack(rack) || m_pair.state(rack) == CpuState::Off) return;
+  m_pair.log_entry(rack, m_sched.now(), std::move(text), code);
+  after_op();  // the deadlines log_entry ran may have changed a side
 }
 
 bool HSystemModel::ps_failure(int rack, int half) {

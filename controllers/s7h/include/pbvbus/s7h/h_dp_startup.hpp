@@ -6,6 +6,8 @@
 // start-up; the standby's at the end of its link-up, 001 Fig. 6-1), reports each station that
 // reaches data exchange, and calls on_time() at next_deadline().
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -34,6 +36,10 @@ std::vector<std::uint8_t> late_stations(bus::Ticks start, std::uint32_t units_10
 
 class HDpStartupMonitor {
  public:
+  /// Where the entry goes: (rack, time, text, code), e.g. HSystemModel::log_entry.
+  using Sink = std::function<void(int, bus::Ticks, std::string, std::uint16_t)>;
+  HDpStartupMonitor(Sink sink, std::uint32_t units_100ms, std::vector<std::uint8_t> stations);
+  /// The entry into the pair's buffer (none when the CPU is off).
   HDpStartupMonitor(HCpuPair& pair, std::uint32_t units_100ms, std::vector<std::uint8_t> stations);
   /// CPU `rack`'s DP master(s) start parameterising every station at `now`.
   void start(int rack, bus::Ticks now);
@@ -48,7 +54,7 @@ class HDpStartupMonitor {
   bool exceeded() const { return !m_late.empty(); }
 
  private:
-  HCpuPair& m_pair;
+  Sink m_sink;
   std::uint32_t m_units;
   std::vector<HStationStart> m_st;
   int m_rack = -1;

@@ -212,6 +212,9 @@ class HSystemModel final : public bus::EventTarget {
   /// That half replaced: W#16#3823 if the other half had kept the CPU on, power_on(rack) if
   /// both had failed (true); false if the half had not failed.
   bool ps_repair(int rack, int half);
+  /// An entry in `rack`'s buffer at now from a part built on the model (h_dp_startup.hpp's
+  /// W#16#6547); nothing for a bad rack or a CPU that is off.
+  void log_entry(int rack, std::string text, std::uint16_t code = 0);
   /// F18 without a program: exactly the reaction of the program's sync error (the standby's
   /// switch_to_stop: standby STOP, Solo, OB 72 StandbyStop on the master; a "sync error (F18)"
   /// entry in both buffers). false (nothing happens) unless the system is Redundant.

@@ -831,6 +831,8 @@ class Planner {
         break;
       case FK::kCycleOverload: info = {K::CycleOverload, "cycle_overload", false}; break;
       case FK::kRedDepa: info = {K::RedDepa, "red_depa", false}; break;  // redundant I/O
+      case FK::kChecksumError: info = {K::ChecksumError, "checksum_error", false}; break;
+      case FK::kPsFailure: info = {K::PsFailure, "ps_failure", true}; break;
       default: return false;
     }
     pf.kind = info.kind;
@@ -844,6 +846,12 @@ class Planner {
       case FK::kCpuHold: cpu = &f.cpu_hold(); break;
       case FK::kMemoryReset: cpu = &f.memory_reset(); break;
       case FK::kLoadMemoryError: cpu = &f.load_memory_error(); break;
+      case FK::kChecksumError: cpu = &f.checksum_error(); break;
+      case FK::kPsFailure:  // rack as for a CPU fault, half checked below
+        h_name = f.ps_failure().h_system();
+        needs_rack = true;
+        if (f.ps_failure().has_rack()) rack = f.ps_failure().rack();
+        break;
       case FK::kSyncError: h_name = f.sync_error().h_system(); break;
       case FK::kCpFailure:  // F4: rack as for a CPU fault, cp checked below
         h_name = f.cp_failure().h_system();
@@ -943,6 +951,18 @@ class Planner {
         return false;
       }
       pf.fibre = static_cast<int>(*fibre);
+    }
+    if (pf.kind == K::PsFailure) {
+      if (!f.ps_failure().has_half()) {
+        error(kw, "ps_failure needs a half: half: 0 or half: 1 (the PS of the PS 407 10A R pair)");
+        return false;
+      }
+      if (f.ps_failure().half() > 1) {
+        error(at_field(kw, kd, "half"),
+              "ps_failure: half " + std::to_string(f.ps_failure().half()) + " is not 0 or 1");
+        return false;
+      }
+      pf.half = static_cast<int>(f.ps_failure().half());
     }
     if (pf.kind == K::CpFailure) {  // F4: an h_system cp entry of that rack
       if (!f.cp_failure().has_cp()) {
@@ -1192,6 +1212,8 @@ class Planner {
         case FK::kExpansionRackFailure:
         case FK::kCycleOverload:
         case FK::kRedDepa:
+        case FK::kChecksumError:
+        case FK::kPsFailure:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::kQuantumPowerLoss:
@@ -1361,6 +1383,9 @@ std::string h_fault_description(const PlanFault& f) {
     case K::MemoryReset: return "memory reset of " + cpu + " after its reset request";
     case K::LoadMemoryError: return cpu + ": load-memory access error";
     case K::SyncError: return "sync error (diverging uninitialised data)";
+    case K::ChecksumError: return cpu + ": checksum error in the cyclic self-test";
+    case K::PsFailure:
+      return "PS 407 10A R half " + std::to_string(f.half) + " of rack " + std::to_string(f.rack) + " fails";
     case K::CpFailure: return "CP " + std::to_string(f.cp) + " in rack " + std::to_string(f.rack) + " fails (F4)";
     case K::ExpansionRackFailure:
       return "expansion rack " + std::to_string(f.rack_number) + " of CPU " + std::to_string(f.rack) +
@@ -1431,8 +1456,10 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::SyncError:
     case K::CpFailure: return true;
     case K::ExpansionRackFailure:
-    case K::CycleOverload: return true;
-    case K::RedDepa: return true;
+    case K::CycleOverload:
+    case K::RedDepa:
+    case K::ChecksumError:
+    case K::PsFailure: return true;
     default: return false;
   }
 }

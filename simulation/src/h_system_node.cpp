@@ -201,6 +201,16 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
     case K::RedDepa:  // FC 451 (docs/h-redundant-io.md)
       if (!m.red_depa()) text += ": nothing passivated, refused";
       break;
+    case K::ChecksumError:  // docs/h-changes.md (001 Table 5-6)
+      if (!m.checksum_error(f.rack)) text += ": refused (CPU off or DEFECTIVE)";
+      break;
+    case K::PsFailure:  // F1 with a PS 407 10A R pair (docs/h-changes.md)
+      if (on) {
+        text += m.ps_failure(f.rack, f.half) ? ": no half left, the CPU fails" : ": the other half supplies the rack";
+      } else if (!m.ps_repair(f.rack, f.half)) {
+        text += ": nothing to do";
+      }
+      break;
     default: break;
   }
   m_faults.back().second = text;  // with what the pair answered ("refused", ...)

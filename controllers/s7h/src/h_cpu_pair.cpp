@@ -104,6 +104,8 @@ std::string_view to_string(HReason r) {
       return "master/standby swap";
     case HReason::UpdateTimeout:
       return "update timeout";
+    case HReason::ChecksumError:
+      return "checksum error";
   }
   return "?";
 }
@@ -1029,6 +1031,7 @@ void HCpuPair::repair_cpu(int r, bus::Ticks now) {
   c.hw_fault = false;
   c.defective = false;
   c.last_ob121.reset();
+  c.last_checksum.reset();
   if (c.state == CpuState::Defective) stop_cpu(r, now, "CPU repaired");
   after_step(now);
 }

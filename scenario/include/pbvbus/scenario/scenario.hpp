@@ -152,6 +152,9 @@ struct PlanFault {
     // Redundant I/O (docs/h-redundant-io.md)
     ChannelStuck,  ///< DP slave `slave` module `module`'s inputs stick at `stuck_value`; repair: behaviours again
     RedDepa,       ///< H fault: FC 451 RED_DEPA on `h_system`
+    // Changes in operation and self-test (docs/h-changes.md)
+    ChecksumError,         ///< `rack`: a checksum error in the cyclic self-test (001 Table 5-6)
+    PsFailure,             ///< F1, `rack`, `half` of its PS 407 10A R; repair: that half replaced
     // Quantum Hot Standby (quantum_plan.hpp): `quantum`, and `rack` where the kind names one.
     QuantumPowerLoss,     ///< the rack's power fails; repair: power back
     QuantumCpuStop,       ///< the rack's CPU stops; repair: started again
@@ -186,6 +189,7 @@ struct PlanFault {
   int h_system = -1;   ///< H faults: index into ScenarioPlan::h_systems (one with a runtime)
   int rack = -1;       ///< H faults: 0 or 1 where the kind names a CPU
   int fibre = -1;      ///< fibre_cut: 0 = upper, 1 = lower
+  int half = -1;       ///< ps_failure: 0 or 1, the PS of the rack's PS 407 10A R pair
   int cp = -1;         ///< cp_failure: the CP's index in `rack`
   std::uint32_t kb = 0;  ///< update_load: KB the next update copies
   HProgramChangeKind change = HProgramChangeKind::Allowed;  ///< program_change

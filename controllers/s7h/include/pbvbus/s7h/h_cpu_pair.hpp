@@ -162,6 +162,7 @@ enum class HReason : std::uint8_t {
   OneSidedOb121,    ///< F17
   MasterSwap,       ///< automatic swap after ERROR-SEARCH or the operator's swap
   UpdateTimeout,    ///< F19/R6: the update exceeded a configured monitoring time
+  ChecksumError,    ///< a checksum error on one CPU in Redundant mode (001 Table 5-6)
 };
 std::string_view to_string(HReason r);
 
@@ -256,6 +257,12 @@ struct UpdateWindow {
 /// F19/R6: the standby retries the link-up this long after an update timeout (>= 1 min).
 inline constexpr bus::Ticks kUpdateRetryDelayTicks = to_ticks(kUpdateRetryDelay);
 
+/// Where a checksum error was found (001 L4023-4065, Table 5-6; docs/h-changes.md).
+enum class HChecksumContext : std::uint8_t {
+  PowerOnTest,  ///< the self-test of the start-up after an unbuffered power-on
+  Cyclic,       ///< the cyclic self-test (STOP, Solo, Redundant; in ERROR-SEARCH: the full test)
+};
+
 class HCpuPair {
  public:
   explicit HCpuPair(HCpuPairParams p = {});
@@ -323,6 +330,15 @@ class HCpuPair {
   /// R7: the result of a data-record SFC started at `now`: W#16#80C3 for SFC 13, 55..59 and
   /// W#16#8085 for SFC 51 while an update runs ([t1, t5)), else 0.
   std::uint16_t record_job_result(int sfc, bus::Ticks now);
+  /// A checksum error found on `rack` (001 Table 5-6, h_cpu_pair_checksum.cpp): PowerOnTest or
+  /// in ERROR-SEARCH -> DEFECTIVE; cyclic in STOP/Solo -> corrected (entry only); cyclic in
+  /// Redundant -> corrected, that CPU ERROR-SEARCH, the partner master in Solo with OB 72
+  /// ChecksumError; a repetition within defective_window -> DEFECTIVE. false (nothing happens)
+  /// on a CPU that is off or DEFECTIVE, or in the 1500 profile.
+  bool checksum_error(int rack, HChecksumContext where, bus::Ticks now);
+  /// An entry from a part built on the pair (h_config_change, h_rack_power, h_dp_startup): the
+  /// deadlines due at `now` run first, then `rack`'s buffer gets `text` with `code`.
+  void log_entry(int rack, bus::Ticks now, std::string text, std::uint16_t code = 0);
 
   bus::Ticks next_deadline() const;
   void on_time(bus::Ticks now);
@@ -384,6 +400,7 @@ class HCpuPair {
     bus::Ticks pending_master = bus::kNever;  ///< alone, remembered standby: master at this time
     bus::Ticks hold_remaining = -1;  ///< STARTUP time left when HOLD was entered, -1: from RUN
     std::optional<bus::Ticks> last_ob121;
+    std::optional<bus::Ticks> last_checksum;  ///< the last checksum error (7-day rule)
     Pending after_update = Pending::None;  ///< what the end of this standby's update does
     bool reset_request = false;            ///< F20/R9: STOP until memory_reset()
     bool retrying = false;                 ///< the pending start is an F19 retry

@@ -202,6 +202,20 @@ class HSystemModel final : public bus::EventTarget {
   bool memory_reset(int rack);                              ///< F20: clears a reset request
   /// F2: HCpuPair::load_memory_error on `rack` (false: bad rack, CPU off or DEFECTIVE).
   bool load_memory_error(int rack);
+  /// A checksum error found by `rack`'s cyclic self-test: HCpuPair::checksum_error(rack,
+  /// Cyclic) (001 Table 5-6; h_system_power.cpp, docs/h-changes.md). false: bad rack, CPU off
+  /// or DEFECTIVE.
+  bool checksum_error(int rack);
+  /// F1 with a PS 407 10A R pair per rack (h_system_power.cpp, docs/h-changes.md): half `half`
+  /// of `rack`'s PS fails. The other half supplies: an entry W#16#3923 on that CPU, nothing
+  /// else (false); none left: power_off(rack) (true). A half already failed: false.
+  bool ps_failure(int rack, int half);
+  /// That half replaced: W#16#3823 if the other half had kept the CPU on, power_on(rack) if
+  /// both had failed (true); false if the half had not failed.
+  bool ps_repair(int rack, int half);
+  /// An entry in `rack`'s buffer at now from a part built on the model (h_dp_startup.hpp's
+  /// W#16#6547); nothing for a bad rack or a CPU that is off.
+  void log_entry(int rack, std::string text, std::uint16_t code = 0);
   /// F18 without a program: exactly the reaction of the program's sync error (the standby's
   /// switch_to_stop: standby STOP, Solo, OB 72 StandbyStop on the master; a "sync error (F18)"
   /// entry in both buffers). false (nothing happens) unless the system is Redundant.
@@ -410,6 +424,7 @@ class HSystemModel final : public bus::EventTarget {
   std::function<void(const HSystemEvent&)> m_handler;
   std::function<void(const HEvent&)> m_pair_handler;
   std::array<std::vector<DiagEntry>, 2> m_io_diag;
+  std::array<std::array<bool, 2>, 2> m_ps_failed{};  ///< [rack][half]: PS 407 10A R half failed
 
   // ---- F4 connections, SSL ----
   // (controllers/s7h/src/h_system_comms.cpp; rules in h_connections.hpp and h_ssl.hpp). The

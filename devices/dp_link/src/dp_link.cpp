@@ -81,6 +81,15 @@ DpLinkBuild DpLink::build(DpLinkOptions o, std::vector<dp::SlaveParams> lower) {
   so.bus_params = o.upper_bus_params;
   so.name = l->m_name;
   so.redundancy = o.redundancy;
+  if (o.switchover > 0) {
+    // The coupler's own switchover time: a commanded switchover crosses the internal link twice
+    // (switchover request, take-over; redundant_slave.hpp), so each crossing takes half of it.
+    redundancy::RedundantSlaveParams& rp = so.redundancy;
+    rp.link_delay = std::max<bus::Ticks>(1, o.switchover / 2);
+    rp.switch_timeout = 2 * rp.link_delay + 10 * bus::kTicksPerMs;
+    rp.supervision = std::max(rp.supervision, rp.heartbeat_period + 2 * rp.link_delay +
+                                                  100 * bus::kTicksPerMs);
+  }
   SwitchedStationBuild sb = SwitchedStationModel::build(*l->m_gsd, l->m_choices, so);
   if (!sb.ok()) {
     r.errors = std::move(sb.errors);

@@ -28,7 +28,12 @@
 //   lower station's position + 1), its return (DataExchangeEntered) as OB 83 W#16#3861; the
 //   link itself stays in data exchange (no OB 86 for the link).
 // - The coupler's switchover time (T_SLAVE_UM) is an option (default 100 ms for the Y-link,
-//   and for the DP/PA link; the IM 157 data sheet is not in the seeds) put into the GSD.
+//   and for the DP/PA link; the IM 157 data sheet is not in the seeds) put into the GSD
+//   (Slave_Max_Switch_Over_Time) and made real: the two IM 157 exchange the switchover over
+//   their internal link (RedundantSlave: request, take-over = 2 x link_delay), so link_delay =
+//   T_SLAVE_UM / 2, switch_timeout = T_SLAVE_UM + 10 ms, supervision >= heartbeat + T_SLAVE_UM +
+//   100 ms. A commanded switchover therefore takes T_SLAVE_UM from the PrmCmd to the new
+//   PRIMARY; an autonomous one (the primary's engine leaves Data_Exch) T_SLAVE_UM / 2.
 
 #include <cstdint>
 #include <memory>

@@ -157,9 +157,9 @@ TEST(YLinkCapture, TheLowerLinePollsOnThroughTheUpperSwitchover) {
   // octets each way: request 9 + 2 = 11 octets x 11 = 121, TSDR <= max TSDR 150 (the line's,
   // PBVB0A01 MaxTsdr_1.5M), response 121, Tid1 = 33 + Tsm 4 = 37: 429; 3 slaves 1287; the
   // token to itself (SD4, 3 octets: 33 + 37) 70: cycle 1357. Margin: one GAP poll (FDL Status
-  // SD1 6 octets 66 + TSL 300 + 37 = 403) and one Global_Control (13 octets 143 + 37 = 180):
-  // 583. Bound 1940 t_bit = 1940 x 2/3 us = 1293.3 us.
-  const std::int64_t bound_ns = 1940 * 2000 / 3;
+  // SD1 6 octets 66 + TSL 300 + 37 = 403) and one Global_Control (13 octets 143 + Tid2 = max
+  // TSDR 150 after an SDN: 293): 696. Bound 2053 t_bit = 2053 x 2/3 us = 1368.7 us.
+  const std::int64_t bound_ns = 2053 * 2000 / 3;
   const std::int64_t from = 900 * kNsPerMs, to = 1300 * kNsPerMs;  // the switchover: 1.0 .. 1.1 s
   std::int64_t gap = 0;
   std::size_t n = 0;

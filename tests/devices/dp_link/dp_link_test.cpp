@@ -235,16 +235,16 @@ TEST(DpLink, UpperSwitchoverLeavesTheLowerLineRunning) {
   //   a DX of 2 octets each way: request SD2 9 + 2 = 11 octets x 11 = 121, TSDR <= max_tsdr
   //   150, response 121, Tid1 = 33 + Tsm 4 = 37 -> 429 per slave, 2 slaves 858;
   //   token to itself (SD4, 3 octets) 33 + Tid 37 = 70 -> cycle 928;
-  //   margin: one GAP poll (FDL Status SD1 6 octets 66 + TSL 300 + Tid 37 = 403) and one
-  //   Global_Control (SD2 with SAPs, 2 data: 13 octets 143 + Tid 37 = 180) = 583.
-  //   Bound 928 + 583 = 1511 t_bit.
+  //   margin: one GAP poll (FDL Status SD1 6 octets 66 + TSL 300 + Tid1 37 = 403) and one
+  //   Global_Control (SD2 with SAPs, 2 data: 13 octets 143 + Tid2 = max TSDR 150 after an SDN:
+  //   293) = 696. Bound 928 + 696 = 1624 t_bit.
   const bus::Ticks tbit = bus::ticks_per_bit(bus::Baud::k1_5M);
-  EXPECT_LE(dx.max_gap(t0, t0 + 600 * kMs), 1511 * tbit);
+  EXPECT_LE(dx.max_gap(t0, t0 + 600 * kMs), 1624 * tbit);
   // ... and the requests were there all along (not a vacuous bound): at least 600 ms / bound.
   const auto n = std::count_if(dx.at.begin(), dx.at.end(), [&](bus::Ticks t) {
     return t >= t0 && t < t0 + 600 * kMs;
   });
-  EXPECT_GE(static_cast<bus::Ticks>(n), 600 * kMs / (1511 * tbit));
+  EXPECT_GE(static_cast<bus::Ticks>(n), 600 * kMs / (1624 * tbit));
   for (const auto& e : r.lower_events)
     EXPECT_NE(e.kind, dp::MasterEvent::Kind::StationFailure) << "at " << e.time;
   // Outputs held across the switchover ("no pulses"): station 3 still has A5 5A.

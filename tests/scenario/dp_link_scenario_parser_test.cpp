@@ -1,6 +1,7 @@
 // y_link / dp_pa_link entries (scenario/dp_link_plan.hpp, docs/dp-link.md): planned as one
 // switched station of their redundant_master_system whose modules are the lower dp_slaves, and
-// the refusals (D5; 001 L8128) as FILE:LINE:COLUMN errors at the field concerned.
+// the refusals (D5; 001 L8128) as FILE:LINE:COLUMN errors at the field concerned. A
+// *_parser_test: the sanitizer builds run it too.
 #include <gtest/gtest.h>
 
 #include <string>

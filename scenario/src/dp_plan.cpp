@@ -8,6 +8,7 @@
 
 #include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/dp/prm.hpp"
+#include "pbvbus/scenario/dp_link_plan.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 
 namespace pbvbus::tools {
@@ -70,6 +71,20 @@ class DpPlanner {
     for (int i = 0; i < proto.dp_slave_size(); ++i) plan_slave(i, base);
     for (int i = 0; i < proto.redundant_master_system_size(); ++i) plan_system(i);
     for (int i = 0; i < proto.switched_station_size(); ++i) plan_switched(i, base);
+    // IM 157 links (dp_link_plan.hpp): each upper interface planned as a switched station's,
+    // from the generated link GSD; errors point at the link entry itself.
+    const DpLocator at_entry = [this](const char* rep, int index, const char*, int) {
+      return m_locate(rep, index, nullptr, -1);
+    };
+    plan_dp_links(m_plan, m_locate, m_errors,
+                  [&](const scenario::DpSlave& d, const devices::GsdFile& g, const char* rep,
+                      int i, int switched, int side) {
+                    DpPlanner sub(m_plan, at_entry, m_errors);
+                    sub.m_wd = m_wd;
+                    const std::size_t before = m_plan.dp_slaves.size();
+                    sub.plan_slave(d, rep, i, base, switched, side, &g);
+                    return m_plan.dp_slaves.size() == before ? -1 : static_cast<int>(before);
+                  });
     derive_line_params();
   }
 
@@ -152,7 +167,8 @@ class DpPlanner {
   /// A dp_slave, or one interface of a switched_station (`rep` = "switched_station", the
   /// synthesised entry `s` carries its line and master); errors point into `rep`[i].
   void plan_slave(const scenario::DpSlave& s, const char* rep, int i,
-                  const std::filesystem::path& base, int switched, int side) {
+                  const std::filesystem::path& base, int switched, int side,
+                  const devices::GsdFile* given = nullptr) {
     m_rep = rep;
     DpSlavePlan sp;
     sp.source = i;
@@ -202,9 +218,10 @@ class DpPlanner {
       return;
     }
     std::filesystem::path p(s.gsd());
-    if (p.is_relative()) p = base / p;
+    if (p.is_relative() && given == nullptr) p = base / p;
     sp.gsd_path = p.string();
-    auto loaded = devices::load_gsd(p);
+    // An IM 157 link's generated GSD comes in `given` (dp_link_plan.hpp).
+    auto loaded = given != nullptr ? devices::GsdParseResult{*given, {}, {}} : devices::load_gsd(p);
     if (!loaded.ok()) {
       std::string why = loaded.errors.empty() ? "cannot be read" : loaded.errors.front().to_string();
       error(m_rep, i, "gsd", -1, "GSD file \"" + s.gsd() + "\": " + why);

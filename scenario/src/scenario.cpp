@@ -379,10 +379,15 @@ class Planner {
     // A switched station sits on both lines of its system, at the place of its entry.
     for (const auto& swp : plan.switched) {
       const auto& rp = plan.redundant_systems[static_cast<std::size_t>(swp.system)];
+      // An IM 157 link (dp_link_plan.hpp) is a switched station at the place of its entry.
+      const bool link = swp.link >= 0;
+      const char* rep = link ? plan.dp_links[static_cast<std::size_t>(swp.link)].repeated
+                             : "switched_station";
       for (int side = 0; side < 2; ++side)
         entries.push_back({StationKind::SwitchedInterface, swp.source,
-                           nested(m_root, sd, "switched_station", swp.source),
-                           plan.lines[static_cast<std::size_t>(rp.line[side])].name, swp.address});
+                           nested(m_root, sd, rep, swp.source),
+                           plan.lines[static_cast<std::size_t>(rp.line[side])].name, swp.address,
+                           link ? scenario::DpLink::descriptor() : nullptr, "system"});
     }
     add_mpi_entries(entries);
     // Cable order = order of appearance in the text. Without text, the order above.

@@ -7,6 +7,7 @@
 
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
+#include "pbvbus/simulation/dp_link_node.hpp"
 #include "pbvbus/simulation/dp_system.hpp"
 #include "pbvbus/scenario/timing_plan.hpp"
 
@@ -77,6 +78,11 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
   // The switched stations.
   for (int k : rp.switched) {
     const SwitchedPlan& swp = plan.switched.at(static_cast<std::size_t>(k));
+    if (swp.link >= 0) {  // an IM 157 link (dp_link_node.hpp)
+      m_links.emplace_back(k, build_dp_link(plan, k, params[0]));
+      m_models.emplace_back(k, &m_links.back().second->upper());
+      continue;
+    }
     const DpSlavePlan& sp = plan.dp_slaves.at(static_cast<std::size_t>(swp.slave[0]));
     devices::SwitchedStationOptions so;
     so.address = swp.address;
@@ -100,6 +106,7 @@ RedundantSystemNode::RedundantSystemNode(const ScenarioPlan& plan, int system,
         [&](std::size_t m, std::size_t off, std::size_t w, devices::IoBehaviour beh) {
           return model.add_channel_behaviour(m, off, w, std::move(beh));
         });
+    m_models.emplace_back(k, b.model.get());
     m_stations.emplace_back(k, std::move(b.model));
   }
 }
@@ -125,13 +132,18 @@ const std::string& RedundantSystemNode::line_name(int side) const {
 }
 
 devices::SwitchedStationModel* RedundantSystemNode::station(int k) {
-  for (auto& [idx, m] : m_stations)
-    if (idx == k) return m.get();
+  for (auto& [idx, m] : m_models)
+    if (idx == k) return m;
   return nullptr;
 }
 const devices::SwitchedStationModel* RedundantSystemNode::station(int k) const {
-  for (const auto& [idx, m] : m_stations)
-    if (idx == k) return m.get();
+  for (const auto& [idx, m] : m_models)
+    if (idx == k) return m;
+  return nullptr;
+}
+devices::DpLink* RedundantSystemNode::link(int k) {
+  for (auto& [idx, l] : m_links)
+    if (idx == k) return l.get();
   return nullptr;
 }
 
@@ -220,7 +232,7 @@ RedundancyReport RedundantSystemNode::report() const {
     r.recognition[side] = m_timing.line[side].recognition;
     r.system_bound[side] = m_timing.system_bound[side];
   }
-  for (const auto& [k, m] : m_stations) {
+  for (const auto& [k, m] : m_models) {
     const SwitchedPlan& swp = m_plan.switched.at(static_cast<std::size_t>(k));
     const DpSlavePlan& sp = m_plan.dp_slaves.at(static_cast<std::size_t>(swp.slave[0]));
     SwitchedStationReport s;
@@ -275,7 +287,7 @@ RedundancyReport RedundantSystemNode::report() const {
       for (const auto& b : m_timing.stations)
         if (b.address == e.station) x.bound = b.bound[failed_line];
     }
-    for (const auto& [k, m] : m_stations) {
+    for (const auto& [k, m] : m_models) {
       if (m->address() != e.station) continue;
       for (const auto& re : m->events())
         if (re.kind == redundancy::RedEvent::Kind::FreshOutputs && re.iface == e.line &&

@@ -271,8 +271,16 @@ void Simulation::build_line(std::size_t li) {
         break;
       }
       case StationKind::SwitchedInterface: {
+        // By address on this line's system: switched_station and y_link/dp_pa_link entries
+        // number their sources apart, the address on a line is unique.
         const auto it = std::find_if(m_plan.switched.begin(), m_plan.switched.end(),
-                                     [&](const SwitchedPlan& w) { return w.source == ps.source; });
+                                     [&](const SwitchedPlan& w) {
+                                       const RedundancyPlan& r = m_plan.redundant_systems.at(
+                                           static_cast<std::size_t>(w.system));
+                                       return w.address == st.address &&
+                                              (r.line[0] == static_cast<int>(li) ||
+                                               r.line[1] == static_cast<int>(li));
+                                     });
         st.switched = static_cast<int>(it - m_plan.switched.begin());
         st.red = m_redundant.at(static_cast<std::size_t>(it->system)).get();
         st.red_side = st.red->line(0) == static_cast<int>(li) ? 0 : 1;
@@ -357,6 +365,12 @@ void Simulation::build_line(std::size_t li) {
     ls->stations.push_back(std::move(st));
   }
   if (extra_here && !extra_done) ls->line->attach(*m_opts.extra_device, m_opts.extra_label);
+  // An IM 157 link's own master on its lower line, after the planned stations (dp_link_node.hpp).
+  if (const int k = link_of_lower_line(m_plan, static_cast<int>(li)); k >= 0) {
+    const DpLinkPlan& lp = m_plan.dp_links[static_cast<std::size_t>(k)];
+    devices::DpLink* l = m_redundant.at(static_cast<std::size_t>(lp.system))->link(lp.switched);
+    if (l != nullptr) l->attach_lower(*ls->line, l->name() + " master " + std::to_string(lp.master));
+  }
   m_lines.push_back(std::move(ls));
 }
 

@@ -107,6 +107,9 @@ struct SwitchedPlan {
   /// T_SLAVE_UM: the scenario's switchover_time, else the GSD's Slave_Max_Switch_Over_Time.
   std::optional<bus::Ticks> t_slave_um;
   bool t_slave_um_from_gsd = false;
+  /// An IM 157 link's upper side (dp_link_plan.hpp): index into ScenarioPlan::dp_links, and
+  /// `source` indexes its y_link / dp_pa_link entry; -1 for a switched_station.
+  int link = -1;
 };
 
 /// A redundant_master_system: two dp_masters (one per line) as one logical master system.

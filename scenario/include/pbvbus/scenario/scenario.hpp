@@ -39,6 +39,7 @@
 
 #include "pbvbus/bus/time.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/scenario/dp_link_plan.hpp"
 #include "pbvbus/scenario/dp_plan.hpp"
 #include "pbvbus/scenario/gateway_plan.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
@@ -229,6 +230,7 @@ struct ScenarioPlan {
   std::vector<GatewayPlan> gateways;   ///< gateway entries, in file order (gateway_plan.hpp)
   S7Plan s7;  ///< s7_cpu, mpi_station, s7_door entries and the H CPUs' MPI interfaces
   std::vector<QuantumPlan> quantum;  ///< quantum_hot_standby entries, valid ones, file order
+  std::vector<DpLinkPlan> dp_links;  ///< y_link, then dp_pa_link entries, valid ones (dp_link_plan.hpp)
 };
 
 struct LoadResult {

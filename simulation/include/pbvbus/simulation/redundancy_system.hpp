@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "pbvbus/bus/line.hpp"
+#include "pbvbus/dp_link/dp_link.hpp"
 #include "pbvbus/switched_io/redundant_master_system.hpp"
 #include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/redundancy/switchover_timing.hpp"
@@ -115,6 +116,8 @@ class RedundantSystemNode {
   /// The model of ScenarioPlan::switched[k], or nullptr if it is not in this system.
   devices::SwitchedStationModel* station(int k);
   const devices::SwitchedStationModel* station(int k) const;
+  /// The IM 157 link of ScenarioPlan::switched[k] (dp_link_node.hpp), or nullptr.
+  devices::DpLink* link(int k);
 
   /// Line indices (ScenarioPlan::lines) of sides A and B.
   int line(int side) const;
@@ -136,6 +139,9 @@ class RedundantSystemNode {
   int m_system;
   std::unique_ptr<devices::RedundantMasterSystemModel> m_model;
   std::vector<std::pair<int, std::unique_ptr<devices::SwitchedStationModel>>> m_stations;
+  std::vector<std::pair<int, std::unique_ptr<devices::DpLink>>> m_links;  ///< IM 157 links
+  /// Every switched station's model (m_stations' and the links' upper sides), plan order.
+  std::vector<std::pair<int, devices::SwitchedStationModel*>> m_models;
   captures::PcapngWriter* m_capture = nullptr;
   redundancy::SwitchoverPlan m_timing;
   scenario::DpMaster::Outputs m_program = scenario::DpMaster::COUNT;

@@ -1,6 +1,7 @@
 // The H-system model: SFC 90 H_CTRL from the user program, the watchdog OBs across an update
 // (R7) and the S7 jobs held by the update. h_system.hpp's block "SFC 90 H_CTRL ..." has the
 // rules, docs/h-sfc90.md the sources.
+#include <algorithm>
 #include <stdexcept>
 #include <vector>
 
@@ -84,6 +85,13 @@ void HSystemModel::wd_fire(std::size_t i, std::uint64_t gen) {
 }
 
 void HSystemModel::sfc90_reconcile(bus::Ticks now) {
+  // OB 72 "redundancy restored" on entering Redundant mode (before the OB 1 due then).
+  const bool red = m_pair.system_mode() == SystemMode::Redundant;
+  if (red && !m_was_redundant) {
+    m_returns.push_back(now);
+    if (m_ob72_return) m_ob72_return(now);
+  }
+  m_was_redundant = red;
   if (m_pair.interrupts_held()) return;
   // The update ended (t5 or the abort): at most one request per watchdog OB that lost any,
   // its cycle restarting from here (the clock was stopped: synchronism lost).
@@ -109,6 +117,24 @@ void HSystemModel::sfc90_reconcile(bus::Ticks now) {
     for (auto& [id, sink] : m_sinks)
       if (id == j.id && sink) sink(std::move(answer));
   }
+}
+
+// ---- SFC 27 UPDAT_PO ----------------------------------------------------------------------
+
+std::uint16_t HSystemModel::updat_po(int part) {
+  if (part < 1 || part > 15) return 0x8090;  // PART outside the CPU's partitions
+  for (std::size_t k = 0; k < m_racks.size(); ++k) {
+    if (!rack_reachable(k)) continue;
+    const HExpansionRack& cfg = m_rack_cfg[k];
+    for (std::size_t m = 0; m < cfg.modules.size(); ++m) {
+      if (cfg.modules[m].partition != part) continue;
+      const HIoEntry* e = m_map.find_central(cfg.number, m);
+      if (e == nullptr || e->out_len == 0 || e->out_addr + e->out_len > m_piq.size()) continue;
+      const auto from = m_piq.begin() + static_cast<std::ptrdiff_t>(e->out_addr);
+      std::copy(from, from + static_cast<std::ptrdiff_t>(e->out_len), m_racks[k].out[m].begin());
+    }
+  }
+  return 0;
 }
 
 // ---- held S7 jobs --------------------------------------------------------------------------

@@ -290,5 +290,86 @@ TEST(HSfc90Cam, HeldJobOfAClosedSessionIsDropped) {
   EXPECT_EQ(c.h->held_s7_jobs(), 0u);
 }
 
+// ---- OB 72 on the return to Redundant, SFC 27 UPDAT_PO (000 L1752, L1886; 001 L5526) ----
+//
+// Rack 2 hangs on CPU 1 (the standby): one-sided outputs of the standby. Module 0 "DO part 1" is
+// in process-image partition 1 (written only by SFC 27), module 1 "DO OB 1" in the OB 1 image.
+// OB 1 writes 0x11 into both until 5 s, then 0x22, and calls SFC 27 for partition 1 only when
+// the value changes (event-driven). Times: Redundant at 3.145 s; the standby STOPs at 4 s;
+// the value changes at 5 s (rack 2 unreachable: its CPU does not run); STOP -> RUN at 6 s:
+// LINK-UP 6 .. 8 s, UPDATE 8 .. 8.145 s, Redundant at 8.145 s.
+struct OneSided {
+  bus::Scheduler sched;
+  std::unique_ptr<HSystemModel> h;
+  std::uint8_t written = 0;
+  explicit OneSided(bool sfc27_in_ob72) {
+    HRackModule part;
+    part.name = "DO part 1";
+    part.out_len = 1;
+    part.partition = 1;
+    HRackModule ob1;
+    ob1.name = "DO OB 1";
+    ob1.out_len = 1;
+    HExpansionRack r;
+    r.number = 2;
+    r.side = 1;
+    r.modules = {part, ob1};
+    h = std::make_unique<HSystemModel>(sched, HCpuPairParams{},
+                                       std::vector<RedundantMasterSystemModel*>{},
+                                       std::vector<HExpansionRack>{r});
+    h->set_program(
+        [this](std::span<const std::uint8_t>, std::span<std::uint8_t> piq, Ticks now) {
+          const std::uint8_t v = now < ms(5000) ? 0x11 : 0x22;
+          piq[0] = v;
+          piq[1] = v;
+          if (v != written) {
+            written = v;
+            h->updat_po(1);
+          }
+        },
+        kScan);
+    if (sfc27_in_ob72) h->set_ob72_return([this](Ticks) { h->updat_po(1); });
+  }
+  std::uint8_t part() const { return h->rack_outputs(2, 0)[0]; }
+  std::uint8_t ob1() const { return h->rack_outputs(2, 1)[0]; }
+  void run() {
+    h->power_on_both();
+    sched.run_until(ms(3200));
+  }
+};
+
+TEST(HSfc90Cam, Ob72WithoutSfc27TheStandbysPartitionOutputsKeepStaleValues) {
+  OneSided o(false);
+  o.run();
+  EXPECT_EQ(o.h->redundancy_returns(), std::vector<Ticks>{kT5});
+  EXPECT_EQ(o.ob1(), 0x11);   // the OB 1 image reaches the standby's modules
+  EXPECT_EQ(o.part(), 0x00);  // SFC 27 ran at 1.000 s, when rack 2 was not reachable
+  o.sched.run_until(ms(4000));
+  o.h->switch_to_stop(1);  // Solo from 4 s
+  o.sched.run_until(ms(6000));
+  o.h->switch_to_run(1);
+  o.sched.run_until(ms(8200));
+  EXPECT_EQ(o.ob1(), 0x22);
+  EXPECT_EQ(o.part(), 0x00);  // stale: the change at 5 s was sent while rack 2 was unreachable
+  EXPECT_EQ(o.h->updat_po(0), 0x8090);
+  EXPECT_EQ(o.h->updat_po(16), 0x8090);
+}
+
+TEST(HSfc90Cam, Ob72WithSfc27RefreshesTheStandbysPartitionOutputs) {
+  OneSided o(true);
+  o.run();
+  EXPECT_EQ(o.part(), 0x11);  // OB 72 at 3.145 s called SFC 27
+  o.sched.run_until(ms(4000));
+  o.h->switch_to_stop(1);  // Solo from 4 s; 0x22 from 5 s is not sent to rack 2
+  o.sched.run_until(ms(6000));
+  EXPECT_EQ(o.part(), 0x11);
+  o.h->switch_to_run(1);
+  o.sched.run_until(ms(8145) - 1);
+  EXPECT_EQ(o.part(), 0x11);
+  o.sched.run_until(ms(8145));
+  EXPECT_EQ(o.part(), 0x22);  // at the return to Redundant, 8.145 s
+  EXPECT_EQ(o.h->redundancy_returns(), (std::vector<Ticks>{kT5, ms(8145)}));
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

@@ -619,6 +619,13 @@ class HSystemModel final : public bus::EventTarget {
   const std::vector<WatchdogRun>& watchdog_runs() const { return m_wd_runs; }
   /// S7 jobs stored now (from t1 to t5 of an update), not yet answered.
   std::size_t held_s7_jobs() const { return m_held_jobs.size(); }
+  /// SFC 27 UPDAT_PO: the PIQ bytes of the expansion-rack modules of partition `part` (1..15)
+  /// go to the reachable modules now. RET_VAL 0, or W#16#8090 for a PART outside 1..15.
+  std::uint16_t updat_po(int part);
+  /// OB 72 "redundancy restored", run on entering Redundant mode (000 L1752: the program must
+  /// refresh its output partitions there with SFC 27); the times it ran.
+  void set_ob72_return(std::function<void(bus::Ticks)> body) { m_ob72_return = std::move(body); }
+  const std::vector<bus::Ticks>& redundancy_returns() const { return m_returns; }
 
  private:
   friend class HS7Session;
@@ -652,6 +659,9 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<WatchdogRun> m_wd_runs;
   std::vector<HeldJob> m_held_jobs;
   std::vector<std::pair<std::uint32_t, std::function<void(std::vector<std::uint8_t>)>>> m_sinks;
+  std::function<void(bus::Ticks)> m_ob72_return;
+  std::vector<bus::Ticks> m_returns;
+  bool m_was_redundant = false;
   // ---- end SFC 90 ----
 };
 

@@ -95,6 +95,10 @@ using ProgramError = std::function<void(std::vector<HPathStep> path, std::string
 /// period > 0, ...). Errors go to `error`.
 void plan_program_spec(const scenario::HProgram& program, devices::ProgramSpec& spec,
                        const ProgramError& error);
+/// The program's SFC 90 calls (`h_ctrl`) into spec.h_ctrl_calls; a MODE/SUBMODE that SFC 90
+/// would refuse (W#16#8090/8091) or a bad time is an error (h_plan_sfc90.cpp).
+void plan_h_ctrl_calls(const scenario::HProgram& program, devices::ProgramSpec& spec,
+                       const ProgramError& error);
 
 struct ScenarioPlan;
 /// Plans the h_system entries (after plan_dp: they refer to redundant_master_systems).

@@ -533,6 +533,7 @@ void plan_program_spec(const scenario::HProgram& pr, devices::ProgramSpec& spec,
         d.discrepancy_time = *t;
     spec.monitors.push_back(d);
   }
+  plan_h_ctrl_calls(pr, spec, error_at);  // SFC 90 (h_plan_sfc90.cpp)
 }
 
 }  // namespace pbvbus::tools

@@ -15,7 +15,8 @@ namespace pbvbus::tools {
 namespace {
 
 bool has_networks(const devices::ProgramSpec& p) {
-  return !p.copies.empty() || !p.counters.empty() || !p.monitors.empty();
+  return !p.copies.empty() || !p.counters.empty() || !p.monitors.empty() ||
+         !p.h_ctrl_calls.empty();  // SFC 90 calls alone are a program too (docs/h-sfc90.md)
 }
 
 devices::HChange to_change(HProgramChangeKind k) {

@@ -92,6 +92,44 @@ TEST(HScenarioParser, CpuPartAndProgramArePlanned) {
   EXPECT_EQ(p.monitors[0].discrepancy_time, 2 * kTicksPerSecond);
 }
 
+TEST(HScenarioParser, Sfc90CallsArePlannedAndBadModesRefused) {
+  // docs/h-sfc90.md: MODE 3 (disable update) at 0 s, MODE 4 (re-enable) at 3.15 s.
+  const auto r = parse_scenario(R"(duration: "10s"
+h_system {
+  name: "H"
+  cpu { }
+  program {
+    h_ctrl { at: "0s" mode: 3 }
+    h_ctrl { at: "3.15s" mode: 4 submode: 0 }
+    h_ctrl { at: "4s" mode: 12 submode: 255 }
+  }
+}
+)", "h.textproto");
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  const auto& c = r.plan->h_systems[0].runtime->program.h_ctrl_calls;
+  ASSERT_EQ(c.size(), 3u);
+  EXPECT_EQ(c[0].at, bus::Ticks{0});
+  EXPECT_EQ(c[0].mode, 3);
+  EXPECT_EQ(c[1].at, 3150 * kTicksPerMs);
+  EXPECT_EQ(c[1].mode, 4);
+  EXPECT_EQ(c[2].submode, 255);
+  EXPECT_EQ(errors_of(R"(duration: "10s"
+h_system {
+  name: "H"
+  cpu { }
+  program {
+    h_ctrl { at: "soon" mode: 2 }
+    h_ctrl { mode: 3 submode: 1 }
+  }
+}
+)"),
+            (std::vector<std::string>{
+                "h.textproto:6:14: bad duration \"soon\" for at (e.g. \"3s\")",
+                "h.textproto:6:25: SFC 90: MODE 2 is not 0, 1, 3, 4, 10, 11 or 12 (W#16#8090)",
+                "h.textproto:7:22: SFC 90: SUBMODE 1 is not valid for MODE 3 (W#16#8091)",
+            }));
+}
+
 TEST(HScenarioParser, AnEmptyCpuPartTakesThePairsDefaults) {
   const auto r = parse_scenario("h_system { name: \"H\" cpu { cpu1 { power_on: \"off\" } } }\n", "h.textproto");
   ASSERT_TRUE(r.ok()) << r.errors[0].str();

@@ -428,6 +428,7 @@ void HCpuPair::set_state(int r, CpuState s, bus::Ticks now, std::string_view why
   if (c.state == s) return;
   // The standby leaves UPDATE: the update window ends (Redundant/swap, or aborted).
   if (c.state == CpuState::Update) close_window(now, s != CpuState::Run, false);
+  if (c.state == CpuState::LinkUp) c.update_waiting = false;  // SFC 90 wait ends with LINK-UP
   HEvent e;
   e.kind = HEvent::Kind::State;
   e.at = now;
@@ -532,7 +533,13 @@ void HCpuPair::expire(int r, bus::Ticks now) {
       set_state(r, CpuState::Run, now, "startup done");
       break;
     case CpuState::LinkUp:
-      begin_update(r, now);
+      if (m_update_disabled) {  // SFC 90 MODE 3: wait in LINK-UP until MODE 4
+        c.update_waiting = true;
+        diag(r, now, "link-up done: update disabled (SFC 90), waiting");
+        diag(p, now, "link-up done: update disabled (SFC 90), waiting");
+      } else {
+        begin_update(r, now);
+      }
       break;
     case CpuState::Update:
       if (m_update_abort_at <= now)
@@ -550,9 +557,13 @@ void HCpuPair::expire(int r, bus::Ticks now) {
         diag(r, now, "self-test: no fault found");
         if (c.switch_run && c.role == CpuRole::Standby && linked(r) &&
             m_cpu[p].role == CpuRole::Master && m_cpu[p].state == CpuState::Run &&
-            mode_of_master(p) == SystemMode::Solo)
+            mode_of_master(p) == SystemMode::Solo && !m_link_up_disabled)
           begin_link_up(r, now, Pending::Relink);
-        else
+        else if (c.switch_run && c.role == CpuRole::Standby && m_link_up_disabled) {
+          // SFC 90 MODE 0: STOP with the start request kept; MODE 1 links up (no swap then).
+          stop_cpu(r, now, "self-test done, link-up disabled (SFC 90)");
+          c.want_run = true;
+        } else
           stop_cpu(r, now, "self-test done, no link-up possible");
       }
       break;
@@ -586,6 +597,11 @@ void HCpuPair::evaluate(bus::Ticks now) {
         diag(r, now, "link-up not possible: master CPU in HOLD");
         diag(p, now, "link-up request of the standby CPU refused: HOLD");
       } else if (q.state == CpuState::Run && mode_of_master(p) == SystemMode::Solo) {
+        if (m_link_up_disabled) {  // SFC 90 MODE 0: the request waits for MODE 1
+          if (!c.link_up_waits) diag(r, now, "link-up request waits: link-up disabled (SFC 90)");
+          c.link_up_waits = true;
+          continue;
+        }
         begin_link_up(r, now, Pending::None);
       }
     }
@@ -640,6 +656,7 @@ void HCpuPair::begin_link_up(int s, bus::Ticks now, Pending after) {
   Cpu& c = m_cpu[s];
   const int m = partner(s);
   c.want_run = false;
+  c.link_up_waits = false;
   c.after_update = after;
   // F19: an automatic retry continues the series, any other start begins a new one.
   if (!c.retrying) m_tries = 0;
@@ -852,6 +869,7 @@ void HCpuPair::cut_fibre(int f, bus::Ticks now) {
   run_due(now);
   if (!m_fibre_ok[f]) return;
   const bool was = link_whole() && powered(0) && powered(1);
+  const bool second = !link_whole() && powered(0) && powered(1);
   m_fibre_ok[f] = false;
   for (int r = 0; r < 2; ++r)
     if (powered(r))
@@ -870,6 +888,8 @@ void HCpuPair::cut_fibre(int f, bus::Ticks now) {
         abort_link_up(s, now, "link-up aborted: redundant link lost");
       }
     }
+  } else if (second) {
+    second_link_lost(now);  // F5, second part: h_cpu_pair_sfc90.cpp
   }
   after_step(now);
 }
@@ -1046,6 +1066,11 @@ bool HCpuPair::request_master_swap(bus::Ticks now) {
   if (!linked(m) || m_cpu[s].role != CpuRole::Standby || m_cpu[s].state != CpuState::Stop)
     return false;
   diag(m, now, "PG/ES: switch to CPU with modified configuration");
+  if (m_link_up_disabled) {  // SFC 90 MODE 0: the swap is a link-up
+    diag(m, now, "master swap refused: link-up disabled (SFC 90)");
+    after_step(now);
+    return false;
+  }
   if (m_param_change) {  // F23: no swap, the standby stays in STOP
     const std::string t = "master swap refused: a parameter that may not change was changed";
     diag(m, now, t, 0x5966);

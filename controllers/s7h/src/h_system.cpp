@@ -164,6 +164,7 @@ void HSystemModel::reconcile() {
   }
   track_update(m_sched.now());
   deliver_held(m_sched.now());
+  sfc90_reconcile(m_sched.now());  // watchdog OBs and S7 jobs held by the update
   if (has_program() && !m_scan_armed && program_runs() && !m_pair.io_frozen())
     arm_scan(m_sched.now());
   comms_update(m_sched.now());  // F4 connections, SSL: h_system_comms.cpp
@@ -278,6 +279,12 @@ void HSystemModel::scan(bus::Ticks now) {
       m_measures.back().first_scan_after == bus::kNever)
     m_measures.back().first_scan_after = now;
   m_last_scan = now;
+  m_in_scan = true;  // SFC 90 from OB 1: its effect on the pair after this OB 1
+  run_program_h_ctrl(now);
+  struct ScanEnd {
+    HSystemModel* m;
+    ~ScanEnd() { m->after_scan_h_ctrl(); }
+  } scan_end{this};
   check_process_image(now);
   read_racks(now);  // F8: the expansion racks' OB 85 and inputs (h_system_racks.cpp)
   if (m_exec) {

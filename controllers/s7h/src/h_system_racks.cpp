@@ -249,6 +249,7 @@ void HSystemModel::write_racks(std::span<const std::uint8_t> piq0,
     RackState& st = m_racks[k];
     const HExpansionRack& cfg = m_rack_cfg[k];
     for (std::size_t m = 0; m < cfg.modules.size(); ++m) {
+      if (cfg.modules[m].partition != 0) continue;  // SFC 27 writes it (h_system_sfc90.cpp)
       const HIoEntry* e = m_map.find_central(cfg.number, m);
       const std::span<const std::uint8_t> piq = cfg.side == 0 ? piq0 : piq1;
       if (e == nullptr || e->out_len == 0 || e->out_addr + e->out_len > piq.size()) continue;

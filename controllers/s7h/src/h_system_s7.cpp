@@ -372,6 +372,7 @@ std::vector<std::uint8_t> HSystemModel::s7_handle(std::uint32_t id,
   if (s == nullptr) return {};
   s7_check(*s);
   if (s->reason != S7CloseReason::None) return {};
+  if (s7_hold(id, pdu)) return {};  // stored during the update (h_system_sfc90.cpp)
   if (s->route == S7Route::Routing) return s->device(pdu);
   const int r = s7_answering(*s);
   if (r < 0) {

@@ -107,6 +107,10 @@ using ProgramError = std::function<void(std::vector<HPathStep> path, std::string
 /// period > 0, ...). Errors go to `error`.
 void plan_program_spec(const scenario::HProgram& program, devices::ProgramSpec& spec,
                        const ProgramError& error);
+/// The program's SFC 90 calls (`h_ctrl`) into spec.h_ctrl_calls; a MODE/SUBMODE that SFC 90
+/// would refuse (W#16#8090/8091) or a bad time is an error (h_plan_sfc90.cpp).
+void plan_h_ctrl_calls(const scenario::HProgram& program, devices::ProgramSpec& spec,
+                       const ProgramError& error);
 
 struct ScenarioPlan;
 /// h_system[i].redundant_io -> rt.redundant_io (h_redundant_io_plan.cpp): each module a station

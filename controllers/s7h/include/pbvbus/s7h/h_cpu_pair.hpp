@@ -340,6 +340,19 @@ class HCpuPair {
   /// deadlines due at `now` run first, then `rack`'s buffer gets `text` with `code`.
   void log_entry(int rack, bus::Ticks now, std::string text, std::uint16_t code = 0);
 
+  // ---- SFC 90 H_CTRL blocks (h_sfc90.hpp decodes the SFC; docs/h-sfc90.md) ----
+  /// MODE 0/1. Disabled: a standby's start request (switch, power-on, F19 retry, the re-link
+  /// after ERROR-SEARCH) waits in STOP and links up when re-enabled; an operator master swap is
+  /// refused; a running link-up/update goes on. false: it already was so.
+  bool set_link_up_enabled(bool on, bus::Ticks now);
+  /// MODE 3/4. Disabled: a standby whose link-up is done waits in LINK-UP (system mode Link-up,
+  /// no t1 yet) and enters UPDATE at the re-enable; a running update goes on. false: no change.
+  bool set_update_enabled(bool on, bus::Ticks now);
+  bool link_up_enabled() const { return !m_link_up_disabled; }
+  bool update_enabled() const { return !m_update_disabled; }
+  /// A standby has done its link-up and waits for the update to be re-enabled.
+  bool update_waiting() const { return m_cpu[0].update_waiting || m_cpu[1].update_waiting; }
+
   bus::Ticks next_deadline() const;
   void on_time(bus::Ticks now);
 
@@ -408,6 +421,8 @@ class HCpuPair {
     bus::Ticks retry_at = bus::kNever;  ///< F19: the standby's own link-up retry
     int connections = 0;                ///< R8: open S7 connections
     std::uint64_t connection_epoch = 0;  ///< bumped when all of them are broken
+    bool update_waiting = false;         ///< SFC 90: link-up done, update disabled
+    bool link_up_waits = false;          ///< SFC 90: a start request waits (logged once)
     std::deque<DiagEntry> diag;
   };
 
@@ -445,6 +460,7 @@ class HCpuPair {
   void output_hold_begins(bus::Ticks now);
   void retry_due(int r, bus::Ticks now);
   void set_reset_request(int r, bus::Ticks now);
+  void second_link_lost(bus::Ticks now);  ///< F5: the other fibre failed earlier
 
   HCpuPairParams m_p;
   bus::Ticks m_now = 0;  ///< the latest time seen (queries without a time use it)
@@ -455,6 +471,8 @@ class HCpuPair {
   bus::Ticks m_phase_at = bus::kNever;         ///< t4 while it lies ahead
   int m_tries = 0;
   bool m_param_change = false;
+  bool m_link_up_disabled = false;  ///< SFC 90 MODE 0
+  bool m_update_disabled = false;   ///< SFC 90 MODE 3
   std::array<Cpu, 2> m_cpu;
   std::array<bool, 2> m_fibre_ok{true, true};
   bus::Ticks m_search_redundant_at = bus::kNever;  ///< Redundant reached after ERROR-SEARCH

@@ -39,6 +39,9 @@ struct HRackModule {
   /// What the inputs show (Constant, Counter: n = the rack's reads so far, Ramp, Table, Echo of
   /// this rack's module `source_module`, default this module's outputs).
   IoBehaviour inputs;
+  /// Outputs in a process-image partition 1..15 (docs/h-sfc90.md "OB 72 and SFC 27"): not
+  /// written after OB 1, only by SFC 27 UPDAT_PO of that partition; 0 = the OB 1 image.
+  int partition = 0;
 };
 
 /// An expansion rack on one side of the H-system (IM 460 in CPU `side`'s central rack).

@@ -66,11 +66,21 @@ struct DiscrepancyNetwork {
   bus::Ticks discrepancy_time = 10 * bus::kTicksPerMs;
 };
 
+/// SFC 90 H_CTRL called by OB 1 (h_sfc90.hpp): at the first OB 1 at or after `at` (virtual
+/// time), once. The H-system model executes it (HSystemModel::h_ctrl); RedundantExecution
+/// ignores it.
+struct HCtrlCall {
+  bus::Ticks at = 0;
+  std::uint8_t mode = 0;
+  std::uint8_t submode = 0;
+};
+
 struct ProgramSpec {
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;  ///< OB 1 cycle (start to start)
   std::vector<CopyNetwork> copies;
   std::vector<CounterNetwork> counters;
   std::vector<DiscrepancyNetwork> monitors;
+  std::vector<HCtrlCall> h_ctrl_calls;  ///< SFC 90 calls (docs/h-sfc90.md)
 };
 
 }  // namespace pbvbus::devices

@@ -74,6 +74,10 @@ class HS7Session {
   /// The CPU answering now (-1 for a routing session or a closed one).
   int answering_rack() const;
   S7Route route() const;
+  /// The owner takes answers that come later: a job arriving during an update (t1..t5) is
+  /// stored, handle() answers nothing, and the answer goes to `sink` when the update ends (000
+  /// L1673-1680; docs/h-sfc90.md). Without a sink every job is answered at once.
+  void on_late_answer(std::function<void(std::vector<std::uint8_t>)> sink);
   /// Closes it (Closed) and releases the connection; idempotent.
   void close();
   std::uint32_t id() const { return m_id; }

@@ -106,6 +106,7 @@
 #include "pbvbus/s7h/h_redundant_io.hpp"
 #include "pbvbus/s7h/h_s7_memory.hpp"
 #include "pbvbus/s7h/h_s7_session.hpp"
+#include "pbvbus/s7h/h_sfc90.hpp"
 #include "pbvbus/s7h/h_ssl.hpp"
 #include "pbvbus/s7h/h_system_records.hpp"
 #include "pbvbus/s7h/h_update_measure.hpp"
@@ -636,6 +637,86 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<std::uint8_t> m_red_io_out;
   std::size_t m_red_io_seen = 0;  ///< RedundantIo events already in events()
   // ---- end redundant I/O ----
+
+  // ---- SFC 90 H_CTRL, watchdog OBs during the update (R7), held S7 jobs ----
+  // Code: h_system_sfc90.cpp; rules and sources: docs/h-sfc90.md.
+  // - h_ctrl(MODE, SUBMODE) is SFC 90 called by the user program (h_sfc90.hpp has the table
+  //   and RET_VAL). From inside an OB 1 (the hook, or a ProgramSpec's h_ctrl_calls at the first
+  //   OB 1 at/after their time) its effect on the pair (the update starting at MODE 4) takes
+  //   place when that OB 1 ends, at the same instant (the update delays OB 1, step 3).
+  // - Watchdog OBs 30..38 (set_watchdog_ob): requested every period from their configuration
+  //   while the program runs; from t1 to t5 of an update no request is made (000 L1177 step 3);
+  //   at t5 (or the abort) each OB that lost at least one request runs exactly once ("a maximum
+  //   of one request ... for each watchdog interrupt OB", 000 L1179) and its cycle restarts from
+  //   there (equidistance lost, 000 L1198-1201); an OB that lost none keeps its phase.
+  // - S7 jobs of a session with a late-answer sink (HS7Session::on_late_answer) arriving from
+  //   t1 to t5 are stored (handle() answers nothing) and answered in arrival order at t5 or the
+  //   abort through the sink (000 L1673-1680). Sessions without a sink are answered at once.
+ public:
+  std::uint16_t h_ctrl(std::uint8_t mode, std::uint8_t submode);
+  const HSelfTestControl& self_test() const { return m_self_test; }
+  struct HCtrlRecord {
+    bus::Ticks at = 0;
+    std::uint8_t mode = 0, submode = 0;
+    std::uint16_t ret_val = 0;
+  };
+  const std::vector<HCtrlRecord>& h_ctrl_calls() const { return m_hctrl_calls; }
+
+  struct WatchdogRun {
+    int ob = 0;
+    bus::Ticks at = 0;
+    bool after_update = false;  ///< the single delayed request at the end of an update
+  };
+  /// OB 30..38 every `period` (> 0) from now; `body` runs at each execution. A second call for
+  /// the same OB replaces it. Throws std::invalid_argument for another OB or period <= 0.
+  void set_watchdog_ob(int ob, bus::Ticks period, std::function<void(bus::Ticks)> body = {});
+  const std::vector<WatchdogRun>& watchdog_runs() const { return m_wd_runs; }
+  /// S7 jobs stored now (from t1 to t5 of an update), not yet answered.
+  std::size_t held_s7_jobs() const { return m_held_jobs.size(); }
+  /// SFC 27 UPDAT_PO: the PIQ bytes of the expansion-rack modules of partition `part` (1..15)
+  /// go to the reachable modules now. RET_VAL 0, or W#16#8090 for a PART outside 1..15.
+  std::uint16_t updat_po(int part);
+  /// OB 72 "redundancy restored", run on entering Redundant mode (000 L1752: the program must
+  /// refresh its output partitions there with SFC 27); the times it ran.
+  void set_ob72_return(std::function<void(bus::Ticks)> body) { m_ob72_return = std::move(body); }
+  const std::vector<bus::Ticks>& redundancy_returns() const { return m_returns; }
+
+ private:
+  friend class HS7Session;
+  struct WatchdogOb {
+    int ob = 0;
+    bus::Ticks period = 0;
+    std::function<void(bus::Ticks)> body;
+    bus::Ticks next = 0;
+    bool lost = false;  ///< a request fell into the update
+    std::uint64_t gen = 0;
+  };
+  struct HeldJob {
+    std::uint32_t id = 0;
+    std::vector<std::uint8_t> pdu;
+  };
+  void sfc90_reconcile(bus::Ticks now);  ///< from reconcile(): the update's end
+  void wd_arm(std::size_t i);
+  void wd_fire(std::size_t i, std::uint64_t gen);
+  void wd_run(WatchdogOb& w, bus::Ticks now, bool after_update);
+  void run_program_h_ctrl(bus::Ticks now);  ///< a ProgramSpec's h_ctrl_calls due at this OB 1
+  void after_scan_h_ctrl();
+  bool s7_hold(std::uint32_t id, std::span<const std::uint8_t> pdu);
+  void s7_set_sink(std::uint32_t id, std::function<void(std::vector<std::uint8_t>)> sink);
+  HSelfTestControl m_self_test;
+  std::vector<HCtrlRecord> m_hctrl_calls;
+  bool m_in_scan = false;
+  bool m_hctrl_after_scan = false;
+  const ProgramSpec* m_hctrl_spec = nullptr;
+  std::vector<bool> m_hctrl_done;
+  std::vector<WatchdogOb> m_wd;
+  std::vector<WatchdogRun> m_wd_runs;
+  std::vector<HeldJob> m_held_jobs;
+  std::vector<std::pair<std::uint32_t, std::function<void(std::vector<std::uint8_t>)>>> m_sinks;
+  std::function<void(bus::Ticks)> m_ob72_return;
+  std::vector<bus::Ticks> m_returns;
+  bool m_was_redundant = false;
+  // ---- end SFC 90 ----
 };
 
 }  // namespace pbvbus::devices

@@ -183,6 +183,17 @@ struct HCampaignOptions {
   /// 10: the standby gives up and the repair is a manual RUN). Each failure costs 60 s + 2.2 s
   /// of virtual time (the retry delay), hence the small default.
   int update_timeout_failures_max = 2;
+  /// The IM's own switchover time (seeds-digest §2 S5, 000 L1832; docs/h-campaign.md "With the
+  /// IM's own switchover time"): each switched station's RedundantSlave gets its GSD's T_SLAVE_UM
+  /// (Slave_Max_Switch_Over_Time: PBVB0A10 30 ms, PBVB0A11 820 ms) as im_switchover_bound and
+  /// im_seed = seed x FNV prime + address; every switchover then takes a drawn time in
+  /// [T_SLAVE_UM / 2, T_SLAVE_UM]. false: the link steps only (~2 ms), as before S5.
+  bool im_time = true;
+  /// The PrmCmd Output_Hold_Time the redundant master system sends (10 ms units). Set as a
+  /// commissioning engineer would: >= the planner's worst switchover bound (recognition + T_DP_UM
+  /// + T_SLAVE_UM, ~831 ms for PBVB0A11), so the outputs are held through the slowest IM's
+  /// switchover; the S7 default 1 s does. Shorter: the outputs go to 0 at its expiry (pulses).
+  std::uint16_t output_hold_time = 100;
   /// Keep the step log and a copy of HSystemModel::events() in the result (tests).
   bool keep_log = false;
   HCampaignTamper tamper;
@@ -223,6 +234,19 @@ struct HCampaignResult {
   std::uint64_t split_frames = 0;          ///< frames while two masters drove (F6 only)
   std::uint64_t second_master_frames = 0;  ///< frames with two drivers outside F6 (must be 0)
   std::uint64_t stray_dx = 0;              ///< DX on a side that should not run (must be 0)
+  /// The IMs' switchovers (RedundantSlave::im_switchovers(), HCampaignOptions::im_time): each
+  /// must end (PRIMARY) no earlier than trigger + its drawn IM time (else early) and within the
+  /// planner's bound from the fault that caused it (recognition + T_DP_UM + T_SLAVE_UM,
+  /// redundancy::plan_switchover; else late). Both are mismatches.
+  std::uint64_t im_switchovers = 0;
+  int late_switchovers = 0;
+  int early_switchovers = 0;
+  bus::Ticks max_im_switchover = 0;  ///< longest trigger -> PRIMARY
+  bus::Ticks max_im_drawn = 0;       ///< longest drawn IM time
+  bus::Ticks max_fault_switchover = 0;  ///< longest fault -> PRIMARY
+  /// Frames during an IM switchover (trigger + link delay .. PRIMARY): the backplane outputs
+  /// must stay frozen (a change is a pulse).
+  std::uint64_t frozen_samples = 0;
   std::vector<std::string> mismatches;
   bus::Ticks max_settle = 0;  ///< longest repair -> Redundant + data exchange
   bus::Ticks simulated = 0;

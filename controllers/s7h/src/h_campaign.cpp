@@ -443,6 +443,7 @@ void HCampaignRun::build() {
       p.max_diag_len = m_sw[k].model->config().max_diag_len;
       p.switched = true;
       p.t_slave_um = m_o.im_time ? m_sw[k].model->t_slave_um() : std::nullopt;
+      if (m_o.tamper.planned_t_slave_um >= 0) p.t_slave_um = m_o.tamper.planned_t_slave_um;
       ps.push_back(p);
     }
     for (int l = 0; l < 2; ++l) {

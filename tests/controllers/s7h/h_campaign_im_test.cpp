@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -88,6 +89,24 @@ TEST(HCampaignIm, ObserverCatchesAnOutputHoldShorterThanTheImTime) {
   const HCampaignResult r = run_h_campaign(o);
   print(r);
   EXPECT_GT(r.pulses, 0u);
+}
+
+// The observer can fail: its planner told T_SLAVE_UM = 0 (the IMs still draw from their GSDs'
+// 30 / 820 ms), every switchover whose IM time exceeds the remaining bound (recognition +
+// T_DP_UM + the 10 ms switch timeout) is late - the slow station's (>= 410 ms) always.
+TEST(HCampaignIm, ObserverCatchesASwitchoverBeyondThePlannersBound) {
+  HCampaignOptions o = base(3, 6);
+  o.weights = {};
+  o.weights[static_cast<int>(HFault::ShortCircuit)] = 1;
+  o.tamper.planned_t_slave_um = 0;
+  const HCampaignResult r = run_h_campaign(o);
+  print(r);
+  EXPECT_GT(r.late_switchovers, 0);
+  EXPECT_EQ(r.early_switchovers, 0);
+  EXPECT_TRUE(std::any_of(r.mismatches.begin(), r.mismatches.end(), [](const std::string& m) {
+    return m.find("station 21 switchover") != std::string::npos &&
+           m.find(" late: ") != std::string::npos;
+  }));
 }
 
 // The documented figures (docs/h-campaign.md "With the IM's own switchover time"), not a CI

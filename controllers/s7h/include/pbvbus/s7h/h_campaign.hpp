@@ -153,6 +153,9 @@ struct HCampaignTamper {
   /// At this cycle (0-based): the changed DBs are set to update_timeout_kb before the drawn
   /// cycle and back after it, the observer not told: its restart's update times out (-1: never).
   int hidden_update_timeout_at = -1;
+  /// >= 0: the observer's planner is given this T_SLAVE_UM for both switched stations instead
+  /// of their GSDs' (the IMs still draw from the GSDs'): their switchovers exceed its bound, late.
+  bus::Ticks planned_t_slave_um = -1;
 };
 
 struct HCampaignOptions {

@@ -92,7 +92,13 @@ std::string HCampaignResult::summary() const {
     << " late " << late_switchovers << " early " << early_switchovers << " max IM "
     << static_cast<double>(max_im_switchover) / bus::kTicksPerMs << " ms (drawn "
     << static_cast<double>(max_im_drawn) / bus::kTicksPerMs << " ms, from the fault "
-    << static_cast<double>(max_fault_switchover) / bus::kTicksPerMs << " ms) frozen "
+    << static_cast<double>(max_fault_switchover) / bus::kTicksPerMs << " ms, least margin to "
+    << "the bound "
+    << (min_bound_margin == bus::kNever
+            ? -1.0
+            : static_cast<double>(min_bound_margin) / bus::kTicksPerMs)
+    << " ms, worst bound " << static_cast<double>(worst_bound) / bus::kTicksPerMs
+    << " ms) frozen "
     << frozen_samples << "; mismatches " << mismatches.size()
     << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
     << static_cast<double>(simulated) / bus::kTicksPerSecond << " s in " << wall_seconds
@@ -456,6 +462,11 @@ void HCampaignRun::build() {
       ps.push_back(p);
     }
     m_plan = redundancy::plan_switchover(m_bp, ps);
+    for (const auto& b : m_plan.stations)
+      for (int l = 0; l < 2; ++l)
+        m_r.worst_bound = std::max(
+            {m_r.worst_bound, b.bound[l],
+             m_plan.line[l].line_loss_recognition + b.t_dp_um[l] + b.t_slave_um});
   }
   for (int l = 0; l < 2; ++l) m_sys->attach(l, *m_bus[l], "master");
   for (auto& s : m_sw)
@@ -635,6 +646,7 @@ void HCampaignRun::check_im_times() {
       const bus::Ticks bound = recognition + sb->t_dp_um[lost] + t_slave;
       const bus::Ticks from_fault = im.primary_at - c->at;
       m_r.max_fault_switchover = std::max(m_r.max_fault_switchover, from_fault);
+      m_r.min_bound_margin = std::min(m_r.min_bound_margin, bound - from_fault);
       if (from_fault > bound) {
         ++m_r.late_switchovers;
         m_r.mismatches.push_back(what + " late: PRIMARY " + fmt_time(from_fault) +

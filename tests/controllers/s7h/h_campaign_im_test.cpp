@@ -64,6 +64,10 @@ TEST(HCampaignIm, SwitchoversTakeTheImsTimeWithinTheBound) {
   // PRIMARY at max(trigger + drawn, the link steps: <= the 10 ms switch timeout).
   EXPECT_LE(r.max_im_switchover, 820 * kMs);
   EXPECT_EQ(r.observed_events, r.expected_events);
+  // The default Output_Hold_Time (100 x 10 ms = 1 s) covers the planner's worst bound, which
+  // holds the slow IM's 820 ms (and lies below the hold, else the run would have pulses).
+  EXPECT_GT(r.worst_bound, 820 * kMs);
+  EXPECT_LE(r.worst_bound, 1000 * kMs);
 }
 
 // Without the IM's time (im_time = false) no switchover records a draw (the link steps only).

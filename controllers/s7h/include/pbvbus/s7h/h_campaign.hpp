@@ -97,9 +97,20 @@
 // After each settled cycle: the role rules (pair master == the observer's), the stations'
 // primary interface and MasterSystem::active() == the observer's active line.
 //
+// The IM's own switchover time (S5; 000 L1822 "DP error recognition time + DP switch-over time +
+// switch-over time of DP slave interface module"; docs/h-campaign.md "With the IM's own
+// switchover time"), on by default (im_time): each switched station draws its switchover time
+// in [T_SLAVE_UM / 2, T_SLAVE_UM] from its GSD. The observer checks, for every switchover the
+// stations record: PRIMARY no earlier than trigger + the drawn time (early), no later than the
+// planner's bound (redundancy::plan_switchover) from the fault that caused it (late), the
+// backplane outputs frozen from trigger + one link delay until PRIMARY (§G.1, S1; a change is a
+// pulse); a cycle is settled only when the master system has seen the new PRIMARY
+// (MasterSystem::active, switching_to). Output_Hold_Time 1 s >= the worst bound (828 ms).
+//
 // Tamper options (the observer's own tests): a fault it is not told about, a doctored event
 // list, a program glitch writing 0, a forced second master outside F6 (both fibres cut while
-// the observer is told one fibre), an update timeout (changed DBs set large without telling it).
+// the observer is told one fibre), an update timeout (changed DBs set large without telling it),
+// a planner told a too small T_SLAVE_UM (late switchovers).
 
 #include <array>
 #include <cstdint>
@@ -194,7 +205,7 @@ struct HCampaignOptions {
   bool im_time = true;
   /// The PrmCmd Output_Hold_Time the redundant master system sends (10 ms units). Set as a
   /// commissioning engineer would: >= the planner's worst switchover bound (recognition + T_DP_UM
-  /// + T_SLAVE_UM, ~831 ms for PBVB0A11), so the outputs are held through the slowest IM's
+  /// + T_SLAVE_UM, 828 ms for PBVB0A11: worst_bound), so the outputs are held through the slowest IM's
   /// switchover; the S7 default 1 s does. Shorter: the outputs go to 0 at its expiry (pulses).
   std::uint16_t output_hold_time = 100;
   /// Keep the step log and a copy of HSystemModel::events() in the result (tests).
@@ -247,6 +258,10 @@ struct HCampaignResult {
   bus::Ticks max_im_switchover = 0;  ///< longest trigger -> PRIMARY
   bus::Ticks max_im_drawn = 0;       ///< longest drawn IM time
   bus::Ticks max_fault_switchover = 0;  ///< longest fault -> PRIMARY
+  bus::Ticks min_bound_margin = bus::kNever;  ///< smallest (bound - (fault -> PRIMARY))
+  /// The planner's largest switchover bound of a switched station (any cause): what the
+  /// Output_Hold_Time must cover.
+  bus::Ticks worst_bound = 0;
   /// Frames during an IM switchover (trigger + link delay .. PRIMARY): the backplane outputs
   /// must stay frozen (a change is a pulse).
   std::uint64_t frozen_samples = 0;

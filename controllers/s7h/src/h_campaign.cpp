@@ -98,7 +98,8 @@ std::string HCampaignResult::summary() const {
             ? -1.0
             : static_cast<double>(min_bound_margin) / bus::kTicksPerMs)
     << " ms, worst bound " << static_cast<double>(worst_bound) / bus::kTicksPerMs
-    << " ms) frozen "
+    << " ms; by cause: side stop " << im_by_cause[0] << ", short circuit " << im_by_cause[1]
+    << ", interface " << im_by_cause[2] << ") frozen "
     << frozen_samples << "; mismatches " << mismatches.size()
     << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
     << static_cast<double>(simulated) / bus::kTicksPerSecond << " s in " << wall_seconds
@@ -640,6 +641,7 @@ void HCampaignRun::check_im_times() {
         m_r.mismatches.push_back(what + " without a fault on line " + std::to_string(lost));
         continue;
       }
+      ++m_r.im_by_cause[static_cast<std::size_t>(c->kind)];
       bus::Ticks recognition = 0;
       if (c->kind == CauseKind::LineLoss) recognition = m_plan.line[lost].line_loss_recognition;
       if (c->kind == CauseKind::Interface) recognition = sb->recognition[lost];

@@ -259,6 +259,10 @@ struct HCampaignResult {
   bus::Ticks max_im_drawn = 0;       ///< longest drawn IM time
   bus::Ticks max_fault_switchover = 0;  ///< longest fault -> PRIMARY
   bus::Ticks min_bound_margin = bus::kNever;  ///< smallest (bound - (fault -> PRIMARY))
+  /// Completed IM switchovers by their cause: [0] a side's DP master stopped or its module
+  /// failed (F1, STOP, F5, F9, F16/F17, the swap, ...), [1] a short circuit (F14), [2] one
+  /// interface (F10).
+  std::array<int, 3> im_by_cause{};
   /// The planner's largest switchover bound of a switched station (any cause): what the
   /// Output_Hold_Time must cover.
   bus::Ticks worst_bound = 0;

@@ -11,7 +11,8 @@
 //     repairs, pulses, mismatches, events (observed) and expected_events, samples, dx,
 //     split_frames, second_master_frames, stray_dx, role_swaps, defective, comparison_stops,
 //     update_timeouts, refusals, diag_checks, virt_s, virt_s_per_wall_s, virt_s_per_cpu_s
-//     (std::clock), max_settle_ms.
+//     (std::clock), max_settle_ms, im_switchovers, late_switchovers, early_switchovers,
+//     max_im_ms (the IM's own switchover time, S5).
 //   One iteration (the campaign is one long run); mismatches and pulses are printed to stderr.
 //
 // PBVBUS_HCAMPAIGN_SEED and PBVBUS_HCAMPAIGN_STEPS override the seed and the number of
@@ -107,6 +108,11 @@ void BM_HCampaign(benchmark::State& state) {
   state.counters["virt_s_per_wall_s"] = r.wall_seconds > 0 ? virt / r.wall_seconds : 0;
   state.counters["virt_s_per_cpu_s"] = cpu_s > 0 ? virt / cpu_s : 0;
   state.counters["max_settle_ms"] = static_cast<double>(r.max_settle) / bus::kTicksPerMs;
+  // The IM's own switchover time (S5, docs/h-campaign.md "With the IM's own switchover time").
+  state.counters["im_switchovers"] = static_cast<double>(r.im_switchovers);
+  state.counters["late_switchovers"] = r.late_switchovers;
+  state.counters["early_switchovers"] = r.early_switchovers;
+  state.counters["max_im_ms"] = static_cast<double>(r.max_im_switchover) / bus::kTicksPerMs;
 }
 BENCHMARK(BM_HCampaign)->Args({1, 1000, 0})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 

@@ -22,6 +22,7 @@
 #include "pbvbus/slaves/slave_model.hpp"
 #include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/fdl/telegram.hpp"
+#include "pbvbus/redundancy/switchover_timing.hpp"
 
 namespace pbvbus::devices {
 
@@ -87,7 +88,19 @@ std::string HCampaignResult::summary() const {
     << expected_events << "); samples " << output_samples << " pulses " << pulses << " cleared "
     << cleared_samples << "; DX "
     << dx_requests << " stray " << stray_dx << "; split frames " << split_frames
-    << " second-master frames " << second_master_frames << "; mismatches " << mismatches.size()
+    << " second-master frames " << second_master_frames << "; IM switchovers " << im_switchovers
+    << " late " << late_switchovers << " early " << early_switchovers << " max IM "
+    << static_cast<double>(max_im_switchover) / bus::kTicksPerMs << " ms (drawn "
+    << static_cast<double>(max_im_drawn) / bus::kTicksPerMs << " ms, from the fault "
+    << static_cast<double>(max_fault_switchover) / bus::kTicksPerMs << " ms, least margin to "
+    << "the bound "
+    << (min_bound_margin == bus::kNever
+            ? -1.0
+            : static_cast<double>(min_bound_margin) / bus::kTicksPerMs)
+    << " ms, worst bound " << static_cast<double>(worst_bound) / bus::kTicksPerMs
+    << " ms; by cause: side stop " << im_by_cause[0] << ", short circuit " << im_by_cause[1]
+    << ", interface " << im_by_cause[2] << ") frozen "
+    << frozen_samples << "; mismatches " << mismatches.size()
     << "; max settle " << static_cast<double>(max_settle) / bus::kTicksPerMs << " ms; simulated "
     << static_cast<double>(simulated) / bus::kTicksPerSecond << " s in " << wall_seconds
     << " s wall; frames " << frames;
@@ -240,7 +253,29 @@ class HCampaignRun {
   struct Sw {
     std::unique_ptr<SwitchedStationModel> model;
     campaign::CounterWatch watch;  ///< the backplane outputs' counter
+    std::size_t frozen_im = static_cast<std::size_t>(-1);  ///< the switchover frozen_value is of
+    std::uint16_t frozen_value = 0;
   };
+  /// What can make a switched station switch over, as the observer injected it (the planner's
+  /// bound depends on how the loss is recognised, docs/switchover-timing.md).
+  enum class CauseKind : std::uint8_t {
+    SideStop,   ///< the side's DP master stops or its module fails: recognised at once
+    LineLoss,   ///< short circuit: the line-loss recognition
+    Interface,  ///< one station's interface: that station's recognition
+  };
+  struct Cause {
+    bus::Ticks at = 0;
+    int line = 0;  ///< the line lost
+    CauseKind kind = CauseKind::SideStop;
+    int station = -1;  ///< Interface: the station index
+  };
+  void cause(bus::Ticks at, int line, CauseKind kind, int station = -1) {
+    m_causes.push_back({at, line, kind, station});
+  }
+  /// S5: every IM switchover within [its drawn time, the planner's bound from its cause].
+  void check_im_times();
+  /// False when station k's backplane outputs changed while its IM switchover runs.
+  bool check_frozen(int k, std::uint16_t v, bus::Ticks t);
   void build();
   bus::Ticks now() const { return m_sched.now(); }
   void run_to(bus::Ticks t) { m_sched.run_until(t); }
@@ -339,6 +374,8 @@ class HCampaignRun {
   std::uint16_t m_counter = 0;
   bool m_zero_done = false;
   Observer m_obs;
+  redundancy::SwitchoverPlan m_plan;
+  std::vector<Cause> m_causes;
   std::vector<Step> m_steps;
   std::size_t m_reported_step = static_cast<std::size_t>(-1);  ///< two-master report, once
   std::size_t m_stray_step = static_cast<std::size_t>(-1);
@@ -364,6 +401,13 @@ void HCampaignRun::build() {
     SwitchedStationOptions so;
     so.address = kSw[k];
     so.bus_params = m_bp;
+    if (m_o.im_time) {
+      // S5: the GSD's T_SLAVE_UM (Slave_Max_Switch_Over_Time x 10 ms), as the planner reads it;
+      // the draws seeded like the switched-I/O campaign's (seed x FNV prime + address).
+      if (auto t = g.redundancy().switch_over_time_ms())
+        so.redundancy.im_switchover_bound = bus::Ticks{*t} * kMs;
+      so.redundancy.im_seed = m_o.seed * 0x100000001B3ull + kSw[k];
+    }
     auto b = SwitchedStationModel::build(g, switched_modules(), so);
     if (!b.ok())
       throw std::runtime_error("h campaign: switched station " + std::to_string(kSw[k]) + ": " +
@@ -390,7 +434,41 @@ void HCampaignRun::build() {
   }
   RedundantMasterSystemOptions mo;
   mo.bus_params = m_bp;
+  mo.system.output_hold_time = m_o.output_hold_time;
   m_sys = std::make_unique<RedundantMasterSystemModel>(mo, cfg[0], cfg[1], refs);
+  // The planner's bounds (recognition + T_DP_UM + T_SLAVE_UM) for the late check: 16 DI = 2
+  // input octets, 16 DO = 2 output octets (16DI/16DO likewise), MaxTsdr and Max_Diag_Data_Len
+  // from the GSDs.
+  {
+    std::vector<redundancy::PlannedSlave> ps;
+    for (int k = 0; k < 2; ++k) {
+      const GsdFile& g = k == 1 ? slow : fast;
+      redundancy::PlannedSlave p;
+      p.address = kSw[k];
+      p.in_len = p.out_len = 2;
+      p.max_tsdr_bits = g.max_tsdr(m_o.baud).value_or(0);
+      p.max_diag_len = m_sw[k].model->config().max_diag_len;
+      p.switched = true;
+      p.t_slave_um = m_o.im_time ? m_sw[k].model->t_slave_um() : std::nullopt;
+      if (m_o.tamper.planned_t_slave_um >= 0) p.t_slave_um = m_o.tamper.planned_t_slave_um;
+      ps.push_back(p);
+    }
+    for (int l = 0; l < 2; ++l) {
+      redundancy::PlannedSlave p;
+      p.address = kOne[l];
+      p.in_len = p.out_len = 2;
+      p.max_tsdr_bits = plain.max_tsdr(m_o.baud).value_or(0);
+      p.max_diag_len = std::max<std::size_t>(6, plain.slave_features().max_diag_data_len);
+      p.line = l;
+      ps.push_back(p);
+    }
+    m_plan = redundancy::plan_switchover(m_bp, ps);
+    for (const auto& b : m_plan.stations)
+      for (int l = 0; l < 2; ++l)
+        m_r.worst_bound = std::max(
+            {m_r.worst_bound, b.bound[l],
+             m_plan.line[l].line_loss_recognition + b.t_dp_um[l] + b.t_slave_um});
+  }
   for (int l = 0; l < 2; ++l) m_sys->attach(l, *m_bus[l], "master");
   for (auto& s : m_sw)
     for (int l = 0; l < 2; ++l) s.model->attach(l, *m_bus[l]);
@@ -477,7 +555,16 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
     // value after it.
     const bool none = (!m_obs.reach(k, 0, f.end) && !m_obs.reach(k, 1, f.end)) ||
                       m_obs.no_program(f.end);
+    const bool thawed = !check_frozen(k, v, f.end);
     const campaign::CounterWatch::Sample c = s.watch.sample(v, none);
+    if (thawed && (c.bad.empty() || !c.counted)) {
+      ++m_r.pulses;
+      if (m_r.pulse_reports.size() < 20)
+        m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) +
+                                    " outputs changed during the IM's switchover (" +
+                                    std::to_string(v) + " after " + std::to_string(s.frozen_value) +
+                                    "), step '" + step_name() + "'");
+    }
     if (!c.counted) continue;
     ++m_r.output_samples;
     if (v == 0 && m_obs.no_program(f.end)) ++m_r.cleared_samples;
@@ -487,6 +574,87 @@ void HCampaignRun::on_frame(const bus::TapFrame& f) {
         m_r.pulse_reports.push_back(fmt_time(f.end) + ": station " + std::to_string(kSw[k]) + " " +
                                     std::string(c.bad) + " (" + std::to_string(v) + " after " +
                                     std::to_string(c.previous) + "), step '" + step_name() + "'");
+    }
+  }
+}
+
+// ---- the IM's own switchover time (S5) ------------------------------------------------------
+
+bool HCampaignRun::check_frozen(int k, std::uint16_t v, bus::Ticks t) {
+  // §G.1 "inputs and outputs are frozen during the switchover" (S1, no pulse): while the new
+  // interface is in BP_SWITCHOVER (its IM time running) nothing reaches the backplane. The old
+  // primary hands over at the latest one link delay after the trigger (the switchover request's
+  // way over the internal link), so the outputs are frozen from then until PRIMARY.
+  Sw& s = m_sw[k];
+  const auto& rs = s.model->redundant_slave();
+  const auto& ims = rs.im_switchovers();
+  if (ims.empty()) return true;
+  const redundancy::ImSwitchover& im = ims.back();
+  if (im.primary_at != bus::kNever || rs.role(im.iface) != redundancy::Role::BpSwitchover ||
+      t <= im.trigger + rs.params().link_delay)
+    return true;
+  ++m_r.frozen_samples;
+  if (s.frozen_im != ims.size()) {
+    s.frozen_im = ims.size();
+    s.frozen_value = v;
+    return true;
+  }
+  return v == s.frozen_value;
+}
+
+void HCampaignRun::check_im_times() {
+  // S5 (000 L1832: the switchover time includes "the changeover time of the DP slave
+  // interface"): each switchover ends (PRIMARY) no earlier than its trigger + the IM time drawn
+  // for it, and within the planner's bound from the fault the observer injected (the latest
+  // cause on the lost line at or before the trigger): recognition + T_DP_UM + T_SLAVE_UM, the
+  // recognition by the cause (a stopped side or failed DP master module: at once; a short
+  // circuit: the line-loss recognition; one interface: that station's), T_SLAVE_UM at least the
+  // switch timeout (a silent partner, PI 2.212 model: redundant_slave.hpp).
+  for (int k = 0; k < 2; ++k) {
+    const auto& rs = m_sw[k].model->redundant_slave();
+    const redundancy::StationBound* sb = nullptr;
+    for (const auto& b : m_plan.stations)
+      if (b.address == kSw[k]) sb = &b;
+    if (sb == nullptr) throw std::logic_error("h campaign: station not planned");
+    const bus::Ticks t_slave = std::max(sb->t_slave_um, rs.params().switch_timeout);
+    for (const auto& im : rs.im_switchovers()) {
+      ++m_r.im_switchovers;
+      m_r.max_im_drawn = std::max(m_r.max_im_drawn, im.drawn);
+      if (im.primary_at == bus::kNever) continue;  // abandoned (the interface failed meanwhile)
+      const bus::Ticks took = im.primary_at - im.trigger;
+      m_r.max_im_switchover = std::max(m_r.max_im_switchover, took);
+      const std::string what = fmt_time(im.trigger) + ": station " + std::to_string(kSw[k]) +
+                               " switchover to line " + std::to_string(im.iface);
+      if (took < im.drawn) {
+        ++m_r.early_switchovers;
+        m_r.mismatches.push_back(what + " early: PRIMARY after " + fmt_time(took) +
+                                 " < the IM's drawn " + fmt_time(im.drawn));
+      }
+      const int lost = 1 - im.iface;
+      const Cause* c = nullptr;
+      for (const auto& x : m_causes)
+        if (x.at <= im.trigger && x.line == lost &&
+            (x.kind != CauseKind::Interface || x.station == k) && (c == nullptr || x.at >= c->at))
+          c = &x;
+      if (c == nullptr) {
+        ++m_r.late_switchovers;
+        m_r.mismatches.push_back(what + " without a fault on line " + std::to_string(lost));
+        continue;
+      }
+      ++m_r.im_by_cause[static_cast<std::size_t>(c->kind)];
+      bus::Ticks recognition = 0;
+      if (c->kind == CauseKind::LineLoss) recognition = m_plan.line[lost].line_loss_recognition;
+      if (c->kind == CauseKind::Interface) recognition = sb->recognition[lost];
+      const bus::Ticks bound = recognition + sb->t_dp_um[lost] + t_slave;
+      const bus::Ticks from_fault = im.primary_at - c->at;
+      m_r.max_fault_switchover = std::max(m_r.max_fault_switchover, from_fault);
+      m_r.min_bound_margin = std::min(m_r.min_bound_margin, bound - from_fault);
+      if (from_fault > bound) {
+        ++m_r.late_switchovers;
+        m_r.mismatches.push_back(what + " late: PRIMARY " + fmt_time(from_fault) +
+                                 " after the fault at " + fmt_time(c->at) + " > bound " +
+                                 fmt_time(bound) + " (IM drawn " + fmt_time(im.drawn) + ")");
+      }
     }
   }
 }
@@ -505,6 +673,7 @@ void HCampaignRun::lose_side(int r, bus::Ticks t, std::vector<Expect>& ex) {
   m_obs.stopped_at[r] = t;
   m_obs.prog_until[r] = std::min(m_obs.prog_until[r], t);
   if (!ran) return;
+  cause(t, r, CauseKind::SideStop);
   ex.push_back(io(0x39C3, r, 0xFF, t, t));
   for (int k = 0; k < 2; ++k)
     if (m_obs.act[k] == r && m_obs.iface_ok[k][1 - r] && m_obs.line_ok(1 - r)) m_obs.act[k] = 1 - r;
@@ -575,6 +744,12 @@ bool HCampaignRun::recovered() const {
       if (role != redundancy::Role::Primary && role != redundancy::Role::Backup) return false;
     }
     if (m_sw[k].model->primary() < 0) return false;
+    // The switchover is over when the master system has seen the new PRIMARY in the station's
+    // Red_Status (the diagnosis read after the DH that the role change causes): with the IM's
+    // own time (S5) the station may become PRIMARY just before a poll of this loop, the
+    // master's diagnosis read a few ms later.
+    if (m_sys->system().active(kSw[k]) < 0 || m_sys->system().switching_to(kSw[k]) >= 0)
+      return false;
   }
   for (int l = 0; l < 2; ++l)
     if (m_obs.line_ok(l) && m_obs.side_runs(l, t) &&
@@ -770,6 +945,7 @@ void HCampaignRun::cycle(HFault f) {
       const int k = draw_int(0, 1);
       const int l = f == HFault::ActiveIm ? m_obs.act[k] : 1 - m_obs.act[k];
       m_obs.iface_ok[k][l] = false;
+      cause(t, l, CauseKind::Interface, k);
       ex.push_back(io(0x73A3, l, kSw[k], t, t + m_o.recognition));
       if (m_obs.act[k] == l) m_obs.act[k] = 1 - l;
       m_sw[k].model->fail_interface(l);
@@ -799,6 +975,7 @@ void HCampaignRun::cycle(HFault f) {
         ex.push_back(io(0x39C4, l, kOne[l], t, t + m_o.recognition));
       }
       switch_away(l);
+      cause(t, l, sc ? CauseKind::LineLoss : CauseKind::SideStop);
       if (sc) {
         m_bus[l]->set_short_circuit(true);
       } else {
@@ -919,6 +1096,7 @@ void HCampaignRun::cycle(HFault f) {
       ex.push_back(cpu_ob(72, S, CpuRole::Master, HReason::MasterSwap, te));
       m_obs.prog_until[M] = te;
       m_obs.run_until[M] = te;
+      cause(te, M, CauseKind::SideStop);
       {
         Expect x = io(0x39C3, M, 0xFF, te, te);
         x.rack = S;  // at te only the new master runs the program
@@ -1235,6 +1413,7 @@ HCampaignResult HCampaignRun::run() {
     ++index;
   }
   run_to(now() + 500 * kMs);
+  check_im_times();
   match_all();
   m_r.io_events = campaign::zero_event_counts();
   for (const auto& e : m_h->events()) {

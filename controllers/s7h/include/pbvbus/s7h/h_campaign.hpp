@@ -97,9 +97,20 @@
 // After each settled cycle: the role rules (pair master == the observer's), the stations'
 // primary interface and MasterSystem::active() == the observer's active line.
 //
+// The IM's own switchover time (S5; 000 L1822 "DP error recognition time + DP switch-over time +
+// switch-over time of DP slave interface module"; docs/h-campaign.md "With the IM's own
+// switchover time"), on by default (im_time): each switched station draws its switchover time
+// in [T_SLAVE_UM / 2, T_SLAVE_UM] from its GSD. The observer checks, for every switchover the
+// stations record: PRIMARY no earlier than trigger + the drawn time (early), no later than the
+// planner's bound (redundancy::plan_switchover) from the fault that caused it (late), the
+// backplane outputs frozen from trigger + one link delay until PRIMARY (§G.1, S1; a change is a
+// pulse); a cycle is settled only when the master system has seen the new PRIMARY
+// (MasterSystem::active, switching_to). Output_Hold_Time 1 s >= the worst bound (828 ms).
+//
 // Tamper options (the observer's own tests): a fault it is not told about, a doctored event
 // list, a program glitch writing 0, a forced second master outside F6 (both fibres cut while
-// the observer is told one fibre), an update timeout (changed DBs set large without telling it).
+// the observer is told one fibre), an update timeout (changed DBs set large without telling it),
+// a planner told a too small T_SLAVE_UM (late switchovers).
 
 #include <array>
 #include <cstdint>
@@ -153,6 +164,9 @@ struct HCampaignTamper {
   /// At this cycle (0-based): the changed DBs are set to update_timeout_kb before the drawn
   /// cycle and back after it, the observer not told: its restart's update times out (-1: never).
   int hidden_update_timeout_at = -1;
+  /// >= 0: the observer's planner is given this T_SLAVE_UM for both switched stations instead
+  /// of their GSDs' (the IMs still draw from the GSDs'): their switchovers exceed its bound, late.
+  bus::Ticks planned_t_slave_um = -1;
 };
 
 struct HCampaignOptions {
@@ -183,6 +197,17 @@ struct HCampaignOptions {
   /// 10: the standby gives up and the repair is a manual RUN). Each failure costs 60 s + 2.2 s
   /// of virtual time (the retry delay), hence the small default.
   int update_timeout_failures_max = 2;
+  /// The IM's own switchover time (seeds-digest §2 S5, 000 L1832; docs/h-campaign.md "With the
+  /// IM's own switchover time"): each switched station's RedundantSlave gets its GSD's T_SLAVE_UM
+  /// (Slave_Max_Switch_Over_Time: PBVB0A10 30 ms, PBVB0A11 820 ms) as im_switchover_bound and
+  /// im_seed = seed x FNV prime + address; every switchover then takes a drawn time in
+  /// [T_SLAVE_UM / 2, T_SLAVE_UM]. false: the link steps only (~2 ms), as before S5.
+  bool im_time = true;
+  /// The PrmCmd Output_Hold_Time the redundant master system sends (10 ms units). Set as a
+  /// commissioning engineer would: >= the planner's worst switchover bound (recognition + T_DP_UM
+  /// + T_SLAVE_UM, 828 ms for PBVB0A11: worst_bound), so the outputs are held through the slowest IM's
+  /// switchover; the S7 default 1 s does. Shorter: the outputs go to 0 at its expiry (pulses).
+  std::uint16_t output_hold_time = 100;
   /// Keep the step log and a copy of HSystemModel::events() in the result (tests).
   bool keep_log = false;
   HCampaignTamper tamper;
@@ -223,6 +248,27 @@ struct HCampaignResult {
   std::uint64_t split_frames = 0;          ///< frames while two masters drove (F6 only)
   std::uint64_t second_master_frames = 0;  ///< frames with two drivers outside F6 (must be 0)
   std::uint64_t stray_dx = 0;              ///< DX on a side that should not run (must be 0)
+  /// The IMs' switchovers (RedundantSlave::im_switchovers(), HCampaignOptions::im_time): each
+  /// must end (PRIMARY) no earlier than trigger + its drawn IM time (else early) and within the
+  /// planner's bound from the fault that caused it (recognition + T_DP_UM + T_SLAVE_UM,
+  /// redundancy::plan_switchover; else late). Both are mismatches.
+  std::uint64_t im_switchovers = 0;
+  int late_switchovers = 0;
+  int early_switchovers = 0;
+  bus::Ticks max_im_switchover = 0;  ///< longest trigger -> PRIMARY
+  bus::Ticks max_im_drawn = 0;       ///< longest drawn IM time
+  bus::Ticks max_fault_switchover = 0;  ///< longest fault -> PRIMARY
+  bus::Ticks min_bound_margin = bus::kNever;  ///< smallest (bound - (fault -> PRIMARY))
+  /// Completed IM switchovers by their cause: [0] a side's DP master stopped or its module
+  /// failed (F1, STOP, F5, F9, F16/F17, the swap, ...), [1] a short circuit (F14), [2] one
+  /// interface (F10).
+  std::array<int, 3> im_by_cause{};
+  /// The planner's largest switchover bound of a switched station (any cause): what the
+  /// Output_Hold_Time must cover.
+  bus::Ticks worst_bound = 0;
+  /// Frames during an IM switchover (trigger + link delay .. PRIMARY): the backplane outputs
+  /// must stay frozen (a change is a pulse).
+  std::uint64_t frozen_samples = 0;
   std::vector<std::string> mismatches;
   bus::Ticks max_settle = 0;  ///< longest repair -> Redundant + data exchange
   bus::Ticks simulated = 0;

@@ -278,6 +278,10 @@ class RuleChecker {
     return m < sl.module_names.size() ? sl.module_names[m] : sl.config.modules[m].name;
   }
   std::pair<int, int> module_at(const DpSlavePlan& sl, std::size_t m) const {
+    // An IM 157 link's modules are its lower stations (docs/dp-link.md): `source` indexes its
+    // y_link / dp_pa_link entry, which has no module list.
+    if (sl.switched >= 0 && m_plan.switched[static_cast<std::size_t>(sl.switched)].link >= 0)
+      return m_locate(sl.repeated, sl.source, "address", -1);
     const auto& names = sl.switched >= 0 ? m_plan.proto.switched_station(sl.source).modules()
                                          : m_plan.proto.dp_slave(sl.source).modules();
     if (static_cast<int>(m) < names.size()) return m_locate(sl.repeated, sl.source, "modules", static_cast<int>(m));

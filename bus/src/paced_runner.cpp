@@ -11,7 +11,7 @@
 namespace pbvbus::bus {
 
 namespace {
-__extension__ typedef __int128 Wide;
+__extension__ typedef __int128 Wide128;
 constexpr auto kLateThreshold = std::chrono::milliseconds(1);
 }  // namespace
 
@@ -41,18 +41,18 @@ void PacedRunner::set_speed(Speed s) {
 Ticks PacedRunner::virtual_at_locked(Clock::time_point w) const {
   const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(w - m_wall0).count();
   if (ns <= 0) return m_virt0;
-  const Wide t = static_cast<Wide>(ns) * 3636 * m_speed.num / (static_cast<Wide>(1000) * m_speed.den);
-  const Wide v = static_cast<Wide>(m_virt0) + t;
-  return v > static_cast<Wide>(kNever / 2) ? kNever / 2 : static_cast<Ticks>(v);
+  const Wide128 t = static_cast<Wide128>(ns) * 3636 * m_speed.num / (static_cast<Wide128>(1000) * m_speed.den);
+  const Wide128 v = static_cast<Wide128>(m_virt0) + t;
+  return v > static_cast<Wide128>(kNever / 2) ? kNever / 2 : static_cast<Ticks>(v);
 }
 
 // Wall time of a virtual time, rounded up (the inverse of the above).
 PacedRunner::Clock::time_point PacedRunner::wall_at_locked(Ticks v) const {
   if (v <= m_virt0) return m_wall0;
-  const Wide num = static_cast<Wide>(v - m_virt0) * 1000 * m_speed.den;
-  const Wide den = static_cast<Wide>(3636) * m_speed.num;
-  Wide ns = (num + den - 1) / den;
-  constexpr Wide kMaxNs = static_cast<Wide>(365) * 24 * 3600 * 1'000'000'000LL;  // a year is "never"
+  const Wide128 num = static_cast<Wide128>(v - m_virt0) * 1000 * m_speed.den;
+  const Wide128 den = static_cast<Wide128>(3636) * m_speed.num;
+  Wide128 ns = (num + den - 1) / den;
+  constexpr Wide128 kMaxNs = static_cast<Wide128>(365) * 24 * 3600 * 1'000'000'000LL;  // a year is "never"
   if (ns > kMaxNs) ns = kMaxNs;
   return m_wall0 + std::chrono::nanoseconds(static_cast<std::int64_t>(ns));
 }

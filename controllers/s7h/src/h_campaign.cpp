@@ -23,6 +23,7 @@
 #include "pbvbus/switched_io/switched_station.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 #include "pbvbus/redundancy/switchover_timing.hpp"
+#include "pbvbus/s7h/h_rack_power.hpp"
 
 namespace pbvbus::devices {
 
@@ -68,6 +69,14 @@ std::string_view to_string(HFault f) {
       return "structural change in Redundant (F22)";
     case HFault::ParameterChangeSwap:
       return "master swap with a changed parameter (F23)";
+    case HFault::PsHalf:
+      return "half of a PS 407 10A R (F1)";
+    case HFault::ChecksumError:
+      return "checksum error in Redundant";
+    case HFault::SecondFibre:
+      return "second fibre later (F5)";
+    case HFault::UpdateBlocked:
+      return "update disabled by SFC 90";
   }
   return "?";
 }
@@ -83,7 +92,9 @@ std::string HCampaignResult::summary() const {
     o << ' ' << to_string(static_cast<HFault>(k)) << '=' << drawn[k];
   o << ") defective " << defective << " comparison-stops " << comparison_stops << " role swaps "
     << role_swaps << " update-timeouts " << update_timeouts << " refusals " << refusals
-    << " diag-checks " << diag_checks << "; events" << campaign::format_counts(io_events);
+    << " diag-checks " << diag_checks << " ps-cpu-failures " << ps_cpu_failures
+    << " checksum-defective " << checksum_defective << " update-waits " << update_waits
+    << "; events" << campaign::format_counts(io_events);
   o << " OB72=" << ob72 << " OB121=" << ob121 << " (observed " << observed_events << ", expected "
     << expected_events << "); samples " << output_samples << " pulses " << pulses << " cleared "
     << cleared_samples << "; DX "
@@ -189,6 +200,7 @@ struct Observer {
   bool shorted[2] = {false, false}, mfail[2] = {false, false};
   int act[2] = {0, 0};
   std::optional<bus::Ticks> last121[2];
+  std::optional<bus::Ticks> last_checksum[2];  ///< the last checksum error per CPU (7 days)
   bus::Ticks swap_at = bus::kNever;  ///< the last automatic swap after ERROR-SEARCH
   std::uint32_t kb = 100;            ///< KB of changed DBs the next update copies
 
@@ -347,6 +359,9 @@ class HCampaignRun {
   /// The new kinds (link-up/update reactions); each returns when its last repair is injected
   /// and gives the time the settle counts from.
   bus::Ticks cycle_link(HFault f);
+  /// The kinds of the later fault paths (PsHalf, ChecksumError, SecondFibre, UpdateBlocked),
+  /// likewise.
+  bus::Ticks cycle_later(HFault f);
   /// The standby to STOP by its mode switch: OB 72 StandbyStop on the master, its side lost.
   void stop_standby(const std::string& what);
   void mismatch(const std::string& m) {
@@ -1063,6 +1078,7 @@ void HCampaignRun::cycle(HFault f) {
         since = now();
         ex.clear();
         m_obs.last121[r].reset();  // the CPU is replaced: no history
+        m_obs.last_checksum[r].reset();
         restart_side(r, since, ex);
         m_h->repair_cpu(r);
         m_h->switch_to_run(r);
@@ -1078,6 +1094,12 @@ void HCampaignRun::cycle(HFault f) {
     case HFault::LoadChange:
     case HFault::ParameterChangeSwap:
       since = cycle_link(f);
+      break;
+    case HFault::PsHalf:
+    case HFault::ChecksumError:
+    case HFault::SecondFibre:
+    case HFault::UpdateBlocked:
+      since = cycle_later(f);
       break;
     case HFault::MasterSwap: {
       // The operator: the standby's switch to STOP, the swap request (the standby links up and
@@ -1346,6 +1368,193 @@ bus::Ticks HCampaignRun::cycle_link(HFault f) {
   return since;
 }
 
+// ---- the later fault paths (PS halves, checksum errors, F5's second link, SFC 90) ----------
+
+bus::Ticks HCampaignRun::cycle_later(HFault f) {
+  const std::string name(to_string(f));
+  const int M = m_obs.master, S = 1 - M;
+  const bus::Ticks t = now();
+  std::vector<Expect> ex;
+  bus::Ticks since = t;
+  switch (f) {
+    case HFault::PsHalf: {
+      // 000 L465, L2517, 001 L8387-8390: "if a part of the redundant PS fails, the
+      // corresponding CPU keeps on running": no state, role or OB event, only the entry
+      // W#16#3923 (docs/h-changes.md's decision) on that CPU. Both halves: F1.
+      const int r = draw_int(0, 1), h = draw_int(0, 1);
+      const bool both = draw_int(0, 1) == 1;
+      const std::string half = " half " + std::to_string(h);
+      const bool off = m_h->ps_failure(r, h);
+      begin_step(name + ": " + rack_name(r) + half, false, {});
+      if (off) mismatch("the CPU failed with the other PS half still supplying it");
+      expect_diag(r, t, kPsFailureIncoming,
+                  "OB 81: power supply failure (PS 407 10A R" + half + ")");
+      dwell();
+      if (both) {
+        // The other half fails too: no supply left, as power_off (F1): OB 72 MasterLost /
+        // StandbyLost on the partner, the lost master's partner is master.
+        const bus::Ticks t2 = now();
+        const bool of_master = r == m_obs.master;
+        m_obs.prog_until[r] = t2;
+        ex.push_back(cpu_ob(72, 1 - r, CpuRole::Master,
+                            of_master ? HReason::MasterLost : HReason::StandbyLost, t2));
+        lose_side(r, t2, ex);
+        if (of_master) set_master(1 - r);
+        const bool off2 = m_h->ps_failure(r, 1 - h);
+        begin_step("the other half of " + rack_name(r) + "'s PS fails (F1)", false,
+                   std::move(ex));
+        if (!off2) mismatch("the CPU kept running with both PS halves failed");
+        ++m_r.ps_cpu_failures;
+        settle_step();
+        dwell();
+        // That half replaced: power returns, the CPU starts as standby (link-up, update).
+        since = now();
+        ex.clear();
+        restart_side(r, since, ex);
+        const bool on = m_h->ps_repair(r, 1 - h);
+        begin_step("replace half " + std::to_string(1 - h) + " of " + rack_name(r) +
+                       " (power back)",
+                   true, std::move(ex));
+        if (!on) mismatch("PS half replacement refused");
+        settle_step();  // the 38C3 at the start of its UPDATE lies in this step
+        pause();
+      }
+      const bus::Ticks t3 = now();
+      const bool rep = m_h->ps_repair(r, h);
+      begin_step("replace" + half + " of " + rack_name(r) + "'s PS", true, {});
+      if (!rep) mismatch("PS half replacement refused");
+      expect_diag(r, t3, kPsFailureOutgoing, "OB 81: power supply failure gone");
+      if (!both) since = t3;
+      break;
+    }
+    case HFault::ChecksumError: {
+      // 001 L4023-4065, Table 5-6: found by the cyclic self-test in Redundant -> corrected, that
+      // CPU ERROR-SEARCH, the partner Solo (master if needed, 001 L3910-3913) with OB 72
+      // ChecksumError; then as F16/F17 (rule 10): re-link, automatic swap to the searched CPU.
+      // Again on that CPU within 7 days -> DEFECTIVE (001 L4063): repair by replacing it.
+      const int r = draw_int(0, 1), p = 1 - r;
+      const bool repeated =
+          m_obs.last_checksum[r] && t - *m_obs.last_checksum[r] <= kDefectiveWindow;
+      m_obs.last_checksum[r] = t;
+      ex.push_back(cpu_ob(72, p, CpuRole::Master, HReason::ChecksumError, t));
+      m_obs.prog_until[r] = t;
+      set_master(p);
+      lose_side(r, t, ex);
+      if (!repeated) {
+        restart_side(r, t + m_o.self_test_time, ex);
+        const bus::Ticks te = m_obs.prog_from[r];
+        ex.push_back(cpu_ob(72, r, CpuRole::Master, HReason::MasterSwap, te));
+        ex.push_back(cpu_ob(72, p, CpuRole::Standby, HReason::MasterSwap, te));
+        m_obs.swap_at = te;  // a comparison error within the first self-test cycle: repeat
+        set_master(r);
+      }
+      const bool ok = m_h->checksum_error(r);
+      begin_step(name + ": " + rack_name(r) + (repeated ? " (again: DEFECTIVE)" : ""), false,
+                 std::move(ex));
+      if (!ok) mismatch("checksum error refused in Redundant mode");
+      expect_diag(r, t, 0,
+                  repeated ? "checksum error repeated within 7 days"
+                           : "checksum error in the cyclic self-test: corrected, ERROR-SEARCH");
+      settle_step();
+      if (repeated) {
+        ++m_r.checksum_defective;
+        dwell();
+        since = now();
+        ex.clear();
+        m_obs.last_checksum[r].reset();  // the CPU is replaced: no history (repair_cpu)
+        m_obs.last121[r].reset();
+        restart_side(r, since, ex);
+        m_h->repair_cpu(r);
+        m_h->switch_to_run(r);
+        begin_step("replace CPU " + rack_name(r) + ", RUN", true, std::move(ex));
+      }
+      break;
+    }
+    case HFault::SecondFibre: {
+      // 000 L2594-2597: both fibres damaged one after the other: the reactions of F5, "the only
+      // exception is that the standby CPU does not go to STOP mode but instead requests a
+      // reset" - it is in STOP already (the first fibre, F5): the second gives the reset
+      // request, no OB (Solo, nothing more is lost), no role change.
+      const int fi = draw_int(0, 1);
+      m_obs.prog_until[S] = t;
+      ex.push_back(cpu_ob(72, M, CpuRole::Master, HReason::LinkLost, t));
+      lose_side(S, t, ex);
+      m_h->cut_fibre(fi);
+      begin_step(name + ": fibre " + std::to_string(fi), false, std::move(ex));
+      settle_step();
+      dwell();
+      const bus::Ticks t2 = now();
+      m_h->cut_fibre(1 - fi);
+      begin_step("second fibre " + std::to_string(1 - fi) + " cut", false, {});
+      expect_diag(S, t2, 0, "reset request: second sync link failed");
+      expect_diag(M, t2, 0, "second sync link failed: the standby CPU requests a reset");
+      dwell();
+      // Repair: both fibres; RUN is refused (reset request), then MRES + RUN links up.
+      m_h->repair_fibre(0);
+      m_h->repair_fibre(1);
+      m_h->switch_to_run(S);
+      begin_step("repair both fibres, RUN " + rack_name(S) + " (refused: reset request)", true,
+                 {});
+      ++m_r.refusals;
+      expect_diag(S, now(), 0, "STOP -> RUN refused: reset request");
+      pause();
+      if (m_h->pair().state(S) != CpuState::Stop)
+        mismatch("the standby left STOP with its reset request pending");
+      since = now();
+      ex.clear();
+      if (!m_h->memory_reset(S)) mismatch("memory reset refused");
+      restart_side(S, since, ex);
+      m_h->switch_to_run(S);
+      begin_step("MRES + RUN " + rack_name(S), true, std::move(ex));
+      break;
+    }
+    case HFault::UpdateBlocked: {
+      // SFC 90 MODE 3 (000 L564, L1281-1285; docs/h-sfc90.md): the standby's link-up runs, then
+      // it waits in LINK-UP - no update, no Redundant, its DP master does not run - until MODE 4
+      // starts the update at that instant (t1 = the call): 38C3 then, the program from + W.
+      stop_standby(name);
+      pause();
+      const bus::Ticks t0 = now();
+      const std::uint16_t rv3 = m_h->h_ctrl(3, 0);
+      begin_step("SFC 90 MODE 3 (update disabled)", false, {});
+      if (rv3 != 0) mismatch("SFC 90 MODE 3 RET_VAL " + std::to_string(rv3) + " (not 0)");
+      for (int r = 0; r < 2; ++r) expect_diag(r, t0, 0, "SFC 90: update disabled");
+      pause();
+      const bus::Ticks t1 = now();
+      m_h->switch_to_run(S);
+      begin_step("RUN " + rack_name(S) + " (LINK-UP, update disabled)", true, {});
+      const bus::Ticks done = t1 + m_params.link_up_time;
+      const bus::Ticks t4 = done + draw(m_o.fault_min, m_o.fault_max);
+      bool left = false;
+      while (now() < t4) {
+        run_to(std::min(t4, now() + 50 * kMs));
+        const SystemMode sm = m_h->pair().system_mode();
+        if (!left && (sm == SystemMode::Update || sm == SystemMode::Redundant)) {
+          left = true;
+          mismatch("system mode " + std::string(to_string(sm)) +
+                   " while the update is disabled (SFC 90 MODE 3)");
+        }
+      }
+      if (m_h->pair().state(S) != CpuState::LinkUp)
+        mismatch("the standby does not wait in LINK-UP with the update disabled");
+      for (int r = 0; r < 2; ++r)
+        expect_diag(r, done, 0, "link-up done: update disabled (SFC 90), waiting");
+      ++m_r.update_waits;
+      // MODE 4: the update from now on, as a link-up that ended now.
+      since = now();
+      restart_side(S, since - m_params.link_up_time, ex);
+      const std::uint16_t rv4 = m_h->h_ctrl(4, 0);
+      begin_step("SFC 90 MODE 4 (update enabled)", true, std::move(ex));
+      if (rv4 != 0) mismatch("SFC 90 MODE 4 RET_VAL " + std::to_string(rv4) + " (not 0)");
+      for (int r = 0; r < 2; ++r) expect_diag(r, since, 0, "SFC 90: update re-enabled");
+      break;
+    }
+    default:
+      break;
+  }
+  return since;
+}
+
 void HCampaignRun::hidden_cycle() {
   // Tamper: the standby CPU off and on again; the observer expects nothing.
   const int S = 1 - m_obs.master;
@@ -1377,7 +1586,12 @@ HCampaignResult HCampaignRun::run() {
   std::discrete_distribution<int> pick(w.begin(), w.end());
   while (m_r.injections() < m_o.steps) {
     run_to(now() + draw(m_o.gap_min, m_o.gap_max));
-    const auto f = static_cast<HFault>(pick(m_rng.engine()));
+    int fi = pick(m_rng.engine());
+    // libstdc++'s discrete_distribution returns the last index for a draw above the rounded
+    // cumulative sum of the positive weights: trailing weights 0 (the four later kinds left
+    // out) must give the 20-kind campaign's draw, the last kind with a weight.
+    while (fi > 0 && w[static_cast<std::size_t>(fi)] == 0) --fi;
+    const auto f = static_cast<HFault>(fi);
     if (index == m_o.tamper.hidden_fault_at) {
       hidden_cycle();
       m_r.faults -= 1;

@@ -1,5 +1,5 @@
 // The seeded H-system fault campaign (devices/h_campaign.hpp), reduced for CI: seed 7, 150
-// injections, and seed 7 with 1 000 injections over all 20 fault kinds (CPU power/STOP of
+// injections, and seed 7 with 1 000 injections over all 24 fault kinds (CPU power/STOP of
 // master and standby, one fibre, both fibres, active/passive IM, short circuit, DP master
 // module, comparison error, one-sided OB 121, operator master swap, and the link-up/update
 // faults: master HOLD, load-memory error, sync error, update timeout, standby lost in LINK-UP,
@@ -60,7 +60,7 @@ TEST(HCampaign, ReducedCampaignHasNoPulseAndNoMismatch) {
   EXPECT_GT(r.ob72, 0);
 }
 
-// >= 1 000 injections: every one of the 20 kinds is drawn, nothing goes wrong, and the counts
+// >= 1 000 injections: every one of the 24 kinds is drawn, nothing goes wrong, and the counts
 // that follow from the draws agree (invariants, not the seed's figures).
 TEST(HCampaign, ThousandInjectionsDrawEveryKindWithoutPulseOrMismatch) {
   HCampaignOptions o = reduced(7, 1000);
@@ -83,15 +83,23 @@ TEST(HCampaign, ThousandInjectionsDrawEveryKindWithoutPulseOrMismatch) {
   EXPECT_GT(r.comparison_stops, 0);
   // One failing update per F19 cycle (failures_max 1).
   EXPECT_EQ(r.update_timeouts, r.drawn[static_cast<int>(HFault::UpdateTimeout)]);
-  // Refusals checked: 2 per HOLD cycle (HOLD in Redundant, RUN in HOLD), 1 per F2 and F23.
+  // Refusals checked: 2 per HOLD cycle (HOLD in Redundant, RUN in HOLD), 1 per F2, F23 and
+  // F5's second fibre (RUN with the reset request).
   EXPECT_EQ(r.refusals, 2 * r.drawn[static_cast<int>(HFault::MasterHold)] +
                             r.drawn[static_cast<int>(HFault::LoadMemoryError)] +
-                            r.drawn[static_cast<int>(HFault::ParameterChangeSwap)]);
-  // Diagnostic entries: HOLD 1, F18 2, F20 1 (6523), F23 2 (5966 on both).
+                            r.drawn[static_cast<int>(HFault::ParameterChangeSwap)] +
+                            r.drawn[static_cast<int>(HFault::SecondFibre)]);
+  // Diagnostic entries: HOLD 1, F18 2, F20 1 (6523), F23 2 (5966 on both); the later kinds: PS
+  // half 2 (3923, 3823), checksum 1, second fibre 3 (both CPUs' entries, the refused RUN),
+  // SFC 90 6 (MODE 3, the wait, MODE 4 on both CPUs).
   EXPECT_EQ(r.diag_checks, r.drawn[static_cast<int>(HFault::MasterHold)] +
                                2 * r.drawn[static_cast<int>(HFault::SyncError)] +
                                r.drawn[static_cast<int>(HFault::StandbyLostDuringLinkUp)] +
-                               2 * r.drawn[static_cast<int>(HFault::ParameterChangeSwap)]);
+                               2 * r.drawn[static_cast<int>(HFault::ParameterChangeSwap)] +
+                               2 * r.drawn[static_cast<int>(HFault::PsHalf)] +
+                               r.drawn[static_cast<int>(HFault::ChecksumError)] +
+                               3 * r.drawn[static_cast<int>(HFault::SecondFibre)] +
+                               6 * r.drawn[static_cast<int>(HFault::UpdateBlocked)]);
 }
 
 // Only comparison errors (seed 5, 10 injections): each cycle without a repeat settles at

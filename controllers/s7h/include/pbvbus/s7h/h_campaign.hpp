@@ -64,6 +64,22 @@
 //   ParameterChangeSwap (F23)          standby STOP, set_standby_parameter_change(true), swap
 //                                      request: refused, W#16#5966 on both, no role change;
 //                                      repair: the change undone, switch_to_run(standby)
+// The kinds of the later fault paths (docs/h-campaign.md "With the new fault kinds"):
+//   PsHalf (F1, PS 407 10A R)          ps_failure(r, h), r and h random: W#16#3923 on r only,
+//                                      no event, no role change; repair ps_repair(r, h):
+//                                      W#16#3823. Drawn half the time: the other half fails too
+//                                      (as MasterPower/StandbyPower); repair: that half replaced
+//                                      (power back: standby, link-up, update), then the first
+//   ChecksumError (001 Table 5-6)      checksum_error(r) in Redundant, r random: r ERROR-SEARCH,
+//                                      OB 72 ChecksumError on the partner (master), re-link and
+//                                      automatic swap to r as F17; repeated on r within 7 days:
+//                                      DEFECTIVE, repair repair_cpu + switch_to_run
+//   SecondFibre (F5, 000 L2594-2597)   cut_fibre(f) (F5), later cut_fibre(1 - f): the standby's
+//                                      reset request, no event; repair: both fibres, RUN refused,
+//                                      memory_reset + switch_to_run
+//   UpdateBlocked (SFC 90 MODE 3/4)    standby STOP, h_ctrl(3, 0), switch_to_run(standby): it
+//                                      waits in LINK-UP (no update, no Redundant) until
+//                                      h_ctrl(4, 0); then the normal update from that instant
 // The observer allows outputs 0 on the switched stations only while no channel reaches them or
 // while, in its model, no CPU runs the program (HOLD, F22); the window ends with the first new
 // counter value. I/O events while no CPU runs a program are no OBs: not expected in events().
@@ -146,8 +162,14 @@ enum class HFault : std::uint8_t {
   StandbyLostDuringLinkUp,  ///< F20/R9: standby off in the load-memory copy -> W#16#6523
   LoadChange,               ///< F22: a structural change in Redundant -> both CPUs STOP
   ParameterChangeSwap,      ///< F23: master swap with a changed parameter -> W#16#5966
+  // The later fault paths (docs/h-campaign.md "With the new fault kinds"); appended, so weights
+  // 0 for these four give the 20-kind campaign's draws.
+  PsHalf,         ///< F1: half of a PS 407 10A R (W#16#3923); sometimes both halves
+  ChecksumError,  ///< 001 Table 5-6: checksum error in Redundant -> ERROR-SEARCH, swap
+  SecondFibre,    ///< F5 second part: the other fibre later -> the standby's reset request
+  UpdateBlocked,  ///< SFC 90 MODE 3: the standby waits in LINK-UP until MODE 4
 };
-inline constexpr int kHFaultKinds = 20;
+inline constexpr int kHFaultKinds = 24;
 std::string_view to_string(HFault f);
 
 struct HCampaignTamper {
@@ -174,9 +196,10 @@ struct HCampaignOptions {
   int steps = 1000;  ///< injections (faults + repairs) to reach; the last cycle is completed
   bus::Baud baud = bus::Baud::k1_5M;
   std::string gsd_dir;  ///< where PBVB0A10/0A11/0A01.gsd are (e.g. <source>/examples/gsd)
-  /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out.
-  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
-                                       1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+  /// Relative weights of the fault kinds (HFault order); 0 leaves a kind out. The last four
+  /// (PsHalf .. UpdateBlocked) at 0 give exactly the 20-kind campaign's draw sequence.
+  std::array<int, kHFaultKinds> weights{1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1,
+                                       1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;
   bus::Ticks self_test_time = 2000 * bus::kTicksPerMs;             ///< ERROR-SEARCH (90 s default)
   bus::Ticks cyclic_self_test_period = 30 * bus::kTicksPerSecond;  ///< 90 min default
@@ -231,7 +254,11 @@ struct HCampaignResult {
   int update_timeouts = 0;                ///< F19 aborts the observer expected
   int refusals = 0;  ///< refused requests checked (HOLD in Redundant, RUN in HOLD/with reset
                      ///< request, F23 swap)
-  int diag_checks = 0;  ///< diagnostic entries checked (6523, 5966, F18's, HOLD's refusal)
+  int diag_checks = 0;  ///< diagnostic entries checked (6523, 5966, F18's, HOLD's refusal,
+                        ///< 3923/3823, the checksum's, F5's second link, SFC 90's)
+  int ps_cpu_failures = 0;     ///< PsHalf cycles in which the second half failed too (F1)
+  int checksum_defective = 0;  ///< ChecksumError cycles that made a CPU DEFECTIVE (repeat)
+  int update_waits = 0;        ///< UpdateBlocked cycles: LINK-UP done, waited for MODE 4
   /// Events of HSystemModel::events() by code (I/O) or OB (72, 121).
   std::array<std::pair<std::uint16_t, int>, 6> io_events{};
   int ob72 = 0, ob121 = 0;

@@ -13,6 +13,7 @@
 //             (checksum error) on CPU 1, Solo
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,37 @@ TEST(HChangesScenario, RunShowsPsHalvesAndChecksumError) {
       {12 * kS, "CPU 0 (rack 0): checksum error in the cyclic self-test"},
   };
   EXPECT_EQ(h.faults, want);
+}
+
+// The scenario's master_swap goes through HConfigChange (docs/h-changes.md "In the H-system
+// model"): CPU 1's switch at STOP; CPU 0 RUN at 1 s (STARTUP 1 s); the swap at 2 s: LINK-UP
+// 2 -> 4 s, UPDATE 4 -> 4.145 s, CPU 1 master (OB 72 master swap), CPU 0 STOP; the cpu_stop's
+// repair at 6 s restarts CPU 0: LINK-UP 6 -> 8 s, UPDATE 8 -> 8.145 s, Redundant, no swap back.
+TEST(HChangesScenario, MasterSwapIsTheSwitchToCpuWithModifiedConfiguration) {
+  const std::string text = R"(name: "h-swap"
+duration: "9s"
+h_system {
+  name: "H-CPU"
+  cpu { cpu0 { power_on: "0s" } cpu1 { power_on: "0s" switch: STOP } }
+}
+fault { at: "2s" master_swap { } }
+fault { at: "5s" repair_at: "6s" cpu_stop { rack: 0 } }
+)";
+  const test::ScenarioRun run = test::run_scenario(text, "h.textproto");
+  ASSERT_TRUE(run.report) << run.error;
+  const HSystemReport& h = run.report->h_systems.at(0);
+  const HCpuReport& c0 = h.cpus[0];
+  const HCpuReport& c1 = h.cpus[1];
+  const auto o = ob72(c1);
+  ASSERT_FALSE(o.empty());
+  EXPECT_EQ(o.front(), (std::pair<bus::Ticks, devices::HReason>{4145 * kMs,
+                                                                devices::HReason::MasterSwap}));
+  const std::string note =
+      "PG/ES: switch to CPU with modified configuration: no blocks copied; data blocks as 5.2.3";
+  const auto is_note = [&](const devices::DiagEntry& d) { return d.at == 2 * kS && d.text == note; };
+  EXPECT_EQ(std::count_if(c0.diag.begin(), c0.diag.end(), is_note), 1);
+  EXPECT_EQ(h.mode, devices::SystemMode::Redundant);
+  EXPECT_EQ(c1.role, devices::CpuRole::Master);
 }
 
 }  // namespace

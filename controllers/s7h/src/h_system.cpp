@@ -63,16 +63,25 @@ void HSystemModel::after_op() {
 
 void HSystemModel::power_on(int r) {
   if (!valid_rack(r)) return;
-  m_pair.power_on(r, m_sched.now());
+  if (m_rp) m_rp->switch_on(r, m_sched.now());  // the RAM test first if unbuffered
+  else m_pair.power_on(r, m_sched.now());
+  rack_power_arm();
   after_op();
 }
 void HSystemModel::power_on_both() {
-  m_pair.power_on_both(m_sched.now());
+  if (m_rp) {  // as HCpuPair::power_on_both: rack 0, then rack 1
+    m_rp->switch_on(0, m_sched.now());
+    m_rp->switch_on(1, m_sched.now());
+  } else {
+    m_pair.power_on_both(m_sched.now());
+  }
+  rack_power_arm();
   after_op();
 }
 void HSystemModel::power_off(int r) {
   if (!valid_rack(r)) return;
-  m_pair.power_off(r, m_sched.now());
+  if (m_rp) m_rp->switch_off(r, m_sched.now());  // also ends a RAM test
+  else m_pair.power_off(r, m_sched.now());
   after_op();
 }
 void HSystemModel::switch_to_run(int r) {
@@ -133,9 +142,9 @@ void HSystemModel::repair_cpu(int r) {
   after_op();
 }
 bool HSystemModel::request_master_swap() {
-  const bool ok = m_pair.request_master_swap(m_sched.now());
-  after_op();
-  return ok;
+  // The operator's swap is the "switch to CPU with modified configuration" with nothing changed
+  // (000 L1120): HConfigChange (h_system_config_change.cpp).
+  return switch_to_cpu(HSwitchVariant::ModifiedConfiguration, {}, {});
 }
 
 // ---- reconciliation ----------------------------------------------------------------------
@@ -162,6 +171,7 @@ void HSystemModel::reconcile() {
     const SideMode to = target(r);
     for (std::size_t s = 0; s < m_systems.size(); ++s) apply(s, r, to);
   }
+  cc_observe();  // the swap, the return to Redundant (h_system_config_change.cpp)
   track_update(m_sched.now());
   deliver_held(m_sched.now());
   sfc90_reconcile(m_sched.now());  // watchdog OBs and S7 jobs held by the update
@@ -279,6 +289,7 @@ void HSystemModel::scan(bus::Ticks now) {
       m_measures.back().first_scan_after == bus::kNever)
     m_measures.back().first_scan_after = now;
   m_last_scan = now;
+  cc_ob1(now);  // OB1_SCAN_1 (h_system_config_change.cpp)
   m_in_scan = true;  // SFC 90 from OB 1: its effect on the pair after this OB 1
   run_program_h_ctrl(now);
   struct ScanEnd {

@@ -48,7 +48,7 @@ bool HSystemModel::ps_repair(int rack, int half) {
   const bool both = h[0] && h[1];
   h[static_cast<std::size_t>(half)] = false;
   if (both) {
-    power_on(rack);  // power returns (the battery kept the memory: no RAM test here)
+    power_on(rack);  // power returns (with set_rack_power: its RAM test rule)
     return true;
   }
   if (m_pair.state(rack) != CpuState::Off)

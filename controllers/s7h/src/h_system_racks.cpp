@@ -248,6 +248,7 @@ void HSystemModel::write_racks(std::span<const std::uint8_t> piq0,
     if (!rack_reachable(k)) continue;  // its modules keep what they had
     RackState& st = m_racks[k];
     const HExpansionRack& cfg = m_rack_cfg[k];
+    if (cfg.side == m_cc_zero_side) continue;  // the new master's first OB 1: still 0
     for (std::size_t m = 0; m < cfg.modules.size(); ++m) {
       if (cfg.modules[m].partition != 0) continue;  // SFC 27 writes it (h_system_sfc90.cpp)
       const HIoEntry* e = m_map.find_central(cfg.number, m);

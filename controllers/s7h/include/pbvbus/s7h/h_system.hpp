@@ -96,11 +96,13 @@
 
 #include "pbvbus/bus/scheduler.hpp"
 #include "pbvbus/bus/time.hpp"
+#include "pbvbus/s7h/h_config_change.hpp"
 #include "pbvbus/s7h/h_connections.hpp"
 #include "pbvbus/s7h/h_cpu_pair.hpp"
 #include "pbvbus/s7h/h_expansion_rack.hpp"
 #include "pbvbus/s7h/h_io_map.hpp"
 #include "pbvbus/s7h/h_program_spec.hpp"
+#include "pbvbus/s7h/h_rack_power.hpp"
 #include "pbvbus/s7cpu/cpu_memory.hpp"
 #include "pbvbus/s7h/h_redundant_execution.hpp"
 #include "pbvbus/s7h/h_redundant_io.hpp"
@@ -717,6 +719,61 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<bus::Ticks> m_returns;
   bool m_was_redundant = false;
   // ---- end SFC 90 ----
+
+  // ---- switch to CPU with modified configuration ---- (h_system_config_change.cpp;
+  // docs/h-changes.md "In the H-system model"). The operator's swap (request_master_swap(), the
+  // scenario's master_swap) is HConfigChange's "switch to CPU with modified configuration" with
+  // nothing changed (000 L1120; §10.4.6 L3364-3388):
+  // - the new master's first OB 1 at or after the swap (t5) has OB1_SCAN_1 = B#16#05, every
+  //   other OB 1 B#16#03 (ob1_scan_1() while the hook runs; first_ob1_after_swap());
+  // - at t5 the new master's central output modules (its expansion racks) are reset to 0 and
+  //   that first OB 1 does not write them: 0 for one OB 1 cycle (000 L3388 "briefly");
+  // - the old master STOPs: its DP master stops (reconcile: side Stop), so its one-sided DP
+  //   slaves go to their fail-safe/substitute values, and its central modules hold their
+  //   values (no longer addressed), until it runs again (Redundant);
+  // - on the return to Redundant one OB 83 W#16#3861 (plug, "to be ignored", 000 L3412) per
+  //   added switched module on both CPUs (source Alarm, rack -1, mdl_addr = its address).
+ public:
+  /// PG/ES "Switch to CPU with ..." now (HConfigChange::request; the variant's checks, refused:
+  /// entries on both CPUs, false). `added_switched`: addresses of the switched modules the new
+  /// configuration adds (OB 83 at the return to Redundant).
+  bool switch_to_cpu(HSwitchVariant v, const HCpuConfig& master, const HCpuConfig& standby,
+                     std::vector<int> added_switched = {});
+  /// The last accepted switch (or the first refused one); nullptr before any request.
+  const HConfigChange* config_change() const { return m_cc.get(); }
+  /// OB1_SCAN_1 of the OB 1 running now (the hook may read it), else of the last one.
+  std::uint8_t ob1_scan_1() const { return m_ob1_scan_1; }
+  /// Start times of the OB 1s with OB1_SCAN_1 = B#16#05.
+  const std::vector<bus::Ticks>& first_ob1_after_swap() const { return m_ob1_after_swap; }
+
+ private:
+  void cc_observe();  ///< from reconcile(): the swap (racks reset), the return to Redundant
+  void cc_ob1(bus::Ticks now);  ///< at each OB 1 start: OB1_SCAN_1, the zero cycle
+  std::unique_ptr<HConfigChange> m_cc;
+  std::uint8_t m_ob1_scan_1 = kOb1ScanFreeCycle;
+  int m_cc_zero_side = -1;  ///< this OB 1 leaves that side's racks' outputs at 0
+  bool m_cc_swap_done = false;
+  bool m_cc_ob83_done = false;
+  std::vector<bus::Ticks> m_ob1_after_swap;
+  // ---- end switch to CPU with modified configuration ----
+
+  // ---- the racks' power supply, RAM test ---- (h_system_rack_power.cpp; docs/h-changes.md
+  // "In the H-system model")
+ public:
+  /// From now on power_on(), power_on_both() and power_off() go through an HRackPower on the
+  /// pair (h_rack_power.hpp): an unbuffered POWER ON (the first one, or a rack without backup
+  /// battery) with ram_kb > 0 runs the RAM test, ram_kb x 8 s / 1024 (000 L640, 001
+  /// L1149-1153), and the pair powers the CPU only at its end; during it the CPU is off. Call it
+  /// before the first power-on (replaces an earlier one).
+  void set_rack_power(HRackPowerParams p);
+  /// nullptr until set_rack_power().
+  const HRackPower* rack_power() const { return m_rp.get(); }
+
+ private:
+  void rack_power_arm();  ///< a scheduler event at the end of the next RAM test
+  std::unique_ptr<HRackPower> m_rp;
+  bus::Ticks m_rp_armed = bus::kNever;
+  // ---- end the racks' power supply ----
 };
 
 }  // namespace pbvbus::devices

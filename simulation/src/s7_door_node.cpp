@@ -74,11 +74,29 @@ class S7DoorNode::MpiChannel final : public iso_on_tcp::S7Channel {
   Closed m_closed;
 };
 
-/// A client connection to an H-system over one of the model's S7 sessions.
+/// A client connection to an H-system over one of the model's S7 sessions. A job the model
+/// holds during an update (t1..t5, 000 L1673-1680; docs/h-sfc90.md "held jobs") waits in a FIFO
+/// of replies and is answered through the session's late-answer sink at t5 (or the abort), in
+/// arrival order; an empty late answer (the session ended meanwhile) closes the connection.
 class S7DoorNode::HChannel final : public iso_on_tcp::S7Channel {
  public:
-  explicit HChannel(devices::HS7Session s) : m_s(std::move(s)) {}
+  explicit HChannel(devices::HS7Session s) : m_s(std::move(s)) {
+    m_s.on_late_answer([this](std::vector<std::uint8_t> answer) { late(std::move(answer)); });
+  }
+  ~HChannel() override { m_s.on_late_answer(nullptr); }  // the held jobs are dropped
+  HChannel(const HChannel&) = delete;
+  HChannel& operator=(const HChannel&) = delete;
+
   void request(std::vector<std::uint8_t> pdu, Reply reply) override {
+    if (m_s.holds_jobs_now()) {
+      m_held.push_back(std::move(reply));
+      auto answer = m_s.handle(pdu);
+      if (answer.empty()) return;  // stored: answered by late()
+      auto r = std::move(m_held.back());  // answered after all (defensive)
+      m_held.pop_back();
+      r(std::move(answer));
+      return;
+    }
     if (m_s.alive()) {
       auto answer = m_s.handle(pdu);
       if (m_s.alive() || !answer.empty()) {
@@ -86,17 +104,34 @@ class S7DoorNode::HChannel final : public iso_on_tcp::S7Channel {
         return;
       }
     }
-    // The connection ended with its CPU (or CP, or at a link-up): the client gets a DR.
+    ended();
+  }
+  void on_closed(Closed closed) override { m_closed = std::move(closed); }
+
+ private:
+  void late(std::vector<std::uint8_t> answer) {
+    if (m_held.empty()) return;  // an answer nobody waits for: dropped
+    if (answer.empty() && !m_s.alive()) {
+      ended();
+      return;
+    }
+    auto r = std::move(m_held.front());
+    m_held.pop_front();
+    r(std::move(answer));
+  }
+  // The connection ended with its CPU (or CP, or at a link-up), also with jobs still held: the
+  // client gets a DR, no reply is left hanging.
+  void ended() {
+    m_held.clear();
     if (m_closed) {
       auto c = std::move(m_closed);
       m_closed = nullptr;
       c(m_s.close_text());
     }
   }
-  void on_closed(Closed closed) override { m_closed = std::move(closed); }
 
- private:
   devices::HS7Session m_s;
+  std::deque<Reply> m_held;
   Closed m_closed;
 };
 

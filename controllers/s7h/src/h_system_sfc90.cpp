@@ -139,14 +139,17 @@ std::uint16_t HSystemModel::updat_po(int part) {
 
 // ---- held S7 jobs --------------------------------------------------------------------------
 
-bool HSystemModel::s7_hold(std::uint32_t id, std::span<const std::uint8_t> pdu) {
+bool HSystemModel::s7_holds(std::uint32_t id) const {
   if (!m_pair.interrupts_held()) return false;
-  for (const auto& [sid, sink] : m_sinks) {
-    if (sid != id || !sink) continue;
-    m_held_jobs.push_back({id, std::vector<std::uint8_t>(pdu.begin(), pdu.end())});
-    return true;
-  }
+  for (const auto& [sid, sink] : m_sinks)
+    if (sid == id && sink) return true;
   return false;
+}
+
+bool HSystemModel::s7_hold(std::uint32_t id, std::span<const std::uint8_t> pdu) {
+  if (!s7_holds(id)) return false;
+  m_held_jobs.push_back({id, std::vector<std::uint8_t>(pdu.begin(), pdu.end())});
+  return true;
 }
 
 void HSystemModel::s7_set_sink(std::uint32_t id,
@@ -161,6 +164,10 @@ void HSystemModel::s7_set_sink(std::uint32_t id,
 
 void HS7Session::on_late_answer(std::function<void(std::vector<std::uint8_t>)> sink) {
   if (m_model != nullptr) m_model->s7_set_sink(m_id, std::move(sink));
+}
+
+bool HS7Session::holds_jobs_now() const {
+  return alive() && m_model->s7_holds(m_id);  // alive(): s7_handle stores only then
 }
 
 }  // namespace pbvbus::devices

@@ -78,6 +78,9 @@ class HS7Session {
   /// stored, handle() answers nothing, and the answer goes to `sink` when the update ends (000
   /// L1673-1680; docs/h-sfc90.md). Without a sink every job is answered at once.
   void on_late_answer(std::function<void(std::vector<std::uint8_t>)> sink);
+  /// True when a job handed to handle() now would be stored and answered through the sink
+  /// (the rule of on_late_answer: a sink is registered and the update is in [t1, t5)).
+  bool holds_jobs_now() const;
   /// Closes it (Closed) and releases the connection; idempotent.
   void close();
   std::uint32_t id() const { return m_id; }

@@ -704,6 +704,7 @@ class HSystemModel final : public bus::EventTarget {
   void run_program_h_ctrl(bus::Ticks now);  ///< a ProgramSpec's h_ctrl_calls due at this OB 1
   void after_scan_h_ctrl();
   bool s7_hold(std::uint32_t id, std::span<const std::uint8_t> pdu);
+  bool s7_holds(std::uint32_t id) const;  ///< s7_hold's rule: a job arriving now is stored
   void s7_set_sink(std::uint32_t id, std::function<void(std::vector<std::uint8_t>)> sink);
   HSelfTestControl m_self_test;
   std::vector<HCtrlRecord> m_hctrl_calls;

@@ -89,6 +89,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -745,8 +746,25 @@ class HSystemModel final : public bus::EventTarget {
   std::uint8_t ob1_scan_1() const { return m_ob1_scan_1; }
   /// Start times of the OB 1s with OB1_SCAN_1 = B#16#05.
   const std::vector<bus::Ticks>& first_ob1_after_swap() const { return m_ob1_after_swap; }
+  /// The 000 §5.2.3 attributes (HDbBlock) of `rack`'s DBs: the standby's are the new
+  /// configuration's (h_system_db_copy.cpp). Set for both racks, a ModifiedConfiguration switch
+  /// applies plan_modified_configuration_copy() to the DBs of set_s7_memory(); else the update
+  /// copies every DB (as before).
+  void set_db_blocks(int rack, std::vector<HDbBlock> blocks);
+  /// DB `number` in `rack`'s memory area (empty: not configured).
+  std::span<std::uint8_t> s7_db(int rack, std::uint16_t number);
+  /// The copy plan of the last accepted ModifiedConfiguration switch with blocks set.
+  const std::optional<HModifiedConfigCopy>& db_copy_plan() const { return m_cc_plan; }
 
  private:
+  std::span<std::uint8_t> s7_work_area(int rack);
+  /// At the request: the plan (aborted: refused), the standby's memory kept aside.
+  bool cc_plan_db_copy(const HCpuConfig& standby);
+  void cc_apply_db_copy(int old_master, int new_master);  ///< at the update's copy (once)
+  std::array<std::vector<HDbBlock>, 2> m_cc_blocks;
+  std::array<bool, 2> m_cc_blocks_set{false, false};
+  std::optional<HModifiedConfigCopy> m_cc_plan;
+  std::vector<std::uint8_t> m_cc_standby_mem;
   void cc_observe();  ///< from reconcile(): the swap (racks reset), the return to Redundant
   void cc_ob1(bus::Ticks now);  ///< at each OB 1 start: OB1_SCAN_1, the zero cycle
   std::unique_ptr<HConfigChange> m_cc;

@@ -100,6 +100,36 @@ TEST(HSystemPower, ParamTransferMonitoringW6547OnTheMastersStartUp) {
   EXPECT_EQ(s.h->pair().state(0), CpuState::Run);
 }
 
+// The same started by the model (set_param_transfer_time, h_system_dp_startup.cpp): CPU 0
+// enters STARTUP at kT0, monitoring 10 x 100 ms = 1 s -> W#16#6547 at kT0 + 1 s naming station
+// 10 (switched off); CPU 1's own monitoring starts at its UPDATE (kUpdate) and ends at
+// kUpdate + 1 s with every station of line B in data exchange: no entry there.
+TEST(HSystemPower, ModelStartsParamTransferMonitoringW6547) {
+  HSys s;
+  s.line[0].set_power(s.one_att[0], false);
+  s.h->set_param_transfer_time(10);
+  EXPECT_EQ(s.h->param_transfer_time_100ms(), 10u);
+  s.at(kT0);
+  s.h->power_on_both();
+  const bus::Ticks end = kT0 + 1000 * kMs;
+  s.run_until(end - kMs);
+  EXPECT_EQ(count_code(s.h->diag_buffer(0), 0x6547), 0);
+  s.run_until(end);
+  int n = 0;
+  for (const auto& d : s.h->diag_buffer(0))
+    if (d.code == 0x6547) {
+      ++n;
+      EXPECT_EQ(d.at, end);
+      EXPECT_EQ(d.text, "transfer of parameters to modules: monitoring time exceeded, stations 10");
+    }
+  EXPECT_EQ(n, 1);
+  EXPECT_EQ(s.h->param_transfer_late(0), (std::vector<std::uint8_t>{kOneA}));
+  s.run_until(kUpdate + 1100 * kMs);
+  EXPECT_EQ(count_code(s.h->diag_buffer(1), 0x6547), 0);
+  EXPECT_TRUE(s.h->param_transfer_late(1).empty());
+  EXPECT_EQ(count_code(s.h->diag_buffer(0), 0x6547), 1);
+}
+
 // ---- the switch to CPU with modified configuration on the model (docs/h-changes.md "In the
 // H-system model"; 000 §10.4.6 L3364-3388, §10.4.7 L3400-3416) ----
 

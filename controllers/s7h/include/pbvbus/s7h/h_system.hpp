@@ -792,6 +792,28 @@ class HSystemModel final : public bus::EventTarget {
   std::unique_ptr<HRackPower> m_rp;
   bus::Ticks m_rp_armed = bus::kNever;
   // ---- end the racks' power supply ----
+
+  // ---- "transfer of parameters to modules", W#16#6547 ---- (h_system_dp_startup.cpp;
+  // h_dp_startup.hpp; docs/h-changes.md "In the H-system model")
+ public:
+  /// The monitoring time in 100 ms units (001 L8094-8114; recommended 600 = 60 s); 0 = off (the
+  /// default: the model's earlier behaviour). From then on each CPU's STARTUP and each standby's
+  /// UPDATE (its DP master starts parameterising, 001 Fig. 6-1) starts it over the stations its
+  /// DP master(s) configure; a station not in data exchange at the end: W#16#6547 on that CPU.
+  void set_param_transfer_time(std::uint32_t units_100ms);
+  std::uint32_t param_transfer_time_100ms() const { return m_ptt; }
+  /// The late stations of `rack`'s last ended monitoring (empty: in time, or none ended).
+  const std::vector<std::uint8_t>& param_transfer_late(int rack) const {
+    return m_ptt_late[rack == 1 ? 1 : 0];
+  }
+
+ private:
+  void ptt_on_pair_event(const HEvent& e);
+  void ptt_end(int rack, std::uint64_t gen, bus::Ticks start);
+  std::uint32_t m_ptt = 0;
+  std::array<std::uint64_t, 2> m_ptt_gen{0, 0};
+  std::array<std::vector<std::uint8_t>, 2> m_ptt_late;
+  // ---- end "transfer of parameters to modules" ----
 };
 
 }  // namespace pbvbus::devices

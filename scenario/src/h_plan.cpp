@@ -175,6 +175,7 @@ class HPlanner {
     p.comparison_reaction = c.comparison_reaction() == scenario::HCpuPair::STOP
                                 ? devices::ComparisonReaction::Stop
                                 : devices::ComparisonReaction::ErrorSearch;
+    rt.param_transfer_time_100ms = c.param_transfer_time_100ms();  // 001 L8094-8114
 
     // The driven systems: dp_system entries naming a redundant_master_system, each once.
     for (std::size_t k = 0; k < hp.dp_systems.size(); ++k) {

@@ -75,6 +75,7 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   try {
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
     m_model->set_max_cycle_time(rt.max_cycle_time);
+    m_model->set_param_transfer_time(rt.param_transfer_time_100ms);  // W#16#6547
     if (has_networks(rt.program)) m_model->set_program(rt.program);
     if (!rt.redundant_io.empty()) {  // docs/h-redundant-io.md
       std::vector<devices::HSystemModel::RedIoPair> pairs;

@@ -145,5 +145,19 @@ fault { at: "5s" repair_at: "6s" cpu_stop { rack: 0 } }
   EXPECT_EQ(c1.role, devices::CpuRole::Master);
 }
 
+
+// HCpuPair.param_transfer_time_100ms (001 L8094-8114; docs/h-changes.md) reaches the runtime
+// plan as given; unset = 0 = off.
+TEST(HChangesScenario, ParamTransferTimeIsPlanned) {
+  const auto r = parse_scenario(R"(h_system { name: "H" cpu { param_transfer_time_100ms: 600 } })",
+                                "h.textproto");
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  ASSERT_TRUE(r.plan->h_systems.at(0).runtime.has_value());
+  EXPECT_EQ(r.plan->h_systems.at(0).runtime->param_transfer_time_100ms, 600u);
+  const auto d = parse_scenario(R"(h_system { name: "H" cpu { } })", "h.textproto");
+  ASSERT_TRUE(d.ok()) << d.errors[0].str();
+  EXPECT_EQ(d.plan->h_systems.at(0).runtime->param_transfer_time_100ms, 0u);
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -335,6 +335,7 @@ void HSystemModel::add_event(HSystemEvent e) {
 void HSystemModel::on_pair_event(const HEvent& e) {
   if (m_pair_handler) m_pair_handler(e);
   if (m_red_io) red_io_on_pair_event(e);  // OB 100 / OB 72 Redundant: depassivation
+  ptt_on_pair_event(e);  // W#16#6547 monitoring (h_system_dp_startup.cpp)
   if (e.kind != HEvent::Kind::Ob) return;
   HSystemEvent h;
   h.time = e.at;

@@ -23,6 +23,11 @@ bool HSystemModel::switch_to_cpu(HSwitchVariant v, const HCpuConfig& master,
   // "Briefly" 0 (000 L3388): one OB 1 cycle of this model (h_config_change.hpp's decision).
   p.first_cycle_time = m_scan_time;
   auto cc = std::make_unique<HConfigChange>(m_pair, p);
+  // 000 §5.2.3: the DB copy plan (h_system_db_copy.cpp); aborted = refused.
+  if (v == HSwitchVariant::ModifiedConfiguration && !cc_plan_db_copy(standby)) {
+    after_op();
+    return false;
+  }
   const bool ok = cc->request(v, master, standby, m_sched.now(), std::move(added_switched));
   if (ok || !m_cc) {  // a refusal keeps a switch still running (its OB 83 is owed)
     m_cc = std::move(cc);

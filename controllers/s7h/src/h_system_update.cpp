@@ -31,6 +31,7 @@ void HSystemModel::track_update(bus::Ticks now) {
     m.standby_operate_from = now;
     if (m_exec) m_exec->copy_state(1 - m.standby, m.standby);
     s7_copy_update(1 - m.standby, m.standby);  // counters, timers (and M/DBs without a spec)
+    cc_apply_db_copy(1 - m.standby, m.standby);  // 000 §5.2.3 (h_system_db_copy.cpp)
   }
   if (!running) m.done = true;
 }

@@ -77,6 +77,8 @@ struct HRuntimePlan {
   std::vector<devices::HExpansionRack> racks;
   bus::Ticks max_cycle_time = 150 * bus::kTicksPerMs;
   std::vector<HRedIoPlan> redundant_io;  ///< plan_redundant_io
+  /// HCpuPair.param_transfer_time_100ms (0 = off; HSystemModel::set_param_transfer_time).
+  std::uint32_t param_transfer_time_100ms = 0;
 };
 
 struct HSystemPlan {

@@ -89,6 +89,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -746,8 +747,25 @@ class HSystemModel final : public bus::EventTarget {
   std::uint8_t ob1_scan_1() const { return m_ob1_scan_1; }
   /// Start times of the OB 1s with OB1_SCAN_1 = B#16#05.
   const std::vector<bus::Ticks>& first_ob1_after_swap() const { return m_ob1_after_swap; }
+  /// The 000 §5.2.3 attributes (HDbBlock) of `rack`'s DBs: the standby's are the new
+  /// configuration's (h_system_db_copy.cpp). Set for both racks, a ModifiedConfiguration switch
+  /// applies plan_modified_configuration_copy() to the DBs of set_s7_memory(); else the update
+  /// copies every DB (as before).
+  void set_db_blocks(int rack, std::vector<HDbBlock> blocks);
+  /// DB `number` in `rack`'s memory area (empty: not configured).
+  std::span<std::uint8_t> s7_db(int rack, std::uint16_t number);
+  /// The copy plan of the last accepted ModifiedConfiguration switch with blocks set.
+  const std::optional<HModifiedConfigCopy>& db_copy_plan() const { return m_cc_plan; }
 
  private:
+  std::span<std::uint8_t> s7_work_area(int rack);
+  /// At the request: the plan (aborted: refused), the standby's memory kept aside.
+  bool cc_plan_db_copy(const HCpuConfig& standby);
+  void cc_apply_db_copy(int old_master, int new_master);  ///< at the update's copy (once)
+  std::array<std::vector<HDbBlock>, 2> m_cc_blocks;
+  std::array<bool, 2> m_cc_blocks_set{false, false};
+  std::optional<HModifiedConfigCopy> m_cc_plan;
+  std::vector<std::uint8_t> m_cc_standby_mem;
   void cc_observe();  ///< from reconcile(): the swap (racks reset), the return to Redundant
   void cc_ob1(bus::Ticks now);  ///< at each OB 1 start: OB1_SCAN_1, the zero cycle
   std::unique_ptr<HConfigChange> m_cc;
@@ -775,6 +793,28 @@ class HSystemModel final : public bus::EventTarget {
   std::unique_ptr<HRackPower> m_rp;
   bus::Ticks m_rp_armed = bus::kNever;
   // ---- end the racks' power supply ----
+
+  // ---- "transfer of parameters to modules", W#16#6547 ---- (h_system_dp_startup.cpp;
+  // h_dp_startup.hpp; docs/h-changes.md "In the H-system model")
+ public:
+  /// The monitoring time in 100 ms units (001 L8094-8114; recommended 600 = 60 s); 0 = off (the
+  /// default: the model's earlier behaviour). From then on each CPU's STARTUP and each standby's
+  /// UPDATE (its DP master starts parameterising, 001 Fig. 6-1) starts it over the stations its
+  /// DP master(s) configure; a station not in data exchange at the end: W#16#6547 on that CPU.
+  void set_param_transfer_time(std::uint32_t units_100ms);
+  std::uint32_t param_transfer_time_100ms() const { return m_ptt; }
+  /// The late stations of `rack`'s last ended monitoring (empty: in time, or none ended).
+  const std::vector<std::uint8_t>& param_transfer_late(int rack) const {
+    return m_ptt_late[rack == 1 ? 1 : 0];
+  }
+
+ private:
+  void ptt_on_pair_event(const HEvent& e);
+  void ptt_end(int rack, std::uint64_t gen, bus::Ticks start);
+  std::uint32_t m_ptt = 0;
+  std::array<std::uint64_t, 2> m_ptt_gen{0, 0};
+  std::array<std::vector<std::uint8_t>, 2> m_ptt_late;
+  // ---- end "transfer of parameters to modules" ----
 };
 
 }  // namespace pbvbus::devices

@@ -341,6 +341,11 @@ class HCampaignRun {
   /// CPU r (standby) starts its link-up at t0: its DP master runs from the UPDATE on (38C3),
   /// its program from the end of the update.
   void restart_side(int r, bus::Ticks t0, std::vector<Expect>& ex);
+  /// CPU r goes to ERROR-SEARCH at t (OB 121 on it alone, F17, or a checksum error): the
+  /// partner runs on as master, r's side is lost; unless `repeated` (-> DEFECTIVE), r re-links
+  /// after the self-test and the automatic swap makes it master (R5), with OB 72 MasterSwap on
+  /// both. A comparison error within the first self-test cycle after that swap repeats (swap_at).
+  void expect_error_search(int r, bus::Ticks t, bool repeated, std::vector<Expect>& ex);
   void switch_away(int l);
   void set_master(int m) {
     if (m != m_obs.master) ++m_r.role_swaps;
@@ -692,6 +697,21 @@ void HCampaignRun::lose_side(int r, bus::Ticks t, std::vector<Expect>& ex) {
   ex.push_back(io(0x39C3, r, 0xFF, t, t));
   for (int k = 0; k < 2; ++k)
     if (m_obs.act[k] == r && m_obs.iface_ok[k][1 - r] && m_obs.line_ok(1 - r)) m_obs.act[k] = 1 - r;
+}
+
+void HCampaignRun::expect_error_search(int r, bus::Ticks t, bool repeated,
+                                      std::vector<Expect>& ex) {
+  const int p = 1 - r;
+  m_obs.prog_until[r] = t;
+  set_master(p);
+  lose_side(r, t, ex);
+  if (repeated) return;
+  restart_side(r, t + m_o.self_test_time, ex);
+  const bus::Ticks te = m_obs.prog_from[r];
+  ex.push_back(cpu_ob(72, r, CpuRole::Master, HReason::MasterSwap, te));
+  ex.push_back(cpu_ob(72, p, CpuRole::Standby, HReason::MasterSwap, te));
+  m_obs.swap_at = te;
+  set_master(r);
 }
 
 void HCampaignRun::restart_side(int r, bus::Ticks t0, std::vector<Expect>& ex) {
@@ -1056,17 +1076,7 @@ void HCampaignRun::cycle(HFault f) {
       ex.push_back(
           cpu_ob(121, r, r == M ? CpuRole::Master : CpuRole::Standby, HReason::OneSidedOb121, t));
       ex.push_back(cpu_ob(72, p, CpuRole::Master, HReason::OneSidedOb121, t));
-      m_obs.prog_until[r] = t;
-      set_master(p);
-      lose_side(r, t, ex);
-      if (!repeated) {
-        restart_side(r, t + m_o.self_test_time, ex);
-        const bus::Ticks te = m_obs.prog_from[r];
-        ex.push_back(cpu_ob(72, r, CpuRole::Master, HReason::MasterSwap, te));
-        ex.push_back(cpu_ob(72, p, CpuRole::Standby, HReason::MasterSwap, te));
-        m_obs.swap_at = te;
-        set_master(r);
-      }
+      expect_error_search(r, t, repeated, ex);
       if (!m_h->one_sided_ob121(r))
         m_r.mismatches.push_back(fmt_time(t) + ": one-sided OB 121 refused in Redundant mode");
       begin_step(name + ": " + rack_name(r) + (repeated ? " (again: DEFECTIVE)" : ""), false,
@@ -1437,17 +1447,7 @@ bus::Ticks HCampaignRun::cycle_later(HFault f) {
           m_obs.last_checksum[r] && t - *m_obs.last_checksum[r] <= kDefectiveWindow;
       m_obs.last_checksum[r] = t;
       ex.push_back(cpu_ob(72, p, CpuRole::Master, HReason::ChecksumError, t));
-      m_obs.prog_until[r] = t;
-      set_master(p);
-      lose_side(r, t, ex);
-      if (!repeated) {
-        restart_side(r, t + m_o.self_test_time, ex);
-        const bus::Ticks te = m_obs.prog_from[r];
-        ex.push_back(cpu_ob(72, r, CpuRole::Master, HReason::MasterSwap, te));
-        ex.push_back(cpu_ob(72, p, CpuRole::Standby, HReason::MasterSwap, te));
-        m_obs.swap_at = te;  // a comparison error within the first self-test cycle: repeat
-        set_master(r);
-      }
+      expect_error_search(r, t, repeated, ex);
       const bool ok = m_h->checksum_error(r);
       begin_step(name + ": " + rack_name(r) + (repeated ? " (again: DEFECTIVE)" : ""), false,
                  std::move(ex));

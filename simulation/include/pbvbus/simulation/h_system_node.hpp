@@ -69,6 +69,11 @@ class HSystemNode {
   /// master system \"H-DP 1\", line DP_B".
   std::string io_event_text(const devices::HSystemEvent& e) const;
   void note(std::string text);
+  // ---- docs/h-scenario-changes.md (h_system_node_changes.cpp) ----
+  void setup_changes();   ///< constructor: RAM test, OB 72's SFC 27
+  void start_changes();   ///< start(): the watchdog OBs at their phase
+  std::string apply_switch(const PlanFault& f);  ///< switch_to_cpu: "" or ": refused ..."
+  void report_changes(HSystemReport& r) const;   ///< OB1_SCAN_1 B#16#05, OB 72's SFC 27
 
   const ScenarioPlan& m_plan;
   int m_index;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "scenario_run_support.hpp"
@@ -340,6 +341,35 @@ fault { at: "1s" switch_to_cpu { added_module { system: "X" address: 3 } changed
   };
   std::sort(want.begin(), want.end());
   EXPECT_EQ(got, want);
+}
+
+}  // namespace
+}  // namespace pbvbus::tools
+
+namespace pbvbus::tools {
+namespace {
+
+// examples/h-changes.textproto: its header's story (startup 1 s, T8 link-up 2 s, update 145 ms).
+TEST(HScenarioFields, TheExampleRuns) {
+  const auto loaded = load_scenario_file(PBVBUS_SOURCE_DIR "/examples/h-changes.textproto");
+  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
+  EXPECT_EQ(loaded.plan->h_systems.at(0).runtime->pair.link_up_time, 2 * kS);
+  Simulation sim(*loaded.plan);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(1.0);
+  const HSystemReport& h = rep.h_systems.at(0);
+  std::vector<std::tuple<bus::Ticks, int, std::uint16_t>> rows;
+  for (const HIoEvent& e : h.io_events)
+    if (e.ob == 1 || e.ob == 72 || e.ob == 83) rows.emplace_back(e.at, e.ob, e.mdl_addr.value_or(0));
+  EXPECT_EQ(rows, (std::vector<std::tuple<bus::Ticks, int, std::uint16_t>>{
+                      {3645 * kMs, 1, 0}, {6645 * kMs, 83, 2}, {6645 * kMs, 72, 0}}));
+  EXPECT_EQ(h.mode, devices::SystemMode::Redundant);
+  EXPECT_EQ(h.cpus[1].role, devices::CpuRole::Master);
+  const devices::HSystemModel& m = sim.h_system(0).model();
+  ASSERT_TRUE(m.db_copy_plan().has_value());
+  EXPECT_EQ(m.db_copy_plan()->copied, (std::vector<int>{1}));
+  EXPECT_EQ(m.db_copy_plan()->sfb_reset, (std::vector<int>{3}));
 }
 
 }  // namespace

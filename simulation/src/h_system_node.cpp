@@ -175,6 +175,7 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
       if (on ? !m.hold(f.rack) : !m.release_hold(f.rack)) text += ": refused";
       break;
     case K::HMasterSwap:
+      equal_db_blocks();  // nothing changed (docs/h-scenario-changes.md)
       if (!m.request_master_swap()) text += ": refused";
       break;
     case K::HSwitchToCpu: text += apply_switch(f); break;  // docs/h-scenario-changes.md

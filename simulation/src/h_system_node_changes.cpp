@@ -75,6 +75,7 @@ std::string HSystemNode::apply_switch(const PlanFault& f) {
         b.interface_stamp = 2;
     m.set_db_blocks(master, c.db_blocks);
     m.set_db_blocks(1 - master, std::move(standby));
+    m_db_blocks_set = true;
   }
   // Added switched modules: OB 83's MDL_ADDR is the module's logical address (its first PII
   // octet, or PIQ octet for an output-only module) in the model's I/O map.
@@ -89,6 +90,14 @@ std::string HSystemNode::apply_switch(const PlanFault& f) {
   if (!m.switch_to_cpu(s.variant, s.master, s.standby, added))
     text += ": refused (the reason is in the diagnostic buffers)";
   return text;
+}
+
+void HSystemNode::equal_db_blocks() {
+  // After a switch_to_cpu both CPUs run the new configuration: a later swap (the switch with
+  // nothing changed, 000 L1120) sees the same interface stamps on both sides.
+  const HChangesPlan& c = plan().runtime->changes;
+  if (!m_db_blocks_set || c.db_blocks.empty()) return;
+  for (int r = 0; r < 2; ++r) m_model->set_db_blocks(r, c.db_blocks);
 }
 
 void HSystemNode::report_changes(HSystemReport& r) const {

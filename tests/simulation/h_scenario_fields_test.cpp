@@ -210,6 +210,30 @@ TEST(HScenarioFields, SwitchToCpuRunShowsOb1Scan1OutputsAndOb83) {
             "PG/ES: switch to CPU with modified configuration (added modules at 2) (changed DBs 2, 3)");
 }
 
+// After the switch both CPUs run the new configuration: a later master_swap (the switch with
+// nothing changed, 000 L1120) copies every DB. The run above, then CPU 0 (standby) to STOP at 2 s
+// (Solo) and the swap at 2.1 s: LINK-UP 2.1 -> 2.6 s, UPDATE -> 2.745 s, CPU 0 master again.
+TEST(HScenarioFields, MasterSwapAfterTheSwitchCopiesEveryDb) {
+  std::string text = switch_text("variant: MODIFIED_CONFIGURATION");
+  text.replace(text.find("duration: \"2s\""), 15, "duration: \"3s\"");
+  text += "fault { at: \"2s\" cpu_stop { rack: 0 } }\nfault { at: \"2100ms\" master_swap { } }\n";
+  const auto loaded = parse_scenario(text, kFile);
+  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
+  Simulation sim(*loaded.plan);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const devices::HSystemModel& m = sim.h_system(0).model();
+  ASSERT_TRUE(m.db_copy_plan().has_value());
+  EXPECT_EQ(m.db_copy_plan()->copied, (std::vector<int>{1, 2, 3}));
+  EXPECT_TRUE(m.db_copy_plan()->sfb_reset.empty());
+  const Report rep = sim.report(1.0);
+  bool swap_back = false;
+  for (const auto& t : rep.h_systems.at(0).cpus[0].timeline)
+    swap_back |= t.kind == devices::HEvent::Kind::Ob && t.ob == 72 && t.at == 2745 * kMs &&
+                 t.reason == devices::HReason::MasterSwap;
+  EXPECT_TRUE(swap_back);
+}
+
 // Expanded memory without a larger memory is refused at the request (000 L1134-1138): the
 // standby stays in STOP, no swap.
 TEST(HScenarioFields, SwitchToCpuRefusedVariantKeepsTheMaster) {

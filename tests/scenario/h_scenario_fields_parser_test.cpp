@@ -82,5 +82,16 @@ fault { at: "1s" repair_at: "2s" switch_to_cpu { } }
   EXPECT_EQ(got, want);
 }
 
+// The S7-1500R/H profile has no operator master swap (docs/h-system.md rule 13): refused at the
+// fault's kind, `fault { at: "1s" ` 17 characters -> col 18.
+TEST(HScenarioFieldsParser, SwitchToCpuIsRefusedInThe1500Profile) {
+  const auto r = parse_scenario(R"(h_system { name: "H" cpu { profile: S7_1500RH } }
+fault { at: "1s" switch_to_cpu { } }
+)",
+                                "h.textproto");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].str(), "h.textproto:2:18: switch_to_cpu: the S7-1500R/H profile has no operator master swap");
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -201,6 +201,9 @@ class HPlanner {
     if (!c.max_cycle_time().empty())
       if (auto t = ticks(i, {{"cpu"}, {"max_cycle_time"}}, c.max_cycle_time(), true))
         rt.max_cycle_time = *t;
+    plan_h_changes(m_plan, i, rt, [&](std::vector<HPathStep> path, std::string msg) {
+      error_at(i, path, std::move(msg));
+    });  // docs/h-scenario-changes.md
 
     // A simulated pair must not run on a bad set of H parameters.
     try {

@@ -838,6 +838,7 @@ class Planner {
       case FK::kRedDepa: info = {K::RedDepa, "red_depa", false}; break;  // redundant I/O
       case FK::kChecksumError: info = {K::ChecksumError, "checksum_error", false}; break;
       case FK::kPsFailure: info = {K::PsFailure, "ps_failure", true}; break;
+      case FK::kSwitchToCpu: info = {K::HSwitchToCpu, "switch_to_cpu", false}; break;
       default: return false;
     }
     pf.kind = info.kind;
@@ -873,6 +874,7 @@ class Planner {
       case FK::kFibresCut: h_name = f.fibres_cut().h_system(); break;
       case FK::kComparisonError: h_name = f.comparison_error().h_system(); break;
       case FK::kMasterSwap: h_name = f.master_swap().h_system(); break;
+      case FK::kSwitchToCpu: h_name = f.switch_to_cpu().h_system(); break;
       case FK::kParameterChange: h_name = f.parameter_change().h_system(); break;
       case FK::kUpdateLoad: h_name = f.update_load().h_system(); break;
       case FK::kProgramChange: h_name = f.program_change().h_system(); break;
@@ -930,7 +932,7 @@ class Planner {
     // that asks for them is wrong, not a run that shows a refusal.
     const auto& rt = *plan.h_systems[static_cast<std::size_t>(found)].runtime;
     if (rt.pair.profile == devices::HProfile::S7_1500RH &&
-        (pf.kind == K::CpuHold || pf.kind == K::HMasterSwap)) {
+        (pf.kind == K::CpuHold || pf.kind == K::HMasterSwap || pf.kind == K::HSwitchToCpu)) {
       error(kw, kind + ": the S7-1500R/H profile has no " +
                     (pf.kind == K::CpuHold ? std::string("HOLD") : std::string("operator master swap")));
       return false;
@@ -956,6 +958,25 @@ class Planner {
         return false;
       }
       pf.fibre = static_cast<int>(*fibre);
+    }
+    if (pf.kind == K::HSwitchToCpu) {  // docs/h-scenario-changes.md (h_changes_plan.cpp)
+      HSwitchPlan sp;
+      const auto err = [&](std::vector<HPathStep> path, std::string msg) {
+        Where x = kw;
+        const pb::Descriptor* d = kd;
+        for (std::size_t k = 0; k < path.size() && d != nullptr; ++k) {
+          const pb::FieldDescriptor* fld = field_of(d, path[k].field);
+          if (k + 1 == path.size()) {
+            x = at_field(x, d, path[k].field, path[k].index);
+          } else {
+            x = nested(x, d, path[k].field, path[k].index);
+            d = fld->message_type();
+          }
+        }
+        error(x, std::move(msg));
+      };
+      if (!plan_switch_to_cpu(plan, found, f.switch_to_cpu(), sp, err)) return false;
+      pf.cpu_switch = std::move(sp);
     }
     if (pf.kind == K::PsFailure) {
       if (!f.ps_failure().has_half()) {
@@ -1219,6 +1240,7 @@ class Planner {
         case FK::kRedDepa:
         case FK::kChecksumError:
         case FK::kPsFailure:
+        case FK::kSwitchToCpu:
           if (plan_h_fault(plan, f, w, pf) && ok) plan.faults.push_back(std::move(pf));
           continue;
         case FK::kQuantumPowerLoss:
@@ -1382,6 +1404,13 @@ std::string h_fault_description(const PlanFault& f) {
     case K::HardwareFault: return "latent hardware fault in " + cpu;
     case K::CpuHold: return cpu + " to HOLD";
     case K::HMasterSwap: return "operator master swap (switch to CPU with modified configuration)";
+    case K::HSwitchToCpu: {
+      const auto v = f.cpu_switch ? f.cpu_switch->variant : devices::HSwitchVariant::ModifiedConfiguration;
+      return std::string("PG/ES: switch to CPU with ") +
+             (v == devices::HSwitchVariant::ExpandedMemory ? "expanded memory configuration"
+              : v == devices::HSwitchVariant::ModifiedOs   ? "modified operating system"
+                                                           : "modified configuration");
+    }
     case K::UpdateLoad: return "DBs changed: the next update copies " + std::to_string(f.kb) + " KB";
     case K::ProgramChange: return "program change in RUN (" + std::string(to_string(f.change)) + ")";
     case K::ParameterChange: return "a parameter that may not change is changed, then a master swap";
@@ -1464,7 +1493,8 @@ bool is_h_fault(PlanFault::Kind k) {
     case K::CycleOverload:
     case K::RedDepa:
     case K::ChecksumError:
-    case K::PsFailure: return true;
+    case K::PsFailure:
+    case K::HSwitchToCpu: return true;
     default: return false;
   }
 }

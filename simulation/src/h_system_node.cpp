@@ -76,6 +76,7 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
     m_model->set_max_cycle_time(rt.max_cycle_time);
     m_model->set_param_transfer_time(rt.param_transfer_time_100ms);  // W#16#6547
+    setup_changes();  // docs/h-scenario-changes.md
     if (has_networks(rt.program)) m_model->set_program(rt.program);
     if (!rt.redundant_io.empty()) {  // docs/h-redundant-io.md
       std::vector<devices::HSystemModel::RedIoPair> pairs;
@@ -117,6 +118,7 @@ void HSystemNode::start() {
   if (m_started) return;
   m_started = true;
   const HRuntimePlan& rt = *plan().runtime;
+  start_changes();  // docs/h-scenario-changes.md
   if (!rt.fibres_connected_at_power_on) {
     m_model->cut_both_fibres();
     note("sync link: both fibres not connected at power-on");
@@ -173,8 +175,10 @@ std::string HSystemNode::apply(const PlanFault& f, bool on) {
       if (on ? !m.hold(f.rack) : !m.release_hold(f.rack)) text += ": refused";
       break;
     case K::HMasterSwap:
+      equal_db_blocks();  // nothing changed (docs/h-scenario-changes.md)
       if (!m.request_master_swap()) text += ": refused";
       break;
+    case K::HSwitchToCpu: text += apply_switch(f); break;  // docs/h-scenario-changes.md
     case K::UpdateLoad: m.set_changed_db_kb(static_cast<std::uint32_t>(f.kb)); break;
     case K::ProgramChange:
       text += std::string(": ") + std::string(devices::to_string(m.load_change(to_change(f.change))));
@@ -329,6 +333,7 @@ HSystemReport HSystemNode::report() const {
     r.racks.push_back(std::move(rr));
   }
   r.ob80 = m_model->ob80_count();
+  report_changes(r);  // docs/h-scenario-changes.md
   return r;
 }
 

@@ -38,6 +38,7 @@
 #include "pbvbus/s7h/h_program_spec.hpp"
 #include "pbvbus/s7h/h_redundant_io.hpp"
 #include "pbvbus/s7h/h_update_timing.hpp"
+#include "pbvbus/scenario/h_changes_plan.hpp"
 #include "pbvbus/scenario/dp_plan.hpp"
 #include "scenario.pb.h"
 
@@ -79,6 +80,7 @@ struct HRuntimePlan {
   std::vector<HRedIoPlan> redundant_io;  ///< plan_redundant_io
   /// HCpuPair.param_transfer_time_100ms (0 = off; HSystemModel::set_param_transfer_time).
   std::uint32_t param_transfer_time_100ms = 0;
+  HChangesPlan changes;  ///< plan_h_changes (docs/h-scenario-changes.md)
 };
 
 struct HSystemPlan {
@@ -121,6 +123,14 @@ struct ScenarioPlan;
 /// <= 1000; end_value > 0. The two modules' lengths are checked when the model is built.
 void plan_redundant_io(const ScenarioPlan& plan, int i, HRuntimePlan& rt,
                        const ProgramError& error);
+/// h_system[i]'s battery/RAM, T8 link-up, DB attributes, watchdog OBs, OB 72's SFC 27 and rack
+/// module partitions into rt (h_changes_plan.cpp); after the program and the racks are planned.
+void plan_h_changes(const ScenarioPlan& plan, int i, HRuntimePlan& rt, const ProgramError& error);
+/// The fault switch_to_cpu for the simulated h_systems[h] (h_changes_plan.cpp): an added module
+/// is a module of a switched_station of a system the pair drives; a changed_db a DB of
+/// cpu.s7_memory. Errors at paths inside the switch_to_cpu message.
+bool plan_switch_to_cpu(const ScenarioPlan& plan, int h, const scenario::HSwitchToCpu& s,
+                        HSwitchPlan& out, const ProgramError& error);
 /// Plans the h_system entries (after plan_dp: they refer to redundant_master_systems).
 void plan_h(ScenarioPlan& plan, const DpLocator& locate, const HLocator& hlocate,
             std::vector<Diagnostic>& errors);

@@ -156,6 +156,7 @@ struct PlanFault {
     // Changes in operation and self-test (docs/h-changes.md)
     ChecksumError,         ///< `rack`: a checksum error in the cyclic self-test (001 Table 5-6)
     PsFailure,             ///< F1, `rack`, `half` of its PS 407 10A R; repair: that half replaced
+    HSwitchToCpu,          ///< PG/ES "switch to CPU with ...", `cpu_switch` (docs/h-scenario-changes.md)
     // Quantum Hot Standby (quantum_plan.hpp): `quantum`, and `rack` where the kind names one.
     QuantumPowerLoss,     ///< the rack's power fails; repair: power back
     QuantumCpuStop,       ///< the rack's CPU stops; repair: started again
@@ -202,6 +203,7 @@ struct PlanFault {
   bool run_a = false, run_b = false;  ///< quantum_command
   bool keyswitch_override = false;    ///< quantum_command: the override bit written
   std::uint32_t checksum = 0;         ///< quantum_logic_change
+  std::optional<HSwitchPlan> cpu_switch;  ///< switch_to_cpu: variant, memories, modules, DBs
 };
 
 /// A Quantum Hot Standby fault kind (QuantumPowerLoss .. QuantumLogicChange)?

@@ -69,6 +69,12 @@ class HSystemNode {
   /// master system \"H-DP 1\", line DP_B".
   std::string io_event_text(const devices::HSystemEvent& e) const;
   void note(std::string text);
+  // ---- docs/h-scenario-changes.md (h_system_node_changes.cpp) ----
+  void setup_changes();   ///< constructor: RAM test, OB 72's SFC 27
+  void start_changes();   ///< start(): the watchdog OBs at their phase
+  std::string apply_switch(const PlanFault& f);  ///< switch_to_cpu: "" or ": refused ..."
+  void equal_db_blocks();  ///< master_swap after a switch_to_cpu: both CPUs' DBs alike again
+  void report_changes(HSystemReport& r) const;   ///< OB1_SCAN_1 B#16#05, OB 72's SFC 27
 
   const ScenarioPlan& m_plan;
   int m_index;
@@ -78,6 +84,7 @@ class HSystemNode {
   bool m_started = false;
   std::vector<std::pair<bus::Ticks, std::string>> m_faults;
   std::optional<bus::Ticks> m_planned_t_p15, m_planned_t_ph;
+  bool m_db_blocks_set = false;  ///< a switch_to_cpu set the DBs' 5.2.3 attributes
 };
 
 }  // namespace pbvbus::tools

@@ -38,6 +38,9 @@ namespace pbvbus::tools {
 ///   slaves in ascending address order, their modules in slot order, each module's inputs at the
 ///   next free input byte and its outputs at the next free output byte, X1's slaves first, then
 ///   X2's. Bytes that do not fit the image are not exchanged (the report says how many).
+/// - The program's DP system functions (docs/h-dp-sfc.md): SFC 14/15 run inside
+///   devices::Program on the modules' addresses given by attach_dp(); SFC 11/12 run after each
+///   OB 1 (s7_dp_sfc.cpp) on the DP master of the interface named by `line`.
 /// - In STOP the CPU keeps answering S7 (SZL 0424 says STOP) and its DP masters write zero
 ///   outputs (the outputs of a CPU in STOP are disabled).
 class S7CpuNode final : public bus::EventTarget {

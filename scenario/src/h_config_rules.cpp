@@ -96,6 +96,7 @@ class RuleChecker {
                    " DP master systems; an H-system has at most 12 per subsystem (2 on the CPU's "
                    "interfaces + 10 CP 443-5 Extended) (S7-400H manual 000 L1722, D5)");
     if (!h.has_cpu()) return;
+    check_dp_sfcs(hp);
     const auto& c = h.cpu();
     const HCpuLimits& lim = h_cpu_limits(c.cpu_type());
     const HProcessImageSize pi = h_process_image_size(c);
@@ -110,6 +111,22 @@ class RuleChecker {
         sizes_ok = false;
       }
     if (sizes_ok && hp.runtime) check_process_image(hp, pi);
+  }
+
+  // ---- D4: SFC 11 DPSYC_FR and SFC 12 D_ACT_DP in the program (docs/h-dp-sfc.md) ----
+  void check_dp_sfcs(const HSystemPlan& hp) {
+    const auto& h = m_plan.proto.h_system(hp.source);
+    if (!h.has_program()) return;
+    const auto& pr = h.program();
+    for (int k = 0; k < pr.dpsyc_fr_size(); ++k)
+      error_at(m_hlocate(hp.source, {{"program"}, {"dpsyc_fr", k}}),
+               "h_system \"" + hp.name + "\": the program calls SFC 11 DPSYC_FR; an H CPU does not support it, "
+               "in Solo and in Redundant mode (no SYNC/FREEZE of DP slave groups) (S7-400H manual 001 L14091-14096, "
+               "L13668-13672; 000 L4112, L4262, D4)");
+    for (int k = 0; k < pr.d_act_dp_size(); ++k)
+      error_at(m_hlocate(hp.source, {{"program"}, {"d_act_dp", k}}),
+               "h_system \"" + hp.name + "\": the program calls SFC 12 D_ACT_DP; an H CPU does not support it "
+               "(DP slaves cannot be deactivated and activated) (S7-400H manual 001 L14098-14103, D4)");
   }
 
   /// C4: the addresses as devices::HIoMap assigns them (h_io_map.hpp): the driven systems in

@@ -538,6 +538,7 @@ void plan_program_spec(const scenario::HProgram& pr, devices::ProgramSpec& spec,
     spec.monitors.push_back(d);
   }
   plan_h_ctrl_calls(pr, spec, error_at);  // SFC 90 (h_plan_sfc90.cpp)
+  plan_dp_sfc_calls(pr, spec, error_at);  // SFC 11/12/14/15 (h_plan_dp_sfc.cpp)
 }
 
 }  // namespace pbvbus::tools

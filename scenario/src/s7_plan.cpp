@@ -243,6 +243,21 @@ class S7Planner {
         error("s7_cpu", i, at, std::move(msg));
         good = false;
       });
+      // SFC 11/12 name one of this CPU's DP interfaces by its line (docs/h-dp-sfc.md).
+      auto dp_line = [&](const std::string& l) {
+        return (c.has_mpi_dp() && c.mpi_dp().mode() == scenario::CpuInterface::DP && c.mpi_dp().line() == l) ||
+               (c.has_dp() && c.dp().line() == l);
+      };
+      auto check_line = [&](const char* list, int k, const std::string& l, const char* sfc) {
+        if (dp_line(l)) return;
+        error("s7_cpu", i, {{"program", -1}, {list, k}, {"line", -1}},
+              std::string(sfc) + ": line \"" + l + "\" is not a DP interface of s7_cpu \"" + c.name() + "\"");
+        good = false;
+      };
+      for (int k = 0; k < c.program().dpsyc_fr_size(); ++k)
+        check_line("dpsyc_fr", k, c.program().dpsyc_fr(k).line(), "SFC 11");
+      for (int k = 0; k < c.program().d_act_dp_size(); ++k)
+        check_line("d_act_dp", k, c.program().d_act_dp(k).line(), "SFC 12");
       if (good) {
         const auto why = devices::validate(spec, p.input_bytes, p.output_bytes);
         if (!why.empty()) error("s7_cpu", i, {{"program", -1}}, "program: " + why.front());

@@ -16,7 +16,8 @@ namespace {
 
 bool has_networks(const devices::ProgramSpec& p) {
   return !p.copies.empty() || !p.counters.empty() || !p.monitors.empty() ||
-         !p.h_ctrl_calls.empty();  // SFC 90 calls alone are a program too (docs/h-sfc90.md)
+         !p.h_ctrl_calls.empty() ||  // SFC 90 calls alone are a program too (docs/h-sfc90.md)
+         !p.dprd_dat.empty() || !p.dpwr_dat.empty();  // so are SFC 14/15 (docs/h-dp-sfc.md)
 }
 
 devices::HChange to_change(HProgramChangeKind k) {

@@ -57,6 +57,7 @@ void S7CpuNode::on_event(bus::Ticks now, std::uint64_t) {
   if (!m_program || m_info.state != s7cpu::cpu_state::kRun) return;
   m_program_events.clear();
   m_program->scan(*m_image, now, m_program_events);
+  run_dp_sfcs(now);  // SFC 11/12 after the networks and SFC 14/15 (s7_dp_sfc.cpp)
   ++m_scans;
   m_sched.schedule(now + m_program->scan_time(), *this, 0);
 }

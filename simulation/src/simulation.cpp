@@ -264,6 +264,7 @@ void Simulation::build_line(std::size_t li) {
           if ((cp.x1_dp && cp.x1_dp->dp_master == mi) || (cp.x2_dp && cp.x2_dp->dp_master == mi)) {
             S7CpuNode* node = cpu.get();
             st.dp_master->set_cpu([node](dp::Master& m) { node->exchange(m); });
+            node->attach_dp(pl.name, st.dp_master->master(), cp.x1_dp && cp.x1_dp->dp_master == mi);
             label = "CPU " + cp.name + " DP interface " + std::to_string(st.address);
           }
         }

@@ -138,6 +138,46 @@ TEST(HRefusals, D4_ASecondMasterOnARedundantSystemWithoutAnHSystemLoads) {
 
 // ---- D5 ----
 
+// ---- D4: SFC 11 DPSYC_FR and SFC 12 D_ACT_DP are not supported by an H CPU (001 Appendix B
+// L14091-14096, L14098-14103; table B-1 L13668-13672: standard CPU yes, Solo no, Redundant no;
+// 000 L4112, L4262). The error is at the call in the program (line 10 / 11, column 3). ----
+
+/// h_system "H" with a program of `calls` (one per line from line 10 on).
+std::string h_program(const std::string& calls) {
+  return "h_system { name: \"H\" dp_system { system: \"H-DP 1\" t_pto: \"2s\" } cpu { } program {\n" + calls +
+         "} }\n";
+}
+
+TEST(HRefusals, D4_Sfc11DpsycFrInAnHProgramIsRefused) {
+  EXPECT_EQ(errors(rms() + h_program("  dpsyc_fr { line: \"DP_A\" group: 1 mode: 32 }\n")),
+            (std::vector<std::string>{
+                "h.textproto:10:3: h_system \"H\": the program calls SFC 11 DPSYC_FR; an H CPU does not support "
+                "it, in Solo and in Redundant mode (no SYNC/FREEZE of DP slave groups) (S7-400H manual 001 "
+                "L14091-14096, L13668-13672; 000 L4112, L4262, D4)"}));
+}
+
+TEST(HRefusals, D4_Sfc12DActDpInAnHProgramIsRefused) {
+  EXPECT_EQ(errors(rms() + h_program("  dprd_dat { laddr: 0 record: 100 length: 2 }\n"
+                                     "  d_act_dp { line: \"DP_A\" station: 3 mode: 2 }\n")),
+            (std::vector<std::string>{
+                "h.textproto:11:3: h_system \"H\": the program calls SFC 12 D_ACT_DP; an H CPU does not support "
+                "it (DP slaves cannot be deactivated and activated) (S7-400H manual 001 L14098-14103, D4)"}));
+}
+
+TEST(HRefusals, C1_Sfc14And15InAnHProgramLoad) {
+  // The length rule is the run's RET_VAL W#16#80B1 (tests/controllers/s7h), not a load error.
+  const auto r = load(rms() + h_program("  dprd_dat { laddr: 0 record: 100 length: 2 ret_val: 98 }\n"
+                                        "  dpwr_dat { laddr: 0 record: 100 length: 3 ret_val: 96 }\n"));
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  ASSERT_EQ(r.plan->h_systems.size(), 1u);
+  ASSERT_TRUE(r.plan->h_systems[0].runtime);
+  const auto& spec = r.plan->h_systems[0].runtime->program;
+  ASSERT_EQ(spec.dprd_dat.size(), 1u);
+  ASSERT_EQ(spec.dpwr_dat.size(), 1u);
+  EXPECT_EQ(spec.dpwr_dat[0].length, 3u);
+  EXPECT_EQ(spec.dpwr_dat[0].ret_val, std::optional<std::uint32_t>(96));
+}
+
 TEST(HRefusals, D5_X1TakesAtMost32Slaves) {
   // X1 on both sides: the switched station (address 3) + 31 one-sided slaves = 32 on DP_A.
   const std::string x1 = "place_a { interface: X1_MPI_DP } place_b { interface: X1_MPI_DP }";

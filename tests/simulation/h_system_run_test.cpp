@@ -179,5 +179,47 @@ TEST(HSystemRun, UpdatesStayWithinTheirWindows) {
   }
 }
 
+
+// SFC 14/15 alone make a program (docs/h-dp-sfc.md): the map puts switched station 3 at IB 0..1 /
+// QB 0..1, slave 10 (DP_A, counting inputs) at IB 2..3 / QB 2..3, slave 11 (DP_B) at IB 4..5 /
+// QB 4..5. SFC 14 reads IB 2..3 into MB 100..101, SFC 15 writes them to QB 0..1 (RET_VALs MW 98,
+// MW 96); a 4-octet RECORD for slave 11's 2-octet outputs: W#16#80B1 in MW 94, QB 4..5 stay 0.
+// At 1.5 s CPU 0 runs Solo (RUN at 1 s).
+TEST(HSystemRun, Sfc14And15AloneAreAProgram) {
+  auto loaded = parse_scenario(R"(name: "sfc" duration: "1500ms"
+line { name: "DP_A" baud: "1.5M" }
+line { name: "DP_B" baud: "1.5M" }
+dp_master { address: 1 line: "DP_A" }
+dp_master { address: 1 line: "DP_B" }
+redundant_master_system { name: "H-DP 1" line_a: "DP_A" master_a: 1 line_b: "DP_B" master_b: 1 }
+switched_station { system: "H-DP 1" address: 3 gsd: "gsd/PBVB0A10.gsd" modules: ["16DI DC24V", "16DO DC24V/0.5A"] }
+dp_slave { address: 10 line: "DP_A" gsd: "gsd/PBVB0A01.gsd" master: 1 inputs: COUNTER }
+dp_slave { address: 11 line: "DP_B" gsd: "gsd/PBVB0A01.gsd" master: 1 }
+h_system { name: "H" dp_system { system: "H-DP 1" t_pto: "2s" } cpu { } program {
+  dprd_dat { laddr: 2 record: 100 length: 2 ret_val: 98 }
+  dpwr_dat { laddr: 0 record: 100 length: 2 ret_val: 96 }
+  dpwr_dat { laddr: 4 record: 100 length: 4 ret_val: 94 }
+} }
+)", std::string(PBVBUS_SOURCE_DIR) + "/examples/h.textproto");
+  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
+  Simulation sim(*loaded.plan);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const auto* exec = sim.h_system(0).model().execution();
+  ASSERT_NE(exec, nullptr);
+  const auto& img = exec->image(0);
+  const auto m = img.memory();
+  auto word = [](std::span<const std::uint8_t> b, std::size_t at) {
+    return static_cast<std::uint16_t>((b[at] << 8) | b[at + 1]);
+  };
+  EXPECT_EQ(word(m, 98), 0x0000);
+  EXPECT_EQ(word(m, 96), 0x0000);
+  EXPECT_EQ(word(m, 94), 0x80B1);
+  EXPECT_NE(word(img.pii(), 2), 0);  // slave 10 counts
+  EXPECT_EQ(word(m, 100), word(img.pii(), 2));
+  EXPECT_EQ(word(img.piq(), 0), word(img.pii(), 2));
+  EXPECT_EQ(word(img.piq(), 4), 0);
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

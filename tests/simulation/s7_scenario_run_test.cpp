@@ -214,5 +214,93 @@ s7_cpu { name: "C" mpi_dp { line: "MPI" } program { copy { from_input: 0 to_outp
   EXPECT_NE(r.errors[0].message.find("program: "), std::string::npos) << r.errors[0].message;
 }
 
+
+// The DP system functions of a plain CPU's program (docs/h-dp-sfc.md) on its DP master (X1 in DP
+// mode, address 2): SFC 11 at 50 ms sends SYNC (MODE 0x20) to group 1 (GROUP 0x01); SFC 12
+// deactivates slave 4 at 100 ms (MODE 2), asks at 150 ms (MODE 0: W#16#0001 deactivated) and
+// activates it at 200 ms (MODE 1); SFC 14/15 move slave 3's inputs (IB 0..1) to slave 4's outputs
+// (QB 2..3) through MB 30..31; a 4-octet RECORD for the 2-octet module: W#16#80B1.
+TEST(S7ScenarioRun, TheProgramsDpSfcsActOnTheCpusDpMaster) {
+  const auto plan = plan_of(R"(name: "sfc" duration: "300ms"
+line { name: "DP" }
+dp_master { address: 2 line: "DP" }
+dp_slave { address: 3 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 inputs: COUNTER }
+dp_slave { address: 4 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 inputs: ZERO }
+s7_cpu { name: "C" mpi_dp { mode: DP line: "DP" address: 2 } program {
+  dpsyc_fr { at: "50ms" line: "DP" group: 1 mode: 32 ret_val: 20 }
+  d_act_dp { at: "100ms" line: "DP" station: 4 mode: 2 ret_val: 22 }
+  d_act_dp { at: "150ms" line: "DP" station: 4 mode: 0 ret_val: 26 }
+  d_act_dp { at: "200ms" line: "DP" station: 4 mode: 1 ret_val: 24 }
+  dprd_dat { laddr: 0 record: 30 length: 2 ret_val: 28 }
+  dpwr_dat { laddr: 2 record: 30 length: 2 ret_val: 32 }
+  dprd_dat { laddr: 0 record: 40 length: 4 ret_val: 34 }
+} }
+)");
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  test::FrameRecorder rec;
+  sim.line(0).add_tap(rec);
+  sim.start();
+  sim.run_until(*sim.duration());
+  constexpr bus::Ticks kMs = bus::kTicksPerMs;
+
+  // Global_Control (protocol-facts.md §D.6): SD2, LE = 7 (DA SA FC + DSAP SSAP + 2 octets),
+  // DA 127 | 0x80 = FF (SAPs follow), SA 2 | 0x80 = 82, FC 46 (SDN high, FCB/FCV 0), DSAP 3A (58),
+  // SSAP 3E (62), Control_Command 20 (SYNC; Operate: no Clear_Data), Group_Select 01;
+  // FCS = FF+82+46+3A+3E+20+01 = 0x260 -> 60.
+  const std::vector<std::uint8_t> sync = {0x68, 0x07, 0x07, 0x68, 0xFF, 0x82, 0x46,
+                                          0x3A, 0x3E, 0x20, 0x01, 0x60, 0x16};
+  std::vector<bus::Ticks> sync_at;
+  for (const auto& f : rec.frames())
+    if (f.bytes == sync) sync_at.push_back(f.start);
+  ASSERT_EQ(sync_at.size(), 1u);
+  EXPECT_GE(sync_at[0], 50 * kMs);
+  EXPECT_LT(sync_at[0], 60 * kMs);  // the OB 1 at 50 ms, then the master's next pass
+
+  // Requests of master 2 to slave 4 (SD2, DA 04 or 84, SA 02 or 82), by time; Set_Prm has
+  // DSAP 3D (61).
+  auto requests = [&](bus::Ticks from, bus::Ticks to, bool set_prm_only) {
+    int n = 0;
+    for (const auto& f : rec.frames())
+      if (f.bytes.size() > 8 && f.bytes[0] == 0x68 && (f.bytes[4] & 0x7F) == 4 && (f.bytes[5] & 0x7F) == 2 &&
+          f.start >= from && f.start < to && (!set_prm_only || ((f.bytes[4] & 0x80) != 0 && f.bytes[7] == 0x3D)))
+        ++n;
+    return n;
+  };
+  EXPECT_GT(requests(50 * kMs, 100 * kMs, false), 10);
+  EXPECT_EQ(requests(110 * kMs, 200 * kMs, false), 0);  // deactivated: not polled
+  EXPECT_GT(requests(210 * kMs, 300 * kMs, false), 10);  // polled again ...
+  EXPECT_EQ(requests(200 * kMs, 300 * kMs, true), 1);    // ... after a new Set_Prm
+
+  const auto m = sim.s7_cpu(0).memory().area(s7cpu::Area::Flags);
+  auto mw = [&](std::size_t at) { return static_cast<std::uint16_t>((m[at] << 8) | m[at + 1]); };
+  EXPECT_EQ(mw(20), 0x0000);  // SFC 11 done
+  EXPECT_EQ(mw(22), 0x0000);  // SFC 12 deactivated
+  EXPECT_EQ(mw(26), 0x0001);  // SFC 12 MODE 0: deactivated
+  EXPECT_EQ(mw(24), 0x0000);  // SFC 12 activated
+  EXPECT_EQ(mw(28), 0x0000);
+  EXPECT_EQ(mw(32), 0x0000);
+  EXPECT_EQ(mw(34), 0x80B1);
+  EXPECT_NE(mw(30), 0);  // slave 3 counts
+  const auto& calls = sim.s7_cpu(0).dp_sfc_calls();
+  ASSERT_EQ(calls.size(), 4u);
+  EXPECT_EQ(calls[0].sfc, 11);
+  EXPECT_EQ(calls[0].time, 50 * kMs);  // OB 1 every 10 ms from 0
+}
+
+TEST(S7ScenarioRun, Sfc11And12NameOneOfTheCpusDpInterfaces) {
+  auto r = parse_scenario(R"(name: "sfc" duration: "300ms"
+line { name: "DP" }
+dp_master { address: 2 line: "DP" }
+s7_cpu { name: "C" mpi_dp { mode: DP line: "DP" address: 2 } program {
+  d_act_dp { line: "X" station: 4 mode: 2 }
+} }
+)", kFile);
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_NE(r.errors[0].str().find(":5:14: SFC 12: line \"X\" is not a DP interface of s7_cpu \"C\""),
+            std::string::npos)
+      << r.errors[0].str();
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

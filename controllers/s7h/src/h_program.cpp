@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "pbvbus/s7h/h_dp_sfc.hpp"
+
 namespace pbvbus::devices {
 namespace {
 
@@ -150,8 +152,11 @@ bool Program::scan(ProcessImage& image, bus::Ticks now, std::vector<ProgramEvent
                 mem.subspan(monitor_offsets_[i], kMonitorStateHeaderBytes + m.length), pii, piq,
                 now, events);
   }
+  run_dp_sfcs(spec_, pii, piq, mem, now);  // SFC 14/15 (h_dp_sfc.hpp)
   return true;
 }
+
+void Program::set_io_modules(std::vector<IoModuleExtent> modules) { spec_.io_modules = std::move(modules); }
 
 std::vector<ProgramEvent> Program::scan(ProcessImage& image, bus::Ticks now) const {
   std::vector<ProgramEvent> events;

@@ -9,7 +9,14 @@
 
 namespace pbvbus::devices {
 
-void HSystemModel::set_program(const ProgramSpec& spec) {
+void HSystemModel::set_program(const ProgramSpec& given) {
+  // SFC 14/15 look LADDR up in the I/O map's modules (h_dp_sfc.hpp).
+  ProgramSpec spec = given;
+  spec.io_modules.clear();
+  for (const HIoEntry& e : m_map.entries())
+    spec.io_modules.push_back({static_cast<std::uint32_t>(e.in_addr), static_cast<std::uint32_t>(e.in_len),
+                               static_cast<std::uint32_t>(e.out_addr), static_cast<std::uint32_t>(e.out_len),
+                               !e.central});
   const auto errors = validate(spec, m_map.pii_size(), m_map.piq_size());
   if (!errors.empty()) throw std::invalid_argument("program: " + errors.front());
   // The memory area holds the program's state, the flags and the DBs (h_s7_memory.hpp).

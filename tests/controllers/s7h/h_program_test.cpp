@@ -3,6 +3,7 @@
 // written out by hand in ticks (1 ms = 3 636 000 ticks, 1 µs = 3 636 ticks, bus/time.hpp) with
 // the arithmetic in a comment; every expected byte is literal.
 #include "pbvbus/s7h/h_program.hpp"
+#include "pbvbus/s7h/h_dp_sfc.hpp"
 
 #include <gtest/gtest.h>
 
@@ -422,6 +423,91 @@ TEST(HProgram, ValidationOfLengthsSignsAndMonitorOutputs) {
                                    "monitor 2: to_output QB 0 (1 octet) overlaps the output of "
                                    "monitor 1",
                                }));
+}
+
+
+// ---- SFC 14 DPRD_DAT / SFC 15 DPWR_DAT (h_dp_sfc.hpp, docs/h-dp-sfc.md) ----------------------
+// Modules: a DP module 4 in at IB 2..5 and 2 out at QB 0..1; a central module 1 in at IB 6.
+// RECORD in MB 10.., RET_VAL in MW 0. Expected RET_VALs: 0000; 8090 no module at LADDR; 8093
+// not a DP module; 80B1 RECORD's length is not the module's (001 L3352-3354, L3365); 8323 RECORD
+// (SFC 14's parameter 3) outside M when writing; 8222 RECORD (SFC 15's parameter 2) outside M
+// when reading.
+struct DpSfcCase {
+  ProgramSpec spec;
+  ProcessImage img{8, 4, 16};
+  DpSfcCase() {
+    spec.io_modules = {{2, 4, 0, 2, true}, {6, 1, 0, 0, false}};
+    const B in = {0x00, 0x00, 0x11, 0x22, 0x33, 0x44, 0x55, 0x00};
+    std::copy(in.begin(), in.end(), img.pii().begin());
+  }
+  std::uint16_t ret_val() const {
+    return static_cast<std::uint16_t>((img.memory()[0] << 8) | img.memory()[1]);
+  }
+  std::uint16_t read(std::uint32_t laddr, std::uint32_t record, std::uint32_t length) {
+    ProgramSpec s = spec;
+    s.dprd_dat.push_back({0, laddr, record, length, 0u});
+    const Program p(s, 8, 4);
+    EXPECT_TRUE(p.scan(img, 0).empty());
+    return ret_val();
+  }
+  std::uint16_t write(std::uint32_t laddr, std::uint32_t record, std::uint32_t length) {
+    ProgramSpec s = spec;
+    s.dpwr_dat.push_back({0, laddr, record, length, 0u});
+    const Program p(s, 8, 4);
+    EXPECT_TRUE(p.scan(img, 0).empty());
+    return ret_val();
+  }
+};
+
+TEST(HProgramDpSfc, Sfc14ReadsTheWholeModuleOrAnswersItsRetVal) {
+  DpSfcCase c;
+  EXPECT_EQ(c.read(2, 10, 4), 0x0000);
+  EXPECT_EQ(bytes(c.img.memory().subspan(10, 4)), (B{0x11, 0x22, 0x33, 0x44}));
+  DpSfcCase w;  // a fresh M each: a refused call writes no RECORD
+  EXPECT_EQ(w.read(2, 10, 2), 0x80B1);  // 2 octets of a 4-octet module
+  EXPECT_EQ(w.read(2, 10, 5), 0x80B1);
+  EXPECT_EQ(w.read(3, 10, 4), 0x8090);  // IB 3 is inside the module, not its start
+  EXPECT_EQ(w.read(0, 10, 2), 0x8090);  // QB 0 is an output address; IB 0 has no module
+  EXPECT_EQ(w.read(6, 10, 1), 0x8093);  // a central module
+  EXPECT_EQ(w.read(2, 13, 4), 0x8323);  // MB 13..16 of a 16-octet M
+  EXPECT_EQ(bytes(w.img.memory().subspan(2, 14)), B(14, 0));
+}
+
+TEST(HProgramDpSfc, Sfc15WritesTheWholeModuleOrAnswersItsRetVal) {
+  DpSfcCase c;
+  c.img.memory()[10] = 0xBE;
+  c.img.memory()[11] = 0xEF;
+  EXPECT_EQ(c.write(0, 10, 2), 0x0000);
+  EXPECT_EQ(bytes(c.img.piq()), (B{0xBE, 0xEF, 0x00, 0x00}));
+  DpSfcCase w;
+  w.img.memory()[10] = 0xBE;
+  EXPECT_EQ(w.write(0, 10, 1), 0x80B1);
+  EXPECT_EQ(w.write(0, 10, 4), 0x80B1);
+  EXPECT_EQ(w.write(2, 10, 2), 0x8090);  // no module's outputs start at QB 2
+  EXPECT_EQ(w.write(0, 15, 2), 0x8222);  // MB 15..16 of a 16-octet M
+  EXPECT_EQ(bytes(w.img.piq()), B(4, 0));
+}
+
+TEST(HProgramDpSfc, CallsRunFromTheirTimeAndInSpecOrder) {
+  DpSfcCase c;
+  // SFC 14 from 20 ms: IB 2..5 -> MB 10..13; SFC 15: MB 10..11 -> QB 0..1, every scan.
+  c.spec.dprd_dat.push_back({20 * kMs, 2, 10, 4, 0u});
+  c.spec.dpwr_dat.push_back({0, 0, 10, 2, std::nullopt});
+  const Program p(c.spec, 8, 4);
+  EXPECT_TRUE(p.scan(c.img, 10 * kMs).empty());  // SFC 14 not due: MB 10..11 are 0
+  EXPECT_EQ(bytes(c.img.piq()), B(4, 0));
+  EXPECT_EQ(c.ret_val(), 0x0000);
+  EXPECT_TRUE(p.scan(c.img, 20 * kMs).empty());  // 14 then 15 in the same OB 1
+  EXPECT_EQ(bytes(c.img.piq()), (B{0x11, 0x22, 0x00, 0x00}));
+  EXPECT_EQ(bytes(c.img.memory().subspan(0, 2)), (B{0x00, 0x00}));  // RET_VAL 0000 stored
+}
+
+TEST(HProgramDpSfc, Sfc11ParameterCheck) {
+  EXPECT_EQ(check_dpsyc_fr(0x01, 0x20), 0);       // SYNC to group 1
+  EXPECT_EQ(check_dpsyc_fr(0x81, 0x0C), 0);       // FREEZE + UNFREEZE, groups 1 and 8
+  EXPECT_EQ(check_dpsyc_fr(0x00, 0x20), 0x8094);  // no group
+  EXPECT_EQ(check_dpsyc_fr(0x01, 0x00), 0x8095);  // no command
+  EXPECT_EQ(check_dpsyc_fr(0x01, 0x22), 0x8095);  // Clear_Data is no SFC 11 command
 }
 
 }  // namespace

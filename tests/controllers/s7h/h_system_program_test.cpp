@@ -219,5 +219,60 @@ TEST(HSystemProgram, Ob85OncePerEpisode) {
   EXPECT_EQ(ob85[1].time, next_scan(back[0]));
 }
 
+
+// C1 (001 §4.10.4 L3344-3365): SFC 14/15 in the H-system's program over the redundant master
+// system's modules (h_dp_sfc.hpp). Slave 10 (line A, 16DI/16DO) has its inputs at IB 4..5,
+// station 5's 16DO lies at QB 0..1 (the fixture's map). SFC 14 reads IB 4..5 into MB 100..101
+// (RET_VAL MW 98), SFC 15 writes MB 100..101 to QB 0..1 (RET_VAL MW 96): the station shows the
+// slave's two input octets, in one piece. A RECORD of 1 octet for the 2-octet modules: W#16#80B1
+// for both, nothing moves; an LADDR inside a module (IB 5): W#16#8090.
+TEST(HSystemProgram, C1_Sfc14And15MoveTheModulesDataWithTheConfiguredLength) {
+  auto word = [](std::span<const std::uint8_t> b, std::size_t at) {
+    return static_cast<std::uint16_t>((b[at] << 8) | b[at + 1]);
+  };
+  {
+    HSys s;
+    ProgramSpec p;
+    p.scan_time = kScan;
+    p.dprd_dat.push_back({0, 4, 100, 2, 98u});
+    p.dpwr_dat.push_back({0, 0, 100, 2, 96u});
+    s.h->set_s7_memory(HS7MemoryConfig{});  // M: 256 octets, as a scenario's cpu part has
+    s.h->set_program(p);
+    ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0xA5, 0x3C}));
+    s.bring_up();
+    ASSERT_NE(s.h->execution(), nullptr);
+    const auto m0 = s.h->execution()->image(0).memory();
+    ASSERT_GE(m0.size(), 256u);  // M: 256 octets (HS7MemoryConfig)
+    EXPECT_EQ(word(m0, 98), 0x0000);
+    EXPECT_EQ(word(m0, 96), 0x0000);
+    EXPECT_EQ(word(m0, 100), 0xA53C);
+    EXPECT_EQ(s.station(kFast).outputs()[0], 0xA5);
+    EXPECT_EQ(s.station(kFast).outputs()[1], 0x3C);
+    EXPECT_EQ(s.h->execution()->image(0), s.h->execution()->image(1));  // both CPUs alike
+    EXPECT_EQ(s.h->pair().system_mode(), SystemMode::Redundant);
+  }
+  {
+    HSys s;
+    ProgramSpec p;
+    p.scan_time = kScan;
+    p.dprd_dat.push_back({0, 4, 100, 1, 98u});
+    p.dpwr_dat.push_back({0, 0, 100, 1, 96u});
+    p.dprd_dat.push_back({0, 5, 110, 1, 94u});
+    s.h->set_s7_memory(HS7MemoryConfig{});  // M: 256 octets, as a scenario's cpu part has
+    s.h->set_program(p);
+    ASSERT_TRUE(s.one[0]->application().write_inputs(0, Bytes{0xA5, 0x3C}));
+    s.bring_up();
+    ASSERT_NE(s.h->execution(), nullptr);
+    const auto m0 = s.h->execution()->image(0).memory();
+    ASSERT_GE(m0.size(), 256u);  // M: 256 octets (HS7MemoryConfig)
+    EXPECT_EQ(word(m0, 98), 0x80B1);
+    EXPECT_EQ(word(m0, 96), 0x80B1);
+    EXPECT_EQ(word(m0, 94), 0x8090);
+    EXPECT_EQ(word(m0, 100), 0x0000);
+    EXPECT_EQ(s.station(kFast).outputs()[0], 0x00);
+    EXPECT_EQ(s.station(kFast).outputs()[1], 0x00);
+  }
+}
+
 }  // namespace
 }  // namespace pbvbus::devices

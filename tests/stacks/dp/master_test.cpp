@@ -797,6 +797,56 @@ TEST(DpMaster, DeactivatedSlaveIsNeverAddressed) {
   EXPECT_EQ(hex(m.slave_diag(kS)), "00 80 00 FF 12 34");
 }
 
+// S7 SFC 12 D_ACT_DP (docs/h-dp-sfc.md): deactivated in data exchange, the slave is no longer
+// addressed (only Global_Control goes out), its diagnosis shows Deactivated (octet 2 bit 7,
+// "00 80 00 FF 12 34" as for a slave configured inactive), no StationFailure; activated again,
+// it runs the whole start-up: Slave_Diag (DSAP 3C), Set_Prm (3D), Chk_Cfg (3E), Slave_Diag.
+TEST(DpMaster, SlaveDeactivatedAndActivatedAtRunTime) {
+  Master m(master1(), {slave10()});
+  Events ev;
+  ev.attach(m);
+  MasterDriver d(m);
+  m.on_power_on(0);
+  bring_up(d, m);
+  ASSERT_FALSE(m.set_slave_active(11, false));  // no such slave
+  ASSERT_TRUE(m.set_slave_active(kS, false));
+  EXPECT_EQ(m.slave_state(kS), St::Inactive);
+  EXPECT_EQ(hex(m.slave_diag(kS)), "00 80 00 FF 12 34");
+  EXPECT_FALSE(m.image(kS).data_valid());
+  for (int i = 0; i < 20; ++i) {
+    d.token();
+    for (std::string f = d.next(); !f.empty(); f = d.next()) {
+      EXPECT_NE(f.find(" FF 81 46 3A 3E "), std::string::npos) << f;  // Global_Control only
+      d.confirm_sent();
+    }
+  }
+  EXPECT_EQ(ev.count(MasterEvent::Kind::StationFailure), 0);
+  const auto startups = m.slave_stats(kS).startups;
+  ASSERT_TRUE(m.set_slave_active(kS, true));
+  EXPECT_EQ(m.slave_state(kS), St::Diag);
+  auto step = [&](const std::string& part) {
+    d.token();
+    std::string f = d.next();
+    if (f.find(" FF 81 46 ") != std::string::npos) {
+      d.confirm_sent();
+      f = d.next();
+    }
+    EXPECT_NE(f.find(part), std::string::npos) << f;
+  };
+  step(" 3C 3E ");  // Slave_Diag
+  d.confirm_data(ResponseStatus::DL, {0x02, 0x05, 0x00, 0xFF, 0x12, 0x34});
+  step(" 3D 3E 88 ");  // Set_Prm
+  d.confirm_sc();
+  step(" 3E 3E ");  // Chk_Cfg
+  d.confirm_sc();
+  step(" 3C 3E ");  // Slave_Diag
+  d.confirm_data(ResponseStatus::DL, {0x00, 0x0C, 0x00, 0x01, 0x12, 0x34});
+  EXPECT_EQ(m.slave_state(kS), St::DataExchange);
+  EXPECT_EQ(m.slave_stats(kS).startups, startups + 1);
+  EXPECT_EQ(ev.count(MasterEvent::Kind::StationFailure), 0);
+  EXPECT_EQ(ev.count(MasterEvent::Kind::StationReturn), 0);
+}
+
 TEST(DpMaster, PollsInConfigurationOrderAndContinuesACutPass) {
   // Configuration order 12, 10, 11 (not address order); no inputs or outputs: SD1 frames.
   std::vector<SlaveParams> ps;

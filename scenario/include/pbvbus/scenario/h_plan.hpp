@@ -115,6 +115,10 @@ void plan_program_spec(const scenario::HProgram& program, devices::ProgramSpec& 
 /// would refuse (W#16#8090/8091) or a bad time is an error (h_plan_sfc90.cpp).
 void plan_h_ctrl_calls(const scenario::HProgram& program, devices::ProgramSpec& spec,
                        const ProgramError& error);
+/// The program's DP system function calls (SFC 11/12/14/15) into spec (h_plan_dp_sfc.cpp):
+/// only their form (a time, octets that fit); the run answers the rest with RET_VALs.
+void plan_dp_sfc_calls(const scenario::HProgram& program, devices::ProgramSpec& spec,
+                       const ProgramError& error);
 
 struct ScenarioPlan;
 /// h_system[i].redundant_io -> rt.redundant_io (h_redundant_io_plan.cpp): each module a station

@@ -38,6 +38,9 @@ namespace pbvbus::tools {
 ///   slaves in ascending address order, their modules in slot order, each module's inputs at the
 ///   next free input byte and its outputs at the next free output byte, X1's slaves first, then
 ///   X2's. Bytes that do not fit the image are not exchanged (the report says how many).
+/// - The program's DP system functions (docs/h-dp-sfc.md): SFC 14/15 run inside
+///   devices::Program on the modules' addresses given by attach_dp(); SFC 11/12 run after each
+///   OB 1 (s7_dp_sfc.cpp) on the DP master of the interface named by `line`.
 /// - In STOP the CPU keeps answering S7 (SZL 0424 says STOP) and its DP masters write zero
 ///   outputs (the outputs of a CPU in STOP are disabled).
 class S7CpuNode final : public bus::EventTarget {
@@ -60,6 +63,18 @@ class S7CpuNode final : public bus::EventTarget {
 
   /// One DP cycle of the interface driven by `master` (called from its token receipt).
   void exchange(dp::Master& master);
+  /// The DP interface on `line` is driven by `master` (X1 when `x1`): its modules get their
+  /// addresses now (X1's first), SFC 14/15 find them, SFC 11/12 act on `master`.
+  void attach_dp(const std::string& line, dp::Master& master, bool x1);
+
+  /// One SFC 11/12 call of the program as it ran (docs/h-dp-sfc.md).
+  struct DpSfcRecord {
+    bus::Ticks time = 0;
+    int sfc = 0;  ///< 11 or 12
+    std::size_t call = 0;  ///< index in the spec's dpsyc_fr / d_act_dp
+    std::uint16_t ret_val = 0;
+  };
+  const std::vector<DpSfcRecord>& dp_sfc_calls() const { return m_dp_sfc; }
 
   std::uint64_t dp_exchanges() const { return m_exchanges; }
   std::uint32_t unmapped_bytes() const { return m_unmapped; }
@@ -87,6 +102,16 @@ class S7CpuNode final : public bus::EventTarget {
   std::uint32_t m_next_in = 0, m_next_out = 0, m_unmapped = 0;
   std::uint64_t m_exchanges = 0;
   std::vector<std::uint8_t> m_buf;
+  struct DpInterface {
+    std::string line;
+    dp::Master* master = nullptr;
+    bool x1 = false;
+  };
+  std::vector<DpInterface> m_dp;  ///< X1 first
+  std::vector<bool> m_dp_sfc_done;  ///< SFC 11 calls, then SFC 12 calls
+  std::vector<DpSfcRecord> m_dp_sfc;
+  void run_dp_sfcs(bus::Ticks now);  ///< SFC 11/12 due at this OB 1 (s7_dp_sfc.cpp)
+  dp::Master* dp_master_on(const std::string& line) const;
 };
 
 /// The MPI interface of one CPU of an h_system: an MPI station whose connections are ad-hoc S7

@@ -106,6 +106,10 @@ class Program {
   /// Same, returning the events (convenience for tests and one-off callers).
   std::vector<ProgramEvent> scan(ProcessImage& image, bus::Ticks now) const;
 
+  /// The owner's module map for SFC 14/15 (ProgramSpec::io_modules): configuration, not state;
+  /// set before the scans (a plain CPU's node knows its DP interfaces' modules only then).
+  void set_io_modules(std::vector<IoModuleExtent> modules);
+
  private:
   ProgramSpec spec_;
   std::size_t pii_bytes_;

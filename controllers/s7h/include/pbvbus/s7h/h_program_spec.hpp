@@ -17,6 +17,8 @@
 //   whole state to its partner and the comparison covers it (digest §5: RAM and output image
 //   are compared).
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "pbvbus/bus/time.hpp"
@@ -75,12 +77,69 @@ struct HCtrlCall {
   std::uint8_t submode = 0;
 };
 
+/// The DP system functions of OB 1 (h_dp_sfc.hpp has the RET_VALs, docs/h-dp-sfc.md the
+/// sources). RECORD and RET_VAL are in the memory area (M): `record` is MB n, `ret_val` MW n
+/// (unset: not stored).
+/// SFC 14 DPRD_DAT: every OB 1 from `at` on, the consistent inputs of the module whose first
+/// input byte is IB `laddr` into MB record .. +length.
+struct DpReadCall {
+  bus::Ticks at = 0;
+  std::uint32_t laddr = 0;
+  std::uint32_t record = 0;
+  std::uint32_t length = 1;
+  std::optional<std::uint32_t> ret_val;
+};
+/// SFC 15 DPWR_DAT: every OB 1 from `at` on, MB record .. +length as the consistent outputs of
+/// the module whose first output byte is QB `laddr`.
+struct DpWriteCall {
+  bus::Ticks at = 0;
+  std::uint32_t laddr = 0;
+  std::uint32_t record = 0;
+  std::uint32_t length = 1;
+  std::optional<std::uint32_t> ret_val;
+};
+/// SFC 11 DPSYC_FR: once, at the first OB 1 at or after `at`: Global_Control with MODE
+/// (Control_Command bits: 0x20 SYNC, 0x10 UNSYNC, 0x08 FREEZE, 0x04 UNFREEZE) to the groups
+/// GROUP (bit n = group n+1) of the DP master system on `line`. A plain S7 CPU only; an H CPU
+/// refuses it (001 L14095, L13670).
+struct DpSyncFreezeCall {
+  bus::Ticks at = 0;
+  std::string line;
+  std::uint8_t group = 0;
+  std::uint8_t mode = 0;
+  std::optional<std::uint32_t> ret_val;
+};
+/// SFC 12 D_ACT_DP: once, at the first OB 1 at or after `at`: MODE 0 query, 1 activate,
+/// 2 deactivate the DP slave `station` of the DP master system on `line`. A plain S7 CPU
+/// only; an H CPU refuses it (001 L14102).
+struct DpActivateCall {
+  bus::Ticks at = 0;
+  std::string line;
+  std::uint8_t station = 0;
+  std::uint8_t mode = 0;
+  std::optional<std::uint32_t> ret_val;
+};
+/// A configured module's place in the process images, as its owner (the H-system model's
+/// I/O map, a CPU node's DP interfaces) assigned it: SFC 14/15 look LADDR up here.
+struct IoModuleExtent {
+  std::uint32_t in_addr = 0;
+  std::uint32_t in_len = 0;
+  std::uint32_t out_addr = 0;
+  std::uint32_t out_len = 0;
+  bool dp = true;  ///< false: a central module (expansion rack): no consistent DP data
+};
+
 struct ProgramSpec {
   bus::Ticks scan_time = 10 * bus::kTicksPerMs;  ///< OB 1 cycle (start to start)
   std::vector<CopyNetwork> copies;
   std::vector<CounterNetwork> counters;
   std::vector<DiscrepancyNetwork> monitors;
   std::vector<HCtrlCall> h_ctrl_calls;  ///< SFC 90 calls (docs/h-sfc90.md)
+  std::vector<DpReadCall> dprd_dat;          ///< SFC 14 (h_dp_sfc.hpp)
+  std::vector<DpWriteCall> dpwr_dat;         ///< SFC 15
+  std::vector<DpSyncFreezeCall> dpsyc_fr;    ///< SFC 11: run by a plain CPU's node, not by Program
+  std::vector<DpActivateCall> d_act_dp;      ///< SFC 12: likewise
+  std::vector<IoModuleExtent> io_modules;    ///< filled by the owner, not by the scenario
 };
 
 }  // namespace pbvbus::devices

@@ -287,6 +287,14 @@ class Master final : public fdl::InitiatorUser {
   /// Whether a pure PrmCmd for the slave is waiting to be sent.
   bool prm_cmd_pending(std::uint8_t address) const;
 
+  /// Deactivates (active = false) or activates a configured slave at run time, as S7's SFC 12
+  /// D_ACT_DP does (master_activate.cpp, docs/s7cpu.md "DP system functions"): a deactivated
+  /// slave is no longer addressed (state Inactive, stored diagnosis Deactivated, its DP-V1 jobs
+  /// fail, its inputs invalid), without a StationFailure event; an activated one runs the full
+  /// start-up again (Slave_Diag, Set_Prm, Chk_Cfg, ...) while the master is in Clear/Operate.
+  /// Returns false for an unknown slave; true (nothing changes) when it already is so.
+  bool set_slave_active(std::uint8_t address, bool active);
+
   // --- DP-V1 MSAC_C1 (bus thread). Each returns an id (> 0) or 0 if refused: unknown slave, not
   // DP-V1, not in data exchange, or a length out of 1..240. The callback runs on completion.
   std::uint32_t read(std::uint8_t address, std::uint8_t slot, std::uint8_t index,

@@ -104,6 +104,9 @@ class HCpuMpiNode {
   const mpi_station::MpiStation& station() const { return *m_station; }
   const HMpiPlan& plan() const { return m_plan; }
   int rack() const { return m_rack; }
+  /// Ends every connection's session now (as a power-off does), so that none outlives the model
+  /// (Simulation's destructor: the model goes first).
+  void end_sessions(bus::Ticks now) { m_station->on_power_off(now); }
 
  private:
   class Factory;

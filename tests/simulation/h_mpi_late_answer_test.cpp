@@ -78,8 +78,8 @@ struct PgRun {
   std::optional<mpi_station::Handle> h;
   std::vector<mpi_station::StationEvent> events;
 
-  PgRun() {
-    auto loaded = parse_scenario(kText, "late-mpi.textproto");
+  explicit PgRun(const std::string& text = kText) {
+    auto loaded = parse_scenario(text, "late-mpi.textproto");
     if (!loaded.ok()) throw std::runtime_error(loaded.errors.at(0).str());
     sim = std::make_unique<Simulation>(*loaded.plan);
     sim->line(0).add_tap(rec);
@@ -181,6 +181,32 @@ TEST(HMpiLateAnswer, JobOfAConnectionReleasedDuringTheUpdateGetsNoAnswer) {
   EXPECT_EQ(r.replies().size(), before);
   EXPECT_EQ(r.cpu_data_message(kT1), r.rec.size());  // nothing sent from the CPU
   EXPECT_EQ(r.sim->h_system(0).model().held_s7_jobs(), 0u);
+}
+
+TEST(HMpiLateAnswer, UpdateAbortedByTheStandbysFailureAnswersTheHeldJobInSolo) {
+  // CPU 1 (the standby being updated) fails at 3.050 s: the update is aborted there and the
+  // master goes on in Solo (000 L1680: the stored jobs are caught up on "after an abort ... back
+  // in Solo mode"): the held job is answered from then, in RUN (08), not RUN-R.
+  constexpr bus::Ticks kAbort = 3050 * kMs;
+  PgRun r(kText + "fault { at: \"3050ms\" cpu_failure { rack: 1 } }\n");
+  ASSERT_NO_FATAL_FAILURE(r.connect());
+  r.sim->run_until(kT1 + 10 * kMs);
+  const std::size_t before = r.replies().size();
+  ASSERT_EQ(r.pg->submit(*r.h, kSzl0424a), mpi::RequestError::None);
+  r.sim->run_until(kAbort - 1);
+  EXPECT_EQ(r.sim->h_system(0).model().held_s7_jobs(), 1u);
+  EXPECT_EQ(r.replies().size(), before);
+  // The ring loses CPU 1's station with it; if it held the token, the PG claims it after its
+  // TTO (6 x TSL = 2490 bits), polls the GAP to find CPU 2 and passes it the token: with one
+  // more rotation and the answer frame, < 2490 + 1653 + 2 x 551 + 768 = 6013 bits = 32 ms.
+  r.sim->run_until(kAbort + kSecond);
+  const auto rs = r.replies();
+  ASSERT_EQ(rs.size(), before + 1);
+  EXPECT_GT(rs[before].at, kAbort);
+  ASSERT_GT(rs[before].pdu.size(), 37u);
+  EXPECT_EQ(rs[before].pdu[5], 0x14);
+  EXPECT_EQ(rs[before].pdu[37], 0x08);  // RUN: Solo after the abort
+  EXPECT_EQ(r.pg->state(*r.h), mpi::State::Connected);
 }
 
 }  // namespace

@@ -136,6 +136,7 @@ class HSession final : public mpi_station::S7Session {
   std::vector<std::uint8_t> handle(std::span<const std::uint8_t> pdu) override { return m_s.handle(pdu); }
   bool holds_jobs_now() const override { return m_s.holds_jobs_now(); }
   void on_late_answer(mpi_station::LateAnswerSink sink) override { m_s.on_late_answer(std::move(sink)); }
+  bool ended() const override { return !m_s.alive(); }  // lost with its CPU, at a link-up (R8)
 
  private:
   devices::HS7Session m_s;

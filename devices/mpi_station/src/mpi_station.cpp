@@ -33,6 +33,7 @@ std::string_view to_string(EndReason r) {
     case EndReason::TokenLost: return "token lost";
     case EndReason::PowerLoss: return "power loss";
     case EndReason::Refused: return "refused by the session factory";
+    case EndReason::SessionEnded: return "session ended";
   }
   return "?";
 }
@@ -238,8 +239,12 @@ void MpiStation::answer_later(std::uint32_t serial, std::vector<std::uint8_t> an
   }
   Served& s = *it;
   if (s.held > 0) --s.held;
+  const bus::Ticks t = now();
   if (answer.empty()) {
-    ++stats_.answers_none;  // as for an answer given at once (the session ended meanwhile)
+    no_answer(t, s);  // as for an answer given at once (the session ended meanwhile)
+    flush(t);
+    rearm();
+    deliver();
     return;
   }
   if (answer.size() > mpi::kMaxDataLen) {
@@ -247,7 +252,6 @@ void MpiStation::answer_later(std::uint32_t serial, std::vector<std::uint8_t> an
     return;
   }
   ++stats_.answers_late;
-  const bus::Ticks t = now();
   s.pending.push_back(std::move(answer));
   send_pending_served(t, s);
   // Inside a station call (the session answered from handle()) the outer flush takes the
@@ -255,6 +259,24 @@ void MpiStation::answer_later(std::uint32_t serial, std::vector<std::uint8_t> an
   flush(t);
   rearm();
   deliver();
+}
+
+void MpiStation::no_answer(bus::Ticks now, Served& s) {
+  ++stats_.answers_none;
+  if (s.reported || !s.session || !s.session->ended()) return;
+  // The session is kept until the connection is gone (it may be inside its own sink now).
+  if (pool_.disconnect(now, s.sap, out_) != mpi::RequestError::None) return;
+  s.reported = true;
+  s.pending.clear();
+  StationEvent ev;
+  ev.at = now;
+  ev.kind = EventKind::Broken;
+  ev.role = Role::Server;
+  ev.local_sap = s.sap;
+  ev.peer = s.peer;
+  ev.reason = EndReason::SessionEnded;
+  count_end(ev.kind, ev.reason);
+  emit(std::move(ev));
 }
 
 std::size_t MpiStation::held_jobs() const {
@@ -415,7 +437,7 @@ void MpiStation::on_server_event(bus::Ticks now, const mpi::Event& e) {
           ++s->held;  // answered later through the sink (answer_later)
           ++stats_.answers_held;
         } else {
-          ++stats_.answers_none;
+          no_answer(now, *s);
         }
         return;
       }

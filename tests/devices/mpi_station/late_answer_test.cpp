@@ -29,18 +29,25 @@ class HoldingSession final : public S7Session {
  public:
   HoldingSession(std::unique_ptr<S7Session> inner, const bool& hold) : inner_(std::move(inner)), hold_(hold) {}
   std::vector<std::uint8_t> handle(std::span<const std::uint8_t> pdu) override {
+    if (ended_) return {};
     if (!hold_) return inner_->handle(pdu);
     held_.emplace_back(pdu.begin(), pdu.end());
     return {};
   }
   bool holds_jobs_now() const override { return hold_; }
+  bool ended() const override { return ended_; }
+  /// From now on every job gets no answer (as an H CPU's session lost with its CPU).
+  void end() {
+    ended_ = true;
+    inner_.reset();
+  }
   void on_late_answer(LateAnswerSink sink) override { sink_ = std::move(sink); }
   /// Answers the held jobs in arrival order through the station's sink.
   void release() {
     while (!held_.empty()) {
       auto job = std::move(held_.front());
       held_.pop_front();
-      sink_(inner_->handle(job));
+      sink_(ended_ ? std::vector<std::uint8_t>{} : inner_->handle(job));
     }
   }
   const LateAnswerSink& sink() const { return sink_; }
@@ -48,6 +55,7 @@ class HoldingSession final : public S7Session {
  private:
   std::unique_ptr<S7Session> inner_;
   const bool& hold_;
+  bool ended_ = false;
   std::deque<std::vector<std::uint8_t>> held_;
   LateAnswerSink sink_;
 };
@@ -216,6 +224,41 @@ TEST_F(MpiLateAnswer, HeldJobOfAConnectionReleasedMeanwhileIsDropped) {
   EXPECT_TRUE(replies.empty());
   EXPECT_EQ(cpu->stats().pdus_sent, sent);
   EXPECT_EQ(l.find_prefix("68 23 23 68 80 82", before), l.rec.size());  // no answer on the wire
+}
+
+TEST_F(MpiLateAnswer, HeldJobOfASessionThatEndedReleasesTheConnection) {
+  // The session ends while it holds a job (an H CPU's connection lost): its late answer is
+  // empty, the station releases the connection (80) instead of leaving the client waiting.
+  factory.hold = true;
+  ASSERT_EQ(pg->submit(handle, bytes_from_hex(kRead7)), mpi::RequestError::None);
+  l.run_ms(50);
+  ASSERT_EQ(cpu->held_jobs(), 1u);
+  (void)cpu->take_events();
+  factory.last->end();
+  factory.last->release();
+  EXPECT_EQ(cpu->held_jobs(), 0u);
+  const auto cpu_broken = of_kind(cpu->take_events(), EventKind::Broken);
+  ASSERT_EQ(cpu_broken.size(), 1u);
+  EXPECT_EQ(cpu_broken[0].reason, EndReason::SessionEnded);
+  EXPECT_EQ(cpu->stats().broken[static_cast<std::size_t>(EndReason::SessionEnded)], 1u);
+  ASSERT_TRUE(l.run_until([&] { return pg->state(handle) == mpi::State::Closed; }, 1000));
+  const auto pg_ends = of_kind(pg->take_events(), EventKind::Closed);
+  ASSERT_EQ(pg_ends.size(), 1u);
+  EXPECT_EQ(pg_ends[0].reason, EndReason::ByPeer);
+  EXPECT_TRUE(of_kind(cpu->take_events(), EventKind::Closed).empty());  // reported once
+  EXPECT_EQ(cpu->server_connections(), 0u);
+}
+
+TEST_F(MpiLateAnswer, JobOfASessionThatEndedGetsTheDisconnect) {
+  // The same without holding: a job answered by nothing from an ended session.
+  factory.last->end();
+  ASSERT_EQ(pg->submit(handle, bytes_from_hex(kRead7)), mpi::RequestError::None);
+  ASSERT_TRUE(l.run_until([&] { return pg->state(handle) == mpi::State::Closed; }, 1000));
+  const auto pg_ends = of_kind(pg->take_events(), EventKind::Closed);
+  ASSERT_EQ(pg_ends.size(), 1u);
+  EXPECT_EQ(pg_ends[0].reason, EndReason::ByPeer);
+  EXPECT_EQ(cpu->stats().broken[static_cast<std::size_t>(EndReason::SessionEnded)], 1u);
+  EXPECT_EQ(cpu->stats().answers_none, 1u);
 }
 
 }  // namespace

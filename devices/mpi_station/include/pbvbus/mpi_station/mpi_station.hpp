@@ -108,8 +108,9 @@ enum class EndReason : std::uint8_t {
   TokenLost,        ///< the peer missing, our station alone after claiming a lost token
   PowerLoss,        ///< our own station lost power
   Refused,          ///< server: the session factory refused the connection
+  SessionEnded,     ///< server: the session answers nothing more (S7Session::ended)
 };
-inline constexpr std::size_t kEndReasonCount = static_cast<std::size_t>(EndReason::Refused) + 1;
+inline constexpr std::size_t kEndReasonCount = static_cast<std::size_t>(EndReason::SessionEnded) + 1;
 std::string_view to_string(EndReason r);
 
 struct StationEvent {
@@ -247,6 +248,9 @@ class MpiStation final : public bus::Device {
   void send_pending_served(bus::Ticks now, Served& s);
   /// A session's late answer (its sink): queued on its connection if that is still open.
   void answer_later(std::uint32_t serial, std::vector<std::uint8_t> answer);
+  /// No answer from `s`'s session: if it has ended, the connection is released (80) and
+  /// reported Broken/SessionEnded (the session itself goes with the connection's end).
+  void no_answer(bus::Ticks now, Served& s);
   /// Queues an event; deliver() hands the queue to the handler (or keeps it for take_events()).
   void emit(StationEvent ev);
   void deliver();

@@ -36,6 +36,10 @@ class S7Session {
   /// The station's sink for late answers, given once when the session opens, before the
   /// first handle(). Default: ignored (the session never answers later).
   virtual void on_late_answer(LateAnswerSink /*sink*/) {}
+  /// True once the session answers nothing more (an H CPU's connection lost with its CPU or at
+  /// a link-up, R8): when a job then gets no answer, the station releases the connection (80)
+  /// and reports it Broken/SessionEnded. Default: never.
+  virtual bool ended() const { return false; }
 };
 
 class S7SessionFactory {

@@ -94,10 +94,10 @@ struct PgRun {
       if (e.kind == mpi_station::EventKind::Reply) out.push_back(e);
     return out;
   }
-  /// Connects to CPU 0 (MPI 2) at 0.2 s and sets up communication (answered at once).
-  void connect() {
+  /// Connects to `cpu` (CPU 0 at MPI 2) at 0.2 s and sets up communication (answered at once).
+  void connect(std::uint8_t cpu = 2) {
     sim->run_until(200 * kMs);
-    h = pg->open(2);
+    h = pg->open(cpu);
     ASSERT_TRUE(h);
     sim->run_until(600 * kMs);
     ASSERT_EQ(pg->state(*h), mpi::State::Connected);
@@ -207,6 +207,29 @@ TEST(HMpiLateAnswer, UpdateAbortedByTheStandbysFailureAnswersTheHeldJobInSolo) {
   EXPECT_EQ(rs[before].pdu[5], 0x14);
   EXPECT_EQ(rs[before].pdu[37], 0x08);  // RUN: Solo after the abort
   EXPECT_EQ(r.pg->state(*r.h), mpi::State::Connected);
+}
+
+TEST(HMpiLateAnswer, StandbyConnectionBrokenAtTheLinkUpIsReleasedAtTheNextJob) {
+  // The PG is connected to CPU 1 (MPI 3, the standby in STOP) before the link-up; at 1 s the
+  // link-up breaks the standby's connections (R8). The model's session answers nothing more;
+  // at the PG's next job the CPU releases the MPI connection (80): the PG sees it closed by the
+  // peer instead of waiting for an answer that never comes.
+  PgRun r;
+  ASSERT_NO_FATAL_FAILURE(r.connect(3));
+  r.sim->run_until(1200 * kMs);
+  ASSERT_EQ(r.pg->state(*r.h), mpi::State::Connected);  // nothing tells the PG before a job
+  const std::size_t before = r.replies().size();
+  ASSERT_EQ(r.pg->submit(*r.h, kSzl0424a), mpi::RequestError::None);
+  r.sim->run_until(1200 * kMs + kSecond);
+  EXPECT_EQ(r.replies().size(), before);
+  EXPECT_EQ(r.pg->state(*r.h), mpi::State::Closed);
+  std::vector<mpi_station::StationEvent> ends;
+  for (const auto& e : r.events)
+    if (e.kind == mpi_station::EventKind::Closed || e.kind == mpi_station::EventKind::Broken) ends.push_back(e);
+  ASSERT_EQ(ends.size(), 1u);
+  EXPECT_EQ(ends[0].kind, mpi_station::EventKind::Closed);
+  EXPECT_EQ(ends[0].reason, mpi_station::EndReason::ByPeer);
+  EXPECT_GT(ends[0].at, 1200 * kMs);
 }
 
 }  // namespace

@@ -94,7 +94,11 @@ class S7CpuNode final : public bus::EventTarget {
 /// resources, refused during a link-up/update, R8). `model` gives the running model (nullptr
 /// before the H-system runs: connections are then refused). The line powers the station with its
 /// CPU (Simulation: the CPU's power-on time, cpu_failure faults), so a CPU that fails leaves the
-/// token ring and its connections break at the PGs (PeerLeftRing / PeerGone).
+/// token ring and its connections break at the PGs (PeerLeftRing / PeerGone). Jobs arriving
+/// during an update (t1..t5) are held by the model and answered at t5 or the abort through the
+/// station's late-answer sink (000 L1673-1680); a session that ended (its CPU lost, R8 at a
+/// link-up) gets its MPI connection released at the next job (docs/h-sfc90.md, docs/mpi.md
+/// decisions 11 and 12).
 class HCpuMpiNode {
  public:
   HCpuMpiNode(const HMpiPlan& plan, int rack, const fdl::BusParams& params,

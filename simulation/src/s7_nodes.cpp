@@ -122,11 +122,22 @@ void S7CpuNode::exchange(dp::Master& master) {
 
 namespace {
 
-/// One MPI connection's S7 session on an H CPU: answers while the model's session lives.
+/// One MPI connection's S7 session on an H CPU: answers while the model's session lives. A job
+/// arriving during an update (t1..t5) is held by the model and answered at t5 or the abort, in
+/// arrival order, through the station's late-answer sink (000 L1673-1680; docs/h-sfc90.md
+/// "Communication jobs held by the update"): the station then queues it on the connection for
+/// its next token, with the line's now (no wake of its own is needed: the station's MAC sends
+/// queued frames whenever it holds the token, and it re-arms its timer through its port).
 class HSession final : public mpi_station::S7Session {
  public:
   explicit HSession(devices::HS7Session s) : m_s(std::move(s)) {}
+  ~HSession() override { m_s.on_late_answer(nullptr); }  // the connection ended: held jobs dropped
+  HSession(const HSession&) = delete;
+  HSession& operator=(const HSession&) = delete;
   std::vector<std::uint8_t> handle(std::span<const std::uint8_t> pdu) override { return m_s.handle(pdu); }
+  bool holds_jobs_now() const override { return m_s.holds_jobs_now(); }
+  void on_late_answer(mpi_station::LateAnswerSink sink) override { m_s.on_late_answer(std::move(sink)); }
+  bool ended() const override { return !m_s.alive(); }  // lost with its CPU, at a link-up (R8)
 
  private:
   devices::HS7Session m_s;

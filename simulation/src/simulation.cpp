@@ -150,6 +150,8 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
 }
 
 Simulation::~Simulation() {
+  // The H CPUs' MPI sessions end while their model lives (m_h is destroyed before m_h_mpi).
+  for (auto& n : m_h_mpi) n->end_sessions(m_sched.now());
   for (const auto& l : m_links) ::unlink(l.c_str());
 }
 

@@ -33,6 +33,7 @@ std::string_view to_string(EndReason r) {
     case EndReason::TokenLost: return "token lost";
     case EndReason::PowerLoss: return "power loss";
     case EndReason::Refused: return "refused by the session factory";
+    case EndReason::SessionEnded: return "session ended";
   }
   return "?";
 }
@@ -230,6 +231,60 @@ void MpiStation::send_pending_served(bus::Ticks now, Served& s) {
   }
 }
 
+void MpiStation::answer_later(std::uint32_t serial, std::vector<std::uint8_t> answer) {
+  auto it = std::find_if(served_.begin(), served_.end(), [&](const Served& s) { return s.serial == serial; });
+  if (it == served_.end() || it->reported || !it->session || !powered_) {
+    ++stats_.late_answers_dropped;  // the connection ended meanwhile: nobody to answer
+    return;
+  }
+  Served& s = *it;
+  if (s.held > 0) --s.held;
+  const bus::Ticks t = now();
+  if (answer.empty()) {
+    no_answer(t, s);  // as for an answer given at once (the session ended meanwhile)
+    flush(t);
+    rearm();
+    deliver();
+    return;
+  }
+  if (answer.size() > mpi::kMaxDataLen) {
+    ++stats_.answers_too_long;
+    return;
+  }
+  ++stats_.answers_late;
+  s.pending.push_back(std::move(answer));
+  send_pending_served(t, s);
+  // Inside a station call (the session answered from handle()) the outer flush takes the
+  // frames; otherwise they are queued for the token here and the data ack's deadline armed.
+  flush(t);
+  rearm();
+  deliver();
+}
+
+void MpiStation::no_answer(bus::Ticks now, Served& s) {
+  ++stats_.answers_none;
+  if (s.reported || !s.session || !s.session->ended()) return;
+  // The session is kept until the connection is gone (it may be inside its own sink now).
+  if (pool_.disconnect(now, s.sap, out_) != mpi::RequestError::None) return;
+  s.reported = true;
+  s.pending.clear();
+  StationEvent ev;
+  ev.at = now;
+  ev.kind = EventKind::Broken;
+  ev.role = Role::Server;
+  ev.local_sap = s.sap;
+  ev.peer = s.peer;
+  ev.reason = EndReason::SessionEnded;
+  count_end(ev.kind, ev.reason);
+  emit(std::move(ev));
+}
+
+std::size_t MpiStation::held_jobs() const {
+  std::size_t n = 0;
+  for (const Served& s : served_) n += s.held;
+  return n;
+}
+
 // --- events ----------------------------------------------------------------------------------
 
 std::vector<StationEvent> MpiStation::take_events() { return std::exchange(events_, {}); }
@@ -339,10 +394,15 @@ void MpiStation::on_server_event(bus::Ticks now, const mpi::Event& e) {
     case mpi::EventKind::ConnectIndication: {
       ++stats_.connects_accepted;
       Served s;
+      s.serial = next_serial_++;
       s.sap = e.local_sap;
       s.peer = e.peer;
       s.session = server_ ? server_->open(e.peer) : nullptr;
       const bool refused = !s.session;
+      if (s.session) {
+        s.session->on_late_answer(
+            [this, serial = s.serial](std::vector<std::uint8_t> answer) { answer_later(serial, std::move(answer)); });
+      }
       served_.push_back(std::move(s));
       ev.kind = EventKind::Accepted;
       emit(std::move(ev));
@@ -370,9 +430,15 @@ void MpiStation::on_server_event(bus::Ticks now, const mpi::Event& e) {
       ++stats_.pdus_received;
       Served* s = served(e.local_sap);
       if (!s || !s->session || s->reported) return;
+      const bool holds = s->session->holds_jobs_now();
       std::vector<std::uint8_t> answer = s->session->handle(e.data);
       if (answer.empty()) {
-        ++stats_.answers_none;
+        if (holds) {
+          ++s->held;  // answered later through the sink (answer_later)
+          ++stats_.answers_held;
+        } else {
+          no_answer(now, *s);
+        }
         return;
       }
       if (answer.size() > mpi::kMaxDataLen) {

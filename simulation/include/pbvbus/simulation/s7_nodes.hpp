@@ -119,7 +119,11 @@ class S7CpuNode final : public bus::EventTarget {
 /// resources, refused during a link-up/update, R8). `model` gives the running model (nullptr
 /// before the H-system runs: connections are then refused). The line powers the station with its
 /// CPU (Simulation: the CPU's power-on time, cpu_failure faults), so a CPU that fails leaves the
-/// token ring and its connections break at the PGs (PeerLeftRing / PeerGone).
+/// token ring and its connections break at the PGs (PeerLeftRing / PeerGone). Jobs arriving
+/// during an update (t1..t5) are held by the model and answered at t5 or the abort through the
+/// station's late-answer sink (000 L1673-1680); a session that ended (its CPU lost, R8 at a
+/// link-up) gets its MPI connection released at the next job (docs/h-sfc90.md, docs/mpi.md
+/// decisions 11 and 12).
 class HCpuMpiNode {
  public:
   HCpuMpiNode(const HMpiPlan& plan, int rack, const fdl::BusParams& params,
@@ -129,6 +133,9 @@ class HCpuMpiNode {
   const mpi_station::MpiStation& station() const { return *m_station; }
   const HMpiPlan& plan() const { return m_plan; }
   int rack() const { return m_rack; }
+  /// Ends every connection's session now (as a power-off does), so that none outlives the model
+  /// (Simulation's destructor: the model goes first).
+  void end_sessions(bus::Ticks now) { m_station->on_power_off(now); }
 
  private:
   class Factory;

@@ -22,6 +22,15 @@
 // follows it as its own data message (the S7 session answers inside the indication, so ack and
 // answer usually leave in the same token visit, ack first).
 //
+// Late answers (s7_session.hpp; an H CPU holds the jobs arriving during an update, 000
+// L1673-1680): the job's data message is acknowledged at once all the same (B0 01 nr: the MPI
+// layer acks the message, not the job), so the client's connection stays up however long the
+// job is held (stacks/mpi times only the connect and the data ack, mpi::ConnectionTiming; the
+// wait for the answer is the client's S7 job timeout, not an MPI matter). The answer goes out,
+// when the session hands it over, as a data message of its own like any answer (queued behind
+// the connection's other answers, sent when the previous one is acked, at the station's next
+// token). A connection that ended meanwhile drops it.
+//
 // Broken connections (reported once, as Broken with a reason): the mpi layer's (no confirm, no
 // data ack in time, FDL NoResponse = PeerGone, FDL refusal, sequence error); a peer that leaves
 // the token ring (our LAS loses it: cut, power off) for `peer_absent_timeout` -> PeerLeftRing,
@@ -99,8 +108,9 @@ enum class EndReason : std::uint8_t {
   TokenLost,        ///< the peer missing, our station alone after claiming a lost token
   PowerLoss,        ///< our own station lost power
   Refused,          ///< server: the session factory refused the connection
+  SessionEnded,     ///< server: the session answers nothing more (S7Session::ended)
 };
-inline constexpr std::size_t kEndReasonCount = static_cast<std::size_t>(EndReason::Refused) + 1;
+inline constexpr std::size_t kEndReasonCount = static_cast<std::size_t>(EndReason::SessionEnded) + 1;
 std::string_view to_string(EndReason r);
 
 struct StationEvent {
@@ -130,6 +140,9 @@ struct MpiStationStats {
   std::uint64_t pdus_received = 0;      ///< S7 PDUs received in data messages
   std::uint64_t answers_none = 0;       ///< server: sessions that gave no answer
   std::uint64_t answers_too_long = 0;   ///< server: answers over 242 octets, dropped
+  std::uint64_t answers_held = 0;       ///< server: jobs a session held to answer later
+  std::uint64_t answers_late = 0;       ///< server: late answers queued on their connection
+  std::uint64_t late_answers_dropped = 0;  ///< server: late answers of connections gone
   std::uint64_t closed = 0;             ///< connections closed in order
   std::array<std::uint64_t, kEndReasonCount> broken{};  ///< Broken events by EndReason
 };
@@ -170,6 +183,8 @@ class MpiStation final : public bus::Device {
   bool serves() const { return server_ != nullptr; }
   /// Server role: connections open in the pool (what counts against max_connections).
   std::size_t server_connections() const { return pool_.open_connections(); }
+  /// Server role: jobs held by the sessions (S7Session::holds_jobs_now), not yet answered.
+  std::size_t held_jobs() const;
   /// MPI frames waiting for the token.
   std::size_t frames_queued() const { return tx_high_.size() + tx_low_.size(); }
 
@@ -196,6 +211,8 @@ class MpiStation final : public bus::Device {
     bool reported = false;  // a Broken/Closed/Refused event has been given
   };
   struct Served {
+    std::uint32_t serial = 0;  // this connection among all the station served (a SAP is reused)
+    std::size_t held = 0;      // jobs held by the session, answers still to come
     std::uint8_t sap = 0;
     std::uint8_t peer = 0;
     std::unique_ptr<S7Session> session;
@@ -229,6 +246,11 @@ class MpiStation final : public bus::Device {
   void on_server_event(bus::Ticks now, const mpi::Event& e);
   void send_pending_client(bus::Ticks now, Client& c);
   void send_pending_served(bus::Ticks now, Served& s);
+  /// A session's late answer (its sink): queued on its connection if that is still open.
+  void answer_later(std::uint32_t serial, std::vector<std::uint8_t> answer);
+  /// No answer from `s`'s session: if it has ended, the connection is released (80) and
+  /// reported Broken/SessionEnded (the session itself goes with the connection's end).
+  void no_answer(bus::Ticks now, Served& s);
   /// Queues an event; deliver() hands the queue to the handler (or keeps it for take_events()).
   void emit(StationEvent ev);
   void deliver();
@@ -255,6 +277,7 @@ class MpiStation final : public bus::Device {
   std::vector<Client> clients_;
   mpi::ConnectionPool pool_;
   std::vector<Served> served_;
+  std::uint32_t next_serial_ = 1;
 
   std::deque<Tx> tx_high_, tx_low_;
   std::optional<Tx> in_flight_;

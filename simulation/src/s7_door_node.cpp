@@ -151,7 +151,9 @@ S7DoorNode::S7DoorNode(bus::Scheduler& sched, const S7DoorPlan& plan, std::vecto
   }
 }
 
-S7DoorNode::~S7DoorNode() {
+S7DoorNode::~S7DoorNode() { close(); }
+
+void S7DoorNode::close() {
   if (m_door) m_door->close();
   m_door.reset();
 }

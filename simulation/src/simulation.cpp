@@ -150,7 +150,9 @@ Simulation::Simulation(const ScenarioPlan& plan, const SimulationOptions& opts)
 }
 
 Simulation::~Simulation() {
-  // The H CPUs' MPI sessions end while their model lives (m_h is destroyed before m_h_mpi).
+  // Sessions on an H model end while the model lives (m_h is destroyed before the doors and
+  // m_h_mpi): the S7 doors' client connections first, then the H CPUs' MPI sessions.
+  for (auto& d : m_s7_doors) d->close();
   for (auto& n : m_h_mpi) n->end_sessions(m_sched.now());
   for (const auto& l : m_links) ::unlink(l.c_str());
 }

@@ -53,6 +53,10 @@ class S7DoorNode final : public iso_on_tcp::S7Router, public bus::EventTarget {
   /// The port it listens on (0 before open()).
   std::uint16_t port() const { return m_door ? m_door->port() : 0; }
   const iso_on_tcp::IsoDoorStats* stats() const { return m_door ? &m_door->stats() : nullptr; }
+  /// Closes the listener and every client connection now (their S7 sessions end while the
+  /// CPUs and H models they talk to still exist); idempotent. The run calls it first when it
+  /// ends: an H session must not outlive its model (h_s7_session.hpp).
+  void close();
   /// Every S7 PDU through the door (for the capture), set before open().
   void set_capture(iso_on_tcp::PduCapture capture) { m_capture = std::move(capture); }
 

@@ -206,5 +206,29 @@ TEST(DpScenario, WithoutEquidistanceTheReportHasNoEquidistance) {
   EXPECT_EQ(json.str().find("equidistance"), std::string::npos);
 }
 
+TEST(DpScenario, TheEquidistanceExampleHoldsItsGrid) {
+  const LoadResult r = load_scenario_file(PBVBUS_SOURCE_DIR "/examples/dp-equidistance.textproto");
+  ASSERT_TRUE(r.ok()) << r.errors.front().str();
+  Simulation sim(*r.plan);
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(0.0);
+  ASSERT_EQ(rep.dp_masters.size(), 1u);
+  const auto& e = rep.dp_masters[0].equidistance;
+  EXPECT_EQ(e.period, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(e.overruns, 0u);
+  EXPECT_EQ(e.jitter, 0);
+  EXPECT_GE(e.cycles, 99u);  // 200 ms / 2 ms
+  for (const auto& s : rep.dp_masters[0].slaves) EXPECT_EQ(s.state, "data exchange") << int{s.address};
+  // The pause frames (FDL Status to itself) are neither repeats nor unanswered requests.
+  std::ostringstream all;
+  write_text(rep, all);
+  EXPECT_NE(all.str().find("on the wire: no response 0, retries 0,"), std::string::npos) << all.str();
+  if (::testing::Test::HasFailure()) {
+    std::ostringstream text;
+    write_text(rep, text);
+    ADD_FAILURE() << text.str();
+  }
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -180,6 +180,33 @@ TEST(DpMasterEquidistance, AMissingReplyMakesAnOverrun) {
   EXPECT_EQ(eq.jitter, 0);  // the late start is not a jitter sample
 }
 
+TEST(DpMasterEquidistance, TheActivePauseKeepsASecondMasterFromClaimingTheToken) {
+  // A second master at address 2 (a DP master in Stop), listening for its admission (the GAP
+  // scan that admits it comes only after 100 visits here). Its TTO is 6·TSL + 2·2·TSL = 10 000
+  // bit times of silence, less than T_DP = 12 000: a silent pause of a whole cycle would make
+  // it claim the token. The active pause never leaves the line silent for more than TSL + the
+  // passive rest (< 66 + TSL = 1066 bit times).
+  constexpr std::int64_t kTdp = 12'000;
+  Bench b(kTdp);
+  MasterParams mp2;
+  mp2.address = 2;
+  mp2.initial_mode = MasterMode::Stop;
+  Master m2(mp2, {});
+  fdl::ActiveStation st2(2, b.bp, m2);
+  b.line.attach(st2, "master 2");
+  b.run_until_bits(40 * kTdp);
+  EXPECT_EQ(b.station->stats().token_losses, 1u);  // its own claim at power-on
+  EXPECT_EQ(st2.stats().token_losses, 0u);          // never claimed
+  EXPECT_EQ(st2.stats().tokens_passed, 0u);
+  EXPECT_EQ(b.station->stats().duplicate_token, 0u);
+  EXPECT_GT(b.station->stats().pause_frames, 300u);  // 39 clean cycles × 10, less the GAP's
+  ASSERT_EQ(b.master->slave_state(10), SlaveStatusState::DataExchange);
+  const auto& eq = b.master->equidistance();
+  EXPECT_EQ(eq.overruns, 0u);
+  EXPECT_EQ(eq.jitter, 0);
+  EXPECT_GE(eq.intervals, 30u);
+}
+
 TEST(DpMasterEquidistance, OffByDefault) {
   MasterParams mp;
   EXPECT_EQ(mp.equidistant_cycle, 0);

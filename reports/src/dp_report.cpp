@@ -10,12 +10,40 @@
 
 namespace pbvbus::tools {
 
+namespace {
+
+// Equidistance (docs/dp-equidistance.md): only for a master that has it, so that every other
+// report stays as it was.
+void write_equidistance_text(const DpMasterReport& m, std::ostream& os) {
+  const auto& e = m.equidistance;
+  if (e.period <= 0) return;
+  const auto bit = bus::ticks_per_bit(m.baud);
+  os << "  equidistance: T_DP " << format_us(e.period) << " us = " << e.period / bit << " bit times, cycles "
+     << e.cycles << ", overruns " << e.overruns << " (due times passed over " << e.missed << "), max lateness "
+     << format_us(e.max_lateness) << " us = " << e.max_lateness / bit << " bit times, cycle start jitter "
+     << e.jitter / bit << " bit times over " << e.intervals << " on-time cycles\n";
+}
+
+void write_equidistance_json(const DpMasterReport& m, std::ostream& os) {
+  const auto& e = m.equidistance;
+  if (e.period <= 0) return;
+  const auto bit = bus::ticks_per_bit(m.baud);
+  os << ",\"equidistance\":{\"t_dp_ns\":" << bus::ticks_to_ns(e.period) << ",\"t_dp_bits\":" << e.period / bit
+     << ",\"cycles\":" << e.cycles << ",\"overruns\":" << e.overruns << ",\"missed\":" << e.missed
+     << ",\"max_lateness_ns\":" << bus::ticks_to_ns(e.max_lateness)
+     << ",\"max_lateness_bits\":" << e.max_lateness / bit << ",\"jitter_bits\":" << e.jitter / bit
+     << ",\"on_time_intervals\":" << e.intervals << "}";
+}
+
+}  // namespace
+
 void write_dp_text(const std::vector<DpMasterReport>& r, std::ostream& os) {
   for (const auto& m : r) {
     const auto bit = bus::ticks_per_bit(m.baud);
     os << "\ndp master " << static_cast<int>(m.address) << " on line " << m.line << ": "
        << m.mode << ", Global_Control sent " << m.global_controls << ", Data_Control_Time "
        << m.data_control_time * 10 << " ms\n";
+    write_equidistance_text(m, os);
     for (const auto& s : m.slaves) {
       os << "  dp slave " << static_cast<int>(s.address) << " \"" << s.model << "\" [";
       for (std::size_t i = 0; i < s.modules.size(); ++i) os << (i ? ", " : "") << s.modules[i];
@@ -50,7 +78,9 @@ void write_dp_json(const std::vector<DpMasterReport>& r, std::ostream& os) {
     os << (mi ? ",\n" : "\n") << "{\"address\":" << static_cast<int>(m.address)
        << ",\"line\":" << json_quote(m.line) << ",\"mode\":" << json_quote(m.mode)
        << ",\"global_controls\":" << m.global_controls
-       << ",\"data_control_time_ms\":" << m.data_control_time * 10 << ",\"slaves\":[";
+       << ",\"data_control_time_ms\":" << m.data_control_time * 10;
+    write_equidistance_json(m, os);
+    os << ",\"slaves\":[";
     for (std::size_t i = 0; i < m.slaves.size(); ++i) {
       const auto& s = m.slaves[i];
       const auto& st = s.stats;

@@ -8,6 +8,7 @@
 
 #include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/dp/prm.hpp"
+#include "pbvbus/scenario/dp_equidistance_plan.hpp"
 #include "pbvbus/scenario/dp_link_plan.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 
@@ -714,6 +715,7 @@ std::uint32_t dp_ttr(const fdl::BusParams& p,
 
 void plan_dp(ScenarioPlan& plan, const DpLocator& locate, std::vector<Diagnostic>& errors) {
   DpPlanner(plan, locate, errors).run();
+  plan_dp_equidistance(plan, locate, errors);
 }
 
 }  // namespace pbvbus::tools

@@ -191,6 +191,16 @@ class RuleChecker {
         if (m_plan.proto.master(k).line() == lname)
           error_at(m_locate("master", k, "line", -1),
                    "master on line \"" + lname + "\": a second master on a line of " + sys + kMultiMaster);
+      // D4: equidistance (docs/dp-equidistance.md).
+      if (rs.master[side] >= 0) {
+        const DpMasterPlan& own = m_plan.dp_masters[static_cast<std::size_t>(rs.master[side])];
+        if (!m_plan.proto.dp_master(own.source).equidistant_cycle().empty())
+          error_at(m_locate("dp_master", own.source, "equidistant_cycle", -1),
+                   "dp_master " + std::to_string(own.params.address) + " on line \"" + lname +
+                       "\": equidistant_cycle on a DP master of " + sys +
+                       ": an H-system has no equidistance of DP slaves (S7-400H manual 001 "
+                       "L14085-14089, L13663-13666, D4)");
+      }
       // D5: the baud rate.
       if (m_plan.lines[static_cast<std::size_t>(line)].baud == bus::Baud::k31_25) {
         const auto& pl = m_plan.proto.line(line_source(lname));

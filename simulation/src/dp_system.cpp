@@ -184,6 +184,7 @@ DpMasterReport dp_master_report(const dp::Master& m, std::uint64_t global_contro
   r.mode = std::string(dp::to_string(m.mode()));
   r.global_controls = global_controls;
   r.data_control_time = m.params().data_control_time;
+  r.equidistance = m.equidistance();
   for (std::size_t i = 0; i < engines.size(); ++i) {
     const DpSlavePlan& p = *plans[i];
     const dp::SlaveEngine& eng = *engines[i];

@@ -117,7 +117,9 @@ void LineStats::on_frame(const bus::TapFrame& f) {
     const fdl::RequestFn fn = fdl::fc_request_fn(t.fc);
     ++requests_by_fn[static_cast<std::size_t>(fn)];
     mark(t.sa, fdl::StationType::MasterInRing, false);
-    if (fdl::fn_expects_reply(fn) && t.da != fdl::kBroadcast) {
+    // A request to the sender itself is an equidistance pause frame (docs/dp-equidistance.md):
+    // nobody answers it, and the next one is no repeat.
+    if (fdl::fn_expects_reply(fn) && t.da != fdl::kBroadcast && t.da != t.sa) {
       const std::uint64_t h = hash_of(f.bytes);
       if (m_last_request[t.sa] == h) ++repeats;
       m_last_request[t.sa] = h;

@@ -129,6 +129,31 @@ TEST(HRefusals, D4_APlainFdlMasterOnARedundantLineIsRefused) {
                 "multi-master operation in Redundant mode (S7-400H manual 001 L14070-14074, L13653-13655, D4)"}));
 }
 
+// D4, equidistance: 001 L14085-14089 ("in a fault-tolerant system there is no equidistance for
+// DP slaves"); table B-1 L13663-13666 (standard CPU yes, Solo no, Redundant no).
+std::string equidistant_base() {
+  std::string b = kBase;
+  const std::string m = "dp_master { address: 1 line: \"DP_A\" }";
+  b.replace(b.find(m), m.size(), "dp_master { address: 1 line: \"DP_A\" equidistant_cycle: \"5ms\" }");
+  return b;
+}
+
+TEST(HRefusals, D4_AnEquidistantMasterOfAnHSystemIsRefused) {
+  // Line 5: `dp_master { address: 1 line: "DP_A" ` is 36 columns: the field at column 37.
+  EXPECT_EQ(errors_of(equidistant_base() + rms() + h()),
+            (std::vector<std::string>{
+                "h.textproto:5:37: dp_master 1 on line \"DP_A\": equidistant_cycle on a DP master of "
+                "redundant_master_system \"H-DP 1\" of h_system \"H\": an H-system has no equidistance of DP "
+                "slaves (S7-400H manual 001 L14085-14089, L13663-13666, D4)"}));
+}
+
+TEST(HRefusals, D4_AnEquidistantMasterOfARedundantSystemWithoutAnHSystemLoads) {
+  // A plain PI 2.212 system: equidistance is the standard CPU's "yes" of table B-1.
+  const auto r = parse_scenario(equidistant_base() + rms(), kFile);
+  ASSERT_TRUE(r.ok()) << r.errors[0].str();
+  EXPECT_EQ(r.plan->dp_masters[0].params.equidistant_cycle, 5 * bus::kTicksPerMs);
+}
+
 TEST(HRefusals, D4_ASecondMasterOnARedundantSystemWithoutAnHSystemLoads) {
   // Without an h_system the redundant system is a plain PI 2.212 system: multi-master is the
   // standard CPU's "yes" of table B-1.

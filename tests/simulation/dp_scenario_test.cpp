@@ -127,5 +127,108 @@ TEST(DpScenario, ReportShowsEverySlave) {
   EXPECT_NE(text.str().find("dp slave 3 \"pbvbus CS16 16DI/16DO\""), std::string::npos) << text.str();
 }
 
+// ---- equidistance (docs/dp-equidistance.md) ----
+// One PBVB0A01 slave (2 octets in, 2 out) at 1.5 Mbit/s: max TSDR 150 (GSD), TSL 300,
+// TID1 = max(33 + 4, 11) = 37, TID2 = max(37, 150) = 150. Planned DP cycle: Data_Exchange
+// 11·11 + 150 + 11·11 + 37 = 429, Global_Control 11·13 + 150 = 293, GAP poll 66 + 300 + 37 =
+// 403, token 33 + 37 = 70: 1195 bit times; margin one repeat 11·11 + 300 = 421: 1616 bit
+// times = 1077.333 µs.
+std::string equidistant(const std::string& t_dp) {
+  return "name: \"t\"\nduration: \"100ms\"\nline { name: \"A\" baud: \"1.5M\" }\n"
+         "dp_master { address: 1 line: \"A\" equidistant_cycle: \"" + t_dp + "\" }\n"
+         "dp_slave { address: 3 line: \"A\" gsd: \"gsd/PBVB0A01.gsd\" master: 1 }\n";
+}
+
+TEST(DpScenario, AnEquidistantCycleShorterThanThePlannedCycleIsRefused) {
+  // `dp_master { address: 1 line: "A" ` is 33 columns: the field at column 34 of line 4.
+  EXPECT_EQ(errors_of(equidistant("1ms")),
+            (std::vector<std::string>{
+                kFile + ":4:34: dp_master 1: equidistant_cycle \"1ms\" (1500 bit times at line \"A\") is "
+                        "shorter than the planned DP cycle of 1195 bit times (1 slave, Global_Control, GAP poll, "
+                        "token) + a margin of 421 (one repeat) = 1616 bit times (1077.333 us)"}));
+  EXPECT_EQ(errors_of(equidistant("0ms")),
+            (std::vector<std::string>{kFile + ":4:34: dp_master 1: equidistant_cycle \"0ms\" is not a positive "
+                                              "duration (e.g. \"2ms\")"}));
+  // 1616 bit times load: 1616 / 1.5 µs is not a whole µs, 1078 µs = 1617 bit times is the first.
+  EXPECT_TRUE(errors_of(equidistant("1078us")).empty());
+  EXPECT_FALSE(errors_of(equidistant("1077us")).empty());
+}
+
+TEST(DpScenario, AnEquidistantMasterRunsOnItsGrid) {
+  const auto r = parse_scenario(equidistant("2ms"), kFile);
+  ASSERT_TRUE(r.ok()) << r.errors.front().str();
+  EXPECT_EQ(r.plan->dp_masters[0].params.equidistant_cycle, 2 * bus::kTicksPerMs);
+  // TTR = 2 × 1195 + 300 + 100 = 2790 (DpScenario.PlansSlavesFromTheGsd), raised by T_DP =
+  // 3000 bit times.
+  EXPECT_EQ(r.plan->lines[0].params.ttr, 2790u + 3000u);
+  Simulation sim(*r.plan);
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(0.0);
+  ASSERT_EQ(rep.dp_masters.size(), 1u);
+  const auto& e = rep.dp_masters[0].equidistance;
+  EXPECT_EQ(e.period, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(e.overruns, 0u);
+  EXPECT_EQ(e.jitter, 0);
+  // 100 ms / 2 ms: the grid starts at the first pass, a few hundred µs after power-on.
+  EXPECT_GE(e.cycles, 49u);
+  EXPECT_LE(e.cycles, 50u);
+  EXPECT_EQ(e.intervals, e.cycles - 1);
+  EXPECT_EQ(e.interval_min, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(e.interval_max, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(rep.dp_masters[0].slaves.at(0).state, "data exchange");
+  std::ostringstream text;
+  write_text(rep, text);
+  EXPECT_NE(text.str().find("  equidistance: T_DP 2000.000 us = 3000 bit times, cycles "), std::string::npos)
+      << text.str();
+  EXPECT_NE(text.str().find(", overruns 0 (due times passed over 0), max lateness 0.000 us = 0 bit times, "
+                            "cycle start jitter 0 bit times over "),
+            std::string::npos)
+      << text.str();
+  std::ostringstream json;
+  write_json(rep, json);
+  EXPECT_NE(json.str().find(",\"equidistance\":{\"t_dp_ns\":2000000,\"t_dp_bits\":3000,\"cycles\":"),
+            std::string::npos)
+      << json.str();
+}
+
+TEST(DpScenario, WithoutEquidistanceTheReportHasNoEquidistance) {
+  const auto r = parse_scenario(
+      head() + "dp_slave { address: 3 line: \"A\" gsd: \"gsd/PBVB0A01.gsd\" master: 1 }\n", kFile);
+  ASSERT_TRUE(r.ok()) << r.errors.front().str();
+  EXPECT_EQ(r.plan->dp_masters[0].params.equidistant_cycle, 0);
+  Simulation sim(*r.plan);
+  sim.run_until(10 * bus::kTicksPerMs);
+  const Report rep = sim.report(0.0);
+  std::ostringstream text, json;
+  write_text(rep, text);
+  write_json(rep, json);
+  EXPECT_EQ(text.str().find("equidistance"), std::string::npos);
+  EXPECT_EQ(json.str().find("equidistance"), std::string::npos);
+}
+
+TEST(DpScenario, TheEquidistanceExampleHoldsItsGrid) {
+  const LoadResult r = load_scenario_file(PBVBUS_SOURCE_DIR "/examples/dp-equidistance.textproto");
+  ASSERT_TRUE(r.ok()) << r.errors.front().str();
+  Simulation sim(*r.plan);
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(0.0);
+  ASSERT_EQ(rep.dp_masters.size(), 1u);
+  const auto& e = rep.dp_masters[0].equidistance;
+  EXPECT_EQ(e.period, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(e.overruns, 0u);
+  EXPECT_EQ(e.jitter, 0);
+  EXPECT_GE(e.cycles, 99u);  // 200 ms / 2 ms
+  for (const auto& s : rep.dp_masters[0].slaves) EXPECT_EQ(s.state, "data exchange") << int{s.address};
+  // The pause frames (FDL Status to itself) are neither repeats nor unanswered requests.
+  std::ostringstream all;
+  write_text(rep, all);
+  EXPECT_NE(all.str().find("on the wire: no response 0, retries 0,"), std::string::npos) << all.str();
+  if (::testing::Test::HasFailure()) {
+    std::ostringstream text;
+    write_text(rep, text);
+    ADD_FAILURE() << text.str();
+  }
+}
+
 }  // namespace
 }  // namespace pbvbus::tools

@@ -117,6 +117,34 @@ s7_cpu { name: "C" mpi_dp { mode: DP line: "DP" address: 2 } }
   EXPECT_EQ(sim.s7_cpu(0).unmapped_bytes(), 0u);
 }
 
+TEST(S7ScenarioRun, TheCpusDpInterfaceRunsWithAConstantBusCycle) {
+  // Equidistance on a standard CPU's DP interface (001 L13663-13666: standard S7-400 "yes";
+  // docs/dp-equidistance.md): the dp_master entry that is the interface carries T_DP.
+  const std::string text = R"(name: "dp" duration: "100ms"
+line { name: "DP" }
+dp_master { address: 2 line: "DP" equidistant_cycle: "2ms" }
+dp_slave { address: 3 line: "DP" gsd: "gsd/PBVB0A01.gsd" master: 2 inputs: COUNTER }
+s7_cpu { name: "C" mpi_dp { mode: DP line: "DP" address: 2 } }
+)";
+  const auto plan = plan_of(text);
+  ASSERT_TRUE(plan);
+  Simulation sim(*plan);
+  auto q = sim.s7_cpu(0).memory().area(s7cpu::Area::Outputs);
+  q[0] = 0x12;
+  q[1] = 0x34;
+  sim.start();
+  sim.run_until(*sim.duration());
+  const auto rep = sim.report(1.0);
+  ASSERT_EQ(rep.dp_masters.size(), 1u);
+  const auto& e = rep.dp_masters[0].equidistance;
+  EXPECT_EQ(e.period, 2 * bus::kTicksPerMs);
+  EXPECT_EQ(e.overruns, 0u);
+  EXPECT_EQ(e.jitter, 0);
+  EXPECT_GE(e.cycles, 49u);
+  ASSERT_EQ(rep.dp_slaves.size(), 1u);
+  EXPECT_EQ(rep.dp_slaves[0].outputs, (std::vector<std::uint8_t>{0x12, 0x34}));
+}
+
 TEST(S7ScenarioRun, ACpuInStopWritesZeroOutputs) {
   const auto plan = plan_of(R"(name: "stop" duration: "100ms"
 line { name: "DP" }

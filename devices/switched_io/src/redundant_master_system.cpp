@@ -42,6 +42,7 @@ class RedundantMasterSystemModel::Node final : public fdl::InitiatorUser {
     m_model.cycle(m_line, now);
     m_master.on_token(now, trr);
   }
+  bus::Ticks pause_until(bus::Ticks now) override { return m_master.pause_until(now); }
 
  private:
   RedundantMasterSystemModel& m_model;

@@ -125,6 +125,8 @@ Master::Master(MasterParams params, std::vector<SlaveParams> slaves) : m_p(std::
     m_index[s.p.address] = static_cast<int>(m_slaves.size());
     m_slaves.push_back(std::move(s));
   }
+  if (m_p.equidistant_cycle < 0) throw std::invalid_argument("DP master: negative equidistant cycle");
+  m_eq.period = m_p.equidistant_cycle;
   m_mode = m_p.initial_mode;
   m_standby = m_p.standby;
   m_scratch.reserve(kMaxDiagLen);
@@ -203,6 +205,8 @@ void Master::reset_slaves() {
   }
   m_pass_active = false;
   m_gc_due = true;
+  m_eq_due = bus::kNever;  // a new equidistance grid with the next pass
+  m_eq_last_late = true;
 }
 
 void Master::set_mode(MasterMode m) {
@@ -243,7 +247,7 @@ void Master::on_token(bus::Ticks now, bus::Ticks /*trr*/) {
   // new token was lost with the ring (the station never confirmed it): forget it.
   m_out_kind = Kind::None;
   m_out_slave = -1;
-  if (!m_pass_active) start_pass();
+  if (!m_pass_active && m_p.equidistant_cycle <= 0) start_pass();
 }
 
 void Master::start_pass() {
@@ -274,6 +278,7 @@ bool Master::next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out)
   if (m_standby) return false;  // a hot-standby master only listens
   if (m_mode != MasterMode::Clear && m_mode != MasterMode::Operate) return false;
   if (m_out_kind != Kind::None) return false;  // one request at a time
+  if (m_p.equidistant_cycle > 0 && !m_pass_active && !equidistant_start(now)) return false;
 
   // Global_Control announcing the operating state.
   if (m_gc_due || m_last_gc == bus::kNever || now - m_last_gc >= m_gc_interval) {

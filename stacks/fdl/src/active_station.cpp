@@ -558,6 +558,13 @@ void ActiveStation::step(bus::Ticks now) {
     if (r == Ask::Sent) return;
     if (r == Ask::Nothing) break;
   }
+  if (m_cycles_visit == 0) {
+    const bus::Ticks until = m_user.pause_until(now);
+    if (until > now) {
+      equidistance_pause(now, until);
+      return;
+    }
+  }
   if (gap_due && (now < m_hold_deadline || m_tth_expired)) {
     gap_poll(now, m_gap_next);
     return;
@@ -729,6 +736,24 @@ void ActiveStation::gap_failed(bus::Ticks now) {
   m_pass_next = true;
   m_state = MacState::Use_Token;
   step(now);
+}
+
+void ActiveStation::equidistance_pause(bus::Ticks now, bus::Ticks until) {
+  // Active pause while an FDL Status request to ourselves (SD1, 6 octets) and its slot time
+  // fit before `until`, then a passive pause (docs/dp-equidistance.md).
+  bus::Ticks wake = until;
+  if (until - now >= bus::chars_to_ticks(6, m_p.baud) + m_tsl) {
+    FrameSpec spec;
+    spec.da = m_ts;
+    spec.sa = m_ts;
+    spec.fc = make_request_fc(RequestFn::FdlStatus);
+    encode_as(FrameType::SD1, spec, m_tx);
+    ++m_stats.pause_frames;
+    wake = send(now, m_tx) + m_tsl;
+  }
+  m_hold_deadline += wake - now;
+  m_state = MacState::Use_Token;
+  arm(wake);
 }
 
 void ActiveStation::pass_token(bus::Ticks now) {

@@ -60,6 +60,8 @@ class DpMasterNode final : public fdl::InitiatorUser {
     m_master.on_request(ind, reply);
   }
   void on_token(bus::Ticks now, bus::Ticks trr) override;
+  /// Equidistance (docs/dp-equidistance.md): the master's pause.
+  bus::Ticks pause_until(bus::Ticks now) override { return m_master.pause_until(now); }
 
  private:
   dp::Master m_master;
@@ -150,6 +152,7 @@ struct DpMasterReport {
   std::string mode;  ///< "Operate", "Clear", "Stop", "Offline"
   std::uint64_t global_controls = 0;
   std::uint16_t data_control_time = 0;  ///< 10 ms units
+  dp::EquidistanceStats equidistance;    ///< period 0 = off (docs/dp-equidistance.md)
   std::vector<DpSlaveReport> slaves;
 };
 

@@ -67,6 +67,9 @@
 //     } ],
 //     "dp_masters": [ { "address": int, "line": str, "mode": "Operate"|"Clear"|"Stop"|"Offline",
 //       "global_controls": int, "data_control_time_ms": int,
+//       "equidistance": { "t_dp_ns","t_dp_bits","cycles","overruns","missed","max_lateness_ns",
+//                         "max_lateness_bits","jitter_bits","on_time_intervals": int },
+//                                    // only with equidistant_cycle (docs/dp-equidistance.md)
 //       "slaves": [ { "address": int, "model": str, "modules": [str],
 //                     "state": str,          // the master's view, e.g. "DataExchange"
 //                     "slave_state": str,    // the slave's own, e.g. "Data_Exch"

@@ -84,6 +84,8 @@ class DpHead final : public IoHead, public fdl::InitiatorUser {
   void on_request(const fdl::Indication& ind, fdl::Reply& reply) override;
   void on_token(bus::Ticks now, bus::Ticks trr) override;
   void on_observed(bus::Ticks now, const fdl::Telegram& t) override;
+  /// Equidistance (docs/dp-equidistance.md): the master's pause.
+  bus::Ticks pause_until(bus::Ticks now) override { return m_master.pause_until(now); }
 
  private:
   dp::Master m_master;

@@ -81,6 +81,13 @@
 // its interval runs on from the one seen. The station is switched separately:
 // ActiveStation::set_passive(false, now) right after take_over(now).
 //
+// Equidistance (constant bus cycle time, docs/dp-equidistance.md): with equidistant_cycle
+// T_DP > 0 a pass does not start at a token receipt but when next_request() is asked at or
+// after its due time; between passes pause_until() asks the station to keep the token until
+// then. The first pass after power-on or a restart from Stop/Offline sets the grid origin;
+// a pass starting after its due time is an overrun (lateness = start − due); the next one is
+// due at the first grid point after the start.
+//
 // Performance: the steady Data_Exchange path does not allocate (the Request's data vector keeps
 // its capacity, cycle statistics use a fixed ring).
 
@@ -156,6 +163,26 @@ struct MasterParams {
   bus::Ticks failed_retry_interval = 0;    ///< minimum time between Slave_Diag retries of an
                                            ///< absent or locked slave; 0 = once per pass
   bool standby = false;                    ///< start in hot standby (see set_standby())
+  /// Equidistance (constant bus cycle time T_DP, docs/dp-equidistance.md); 0 = off.
+  bus::Ticks equidistant_cycle = 0;
+};
+
+/// Equidistance counters (docs/dp-equidistance.md). A cycle is a pass over the slaves; it is due
+/// at origin + k·T_DP (origin = the first pass after power-on or a restart from Stop/Offline).
+struct EquidistanceStats {
+  bus::Ticks period = 0;          ///< T_DP; 0 = equidistance off
+  std::uint64_t cycles = 0;       ///< passes started
+  std::uint64_t overruns = 0;     ///< passes started after their due time
+  std::uint64_t missed = 0;       ///< due times passed over entirely by a late pass
+  bus::Ticks max_lateness = 0;    ///< largest start − due time
+  bus::Ticks last_lateness = 0;   ///< of the last overrun
+  bus::Ticks last_start = bus::kNever;
+  /// Measured start jitter: max − min of the intervals between consecutive pass starts that
+  /// are both on time (0 while the grid holds).
+  bus::Ticks jitter = 0;
+  bus::Ticks interval_min = 0;
+  bus::Ticks interval_max = 0;
+  std::uint64_t intervals = 0;    ///< intervals that went into the jitter
 };
 
 /// Counters of the hot-standby takeovers (see the header comment).
@@ -315,12 +342,16 @@ class Master final : public fdl::InitiatorUser {
   bool shadow_in_dx(std::uint8_t address) const;
   const HsbyStats& hsby_stats() const { return m_hsby; }
 
+  // --- equidistance (docs/dp-equidistance.md) ---
+  const EquidistanceStats& equidistance() const { return m_eq; }
+
   // --- fdl::InitiatorUser ---
   void on_power_on(bus::Ticks now) override;
   bool next_request(fdl::Priority prio, bus::Ticks now, fdl::Request& out) override;
   void on_confirmation(const fdl::Confirmation& con) override;
   void on_token(bus::Ticks now, bus::Ticks trr) override;
   void on_observed(bus::Ticks now, const fdl::Telegram& t) override;
+  bus::Ticks pause_until(bus::Ticks now) override;
 
  private:
   enum class Kind : std::uint8_t { None, GlobalControl, Diag, Prm, Cfg, DataExchange, Acyclic, PrmCmd };
@@ -382,6 +413,8 @@ class Master final : public fdl::InitiatorUser {
   void fill(fdl::Request& out, const Slave& s, std::optional<std::uint8_t> dsap,
             std::optional<std::uint8_t> ssap, Kind kind);
   void start_pass();
+  /// Equidistance: starts the pass if its due time has come (master_equidistance.cpp).
+  bool equidistant_start(bus::Ticks now);
 
   void on_diag(Slave& s, const fdl::Confirmation& con, bool after_dh);
   void on_dx(Slave& s, const fdl::Confirmation& con);
@@ -438,6 +471,11 @@ class Master final : public fdl::InitiatorUser {
   bool m_sh_gc_seen = false;
   bool m_sh_gc_clear = false;
   bus::Ticks m_sh_gc_at = bus::kNever;
+
+  // Equidistance.
+  EquidistanceStats m_eq;
+  bus::Ticks m_eq_due = bus::kNever;  ///< due time of the next pass; kNever = no grid yet
+  bool m_eq_last_late = true;         ///< the last pass started late (or is the first)
 
   std::uint32_t m_next_job_id = 1;
   std::vector<std::uint8_t> m_scratch;

@@ -64,6 +64,11 @@
 //    station) is not sent and confirmed NoResponse at once; so is a request whose reply was
 //    pending when the station dropped its token (duplicate token): neither marks the responder
 //    non-operational.
+//  - Equidistance pause (InitiatorUser::pause_until, docs/dp-equidistance.md): at the start
+//    of a visit with nothing to send, the station may keep the token until the user's next
+//    cycle: FDL Status requests (SD1, DA = SA = TS) to itself, each followed by TSL (nobody
+//    answers), while one fits; then silence until the cycle time. The pause is added to the
+//    hold deadline.
 //  - Requests addressed to this master are answered like a passive station would (FCB filter,
 //    SAP mirroring, TSDR = min TSDR), with the FC's station type bits telling our MAC state.
 //
@@ -136,6 +141,7 @@ struct ActiveStats {
   std::uint64_t duplicate_address = 0;   ///< own address detected in use by another station
   std::uint64_t requests_answered = 0;   ///< requests from other masters answered
   std::uint64_t frames_observed = 0;     ///< valid frames reported while passive
+  std::uint64_t pause_frames = 0;        ///< equidistance: FDL Status requests to itself
   std::array<std::uint64_t, 16> requests_by_fn{};  ///< message cycles by request function
 };
 
@@ -229,6 +235,7 @@ class ActiveStation final : public bus::Device {
   void gap_poll(bus::Ticks now, std::uint8_t addr);
   void gap_failed(bus::Ticks now);
   void pass_token(bus::Ticks now);
+  void equidistance_pause(bus::Ticks now, bus::Ticks until);
   void pass_failed(bus::Ticks now);
   void slot_expired(bus::Ticks now);
   void record_rotation(bus::Ticks trr);

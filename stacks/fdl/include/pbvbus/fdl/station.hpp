@@ -127,6 +127,13 @@ class InitiatorUser {
   /// Used by a hot-standby DP master to shadow the active master at the same address
   /// (docs/quantum-hsby-dp.md).
   virtual void on_observed(bus::Ticks /*now*/, const Telegram& /*t*/) {}
+  /// Equidistance (constant bus cycle time, docs/dp-equidistance.md): asked when a token visit
+  /// has sent nothing yet and next_request() had nothing. A time later than `now` makes the
+  /// station keep the token and pause until then instead of polling the GAP and passing the
+  /// token (active pause: FDL Status requests to itself while one fits with its slot time;
+  /// then a passive pause, silence), and ask next_request() again at its end. The pause does
+  /// not use up the token hold time. Default: no pause.
+  virtual bus::Ticks pause_until(bus::Ticks /*now*/) { return 0; }
 
  protected:
   ~InitiatorUser() = default;

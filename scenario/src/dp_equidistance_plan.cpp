@@ -10,9 +10,6 @@ namespace pbvbus::tools {
 
 namespace {
 
-std::uint64_t request_octets(std::uint64_t n) { return n == 0 ? 6 : n == 8 ? 14 : 9 + n; }
-std::uint64_t response_octets(std::uint64_t n) { return n == 0 ? 1 : request_octets(n); }
-
 std::string us(bus::Ticks t) {
   // Microseconds with up to three decimals (1 bit at 12 Mbit/s is 0.083 µs).
   const std::int64_t ns = t * 1000 / bus::kTicksPerUs;
@@ -33,7 +30,7 @@ std::uint64_t dp_planned_cycle_bits(const ScenarioPlan& plan, const DpMasterPlan
   std::uint64_t cycle = 0;
   for (int si : mp.slaves) {
     const DpSlavePlan& s = plan.dp_slaves[static_cast<std::size_t>(si)];
-    cycle += 11 * request_octets(s.outputs) + p.max_tsdr + 11 * response_octets(s.inputs) + p.tid1();
+    cycle += 11 * dp_request_octets(s.outputs) + p.max_tsdr + 11 * dp_response_octets(s.inputs) + p.tid1();
   }
   cycle += 11 * 13 + p.tid2();          // Global_Control (SD2, SAPs 58/62, 2 octets), then TID2
   cycle += 11 * 6 + p.tsl + p.tid1();   // one unanswered GAP poll
@@ -66,7 +63,7 @@ void plan_dp_equidistance(ScenarioPlan& plan, const DpLocator& locate,
     int min_interval_slave = -1;
     for (int si : mp.slaves) {
       const DpSlavePlan& s = plan.dp_slaves[static_cast<std::size_t>(si)];
-      longest = std::max<std::uint64_t>(longest, 11 * request_octets(s.outputs));
+      longest = std::max<std::uint64_t>(longest, 11 * dp_request_octets(s.outputs));
       const bus::Ticks iv = static_cast<bus::Ticks>(s.params.min_slave_interval) * 100 * bus::kTicksPerUs;
       if (iv > min_interval) {
         min_interval = iv;

@@ -18,8 +18,6 @@ namespace {
 
 constexpr bus::Ticks kTenMs = bus::kTicksPerSecond / 100;
 
-std::uint64_t request_octets(std::uint64_t n) { return n == 0 ? 6 : n == 8 ? 14 : 9 + n; }
-std::uint64_t response_octets(std::uint64_t n) { return n == 0 ? 1 : request_octets(n); }
 
 /// Smallest factor pair (f1 <= f2, both 1..255) with f1 * f2 == units; nullopt if none.
 std::optional<std::pair<std::uint8_t, std::uint8_t>> wd_factors(std::uint64_t units) {
@@ -702,7 +700,7 @@ std::uint32_t dp_ttr(const fdl::BusParams& p,
                      const std::vector<std::pair<std::size_t, std::size_t>>& io) {
   std::uint64_t pass = 0;
   for (const auto& [out, in] : io)
-    pass += 11 * request_octets(out) + p.max_tsdr + 11 * response_octets(in) + p.tid1();
+    pass += 11 * dp_request_octets(out) + p.max_tsdr + 11 * dp_response_octets(in) + p.tid1();
   pass += 11 * 3 + p.tid1();                   // token pass
   pass += 11 * 13 + p.tid2();                  // Global_Control: SD2 with SAPs 58/62, 2 octets
   pass += 11 * 6 + p.tsl + p.tid1();           // one unanswered GAP poll

@@ -25,6 +25,12 @@ namespace pbvbus::tools {
 struct ScenarioPlan;
 struct Diagnostic;
 
+/// Octets on the wire of a DP request / response with `n` data octets (SD1 for a request
+/// without data, SD3 for exactly 8, else SD2; a response without data is the short
+/// acknowledgement E5), as the planners count them (11 bit times per octet).
+inline std::uint64_t dp_request_octets(std::uint64_t n) { return n == 0 ? 6 : n == 8 ? 14 : 9 + n; }
+inline std::uint64_t dp_response_octets(std::uint64_t n) { return n == 0 ? 1 : dp_request_octets(n); }
+
 /// The planned DP cycle of master `mp` in bit times (see the header comment), without margin.
 std::uint64_t dp_planned_cycle_bits(const ScenarioPlan& plan, const DpMasterPlan& mp);
 

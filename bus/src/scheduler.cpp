@@ -27,15 +27,17 @@ Key key_of(const E& e) {
   // The new entry has the highest sequence number, so it goes before a parent only if it is
   // due strictly earlier.
   std::size_t i = m_heap.size();
-  m_heap.emplace_back();
+  m_heap.push_back(e);
   Entry* h = m_heap.data();
-  while (i > 0) {
-    const std::size_t parent = (i - 1) / kArity;
-    if (h[parent].when <= e.when) break;
-    place(h, i, h[parent]);
-    i = parent;
+  if (i > 0 && h[(i - 1) / kArity].when > e.when) {
+    do {
+      const std::size_t parent = (i - 1) / kArity;
+      if (h[parent].when <= e.when) break;
+      place(h, i, h[parent]);
+      i = parent;
+    } while (i > 0);
+    h[i] = e;
   }
-  h[i] = e;
   if (e.slot) e.slot->m_pos = i;
 }
 
@@ -150,40 +152,73 @@ void Scheduler::FnTarget::on_event(Ticks, std::uint64_t tag) {
 }
 
 bool Scheduler::step() {
-  Entry e;
-  if (m_fifo_head != m_fifo.size() &&
-      (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
-       (m_fifo[m_fifo_head].when == m_heap.front().when &&
-        m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
-    e = m_fifo[m_fifo_head++];
-    if (m_fifo_head == m_fifo.size()) {
-      m_fifo.clear();
-      m_fifo_head = 0;
+  const Ticks until = kNever;
+  // The earliest pending entry (FIFO or heap, by (when, seq)), if it is due by `until`.
+  {
+    Entry e;
+    if (m_fifo_head != m_fifo.size() &&
+        (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
+         (m_fifo[m_fifo_head].when == m_heap.front().when &&
+          m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
+      if (m_fifo[m_fifo_head].when > until) return false;
+      e = m_fifo[m_fifo_head];
+      if (++m_fifo_head == m_fifo.size()) {
+        m_fifo.clear();
+        m_fifo_head = 0;
+      }
+    } else {
+      if (m_heap.empty() || m_heap.front().when > until) return false;
+      Entry* h = m_heap.data();
+      e = h[0];
+      if (e.slot) e.slot->m_pos = TimerSlot::kNone;
+      const std::size_t n = m_heap.size() - 1;
+      if (n == 1)
+        place(h, 0, h[1]);
+      else if (n > 1)
+        sift_down(0, h[n], n);
+      m_heap.pop_back();
     }
-  } else if (!m_heap.empty()) {
-    Entry* h = m_heap.data();
-    e = h[0];
-    if (e.slot) e.slot->m_pos = TimerSlot::kNone;
-    const std::size_t n = m_heap.size() - 1;
-    if (n == 1) {
-      place(h, 0, h[1]);
-    } else if (n > 1) {
-      sift_down(0, h[n], n);
-    }
-    m_heap.pop_back();
-  } else {
-    return false;
+    m_now = e.when;
+    ++m_events_run;
+    e.target->on_event(e.when, e.tag);
   }
-  m_now = e.when;
-  ++m_events_run;
-  e.target->on_event(e.when, e.tag);
   return true;
 }
 
 void Scheduler::run_until(Ticks until) {
+  // The same as calling step() while next_time() <= until, with the pop written out here so
+  // that the loop pays no call per event for the queue itself.
   m_stop = false;
-  while (next_time() <= until) {
-    step();
+  for (;;) {
+    // The earliest pending entry (FIFO or heap, by (when, seq)), if it is due by `until`.
+    {
+      Entry e;
+      if (m_fifo_head != m_fifo.size() &&
+          (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
+           (m_fifo[m_fifo_head].when == m_heap.front().when &&
+            m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
+        if (m_fifo[m_fifo_head].when > until) break;
+        e = m_fifo[m_fifo_head];
+        if (++m_fifo_head == m_fifo.size()) {
+          m_fifo.clear();
+          m_fifo_head = 0;
+        }
+      } else {
+        if (m_heap.empty() || m_heap.front().when > until) break;
+        Entry* h = m_heap.data();
+        e = h[0];
+        if (e.slot) e.slot->m_pos = TimerSlot::kNone;
+        const std::size_t n = m_heap.size() - 1;
+        if (n == 1)
+          place(h, 0, h[1]);
+        else if (n > 1)
+          sift_down(0, h[n], n);
+        m_heap.pop_back();
+      }
+      m_now = e.when;
+      ++m_events_run;
+      e.target->on_event(e.when, e.tag);
+    }
     if (m_stop) return;
   }
   if (until > m_now) m_now = until;

@@ -511,7 +511,9 @@ void Line::end_transmission(std::uint64_t id) {
   // Receivers whose filter takes this frame: receive-all, its DA, or everyone for DA 127.
   const int da = frame_da(owned->bytes);
   Mask to;
-  for (std::size_t k = 0; k < to.w.size(); ++k) {
+  // Only the words that hold attachments (one up to 64 stations).
+  const std::size_t words = (m_devs.size() + 63) / 64;
+  for (std::size_t k = 0; k < words; ++k) {
     std::uint64_t want = m_receive_all.w[k];
     if (da >= 0) want |= m_by_addr[static_cast<std::size_t>(da)].w[k];
     if (da == 127) want |= m_filtered.w[k];

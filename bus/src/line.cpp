@@ -98,26 +98,34 @@ struct Line::Attachment final : EventTarget {
         return;
       }
       // The pending transmission due now: earliest start, then order of request.
-      auto it = std::min_element(pending.begin(), pending.end(), [](const auto& a, const auto& b) {
-        return a.start != b.start ? a.start < b.start : a.seq < b.seq;
-      });
-      std::vector<std::uint8_t> bytes = std::move(it->bytes);
-      pending.erase(it);
-      line.start_transmission(*this, bytes, false);
+      std::unique_ptr<Transmission> t;
+      if (pending.size() == 1) {  // the usual case
+        t = std::move(pending.front().tx);
+        pending.clear();
+      } else {
+        auto it = std::min_element(pending.begin(), pending.end(), [](const auto& a, const auto& b) {
+          return a.start != b.start ? a.start < b.start : a.seq < b.seq;
+        });
+        t = std::move(it->tx);
+        pending.erase(it);
+      }
+      line.start_transmission(*this, std::move(t), false);
     } else if (kind == kTagBabble) {
       if (value == babble_epoch) line.babble_burst(*this);
     }
   }
 
   void arm(Ticks at) {
+    // One queued wake-up per attachment: an earlier one moves the entry still queued (a
+    // superseded slot-time timer no longer runs as an event of its own).
     next_event = at;
-    line.m_sched.schedule(at, *this, (++timer_gen << 2) | kTagTimer);
+    line.m_sched.schedule(timer_slot, at, *this, (++timer_gen << 2) | kTagTimer);
   }
 
   struct Pending {
     Ticks start;
     std::uint64_t seq;
-    std::vector<std::uint8_t> bytes;
+    std::unique_ptr<Transmission> tx;  ///< from the line's pool, its bytes filled in
   };
 
   Line& line;
@@ -136,6 +144,7 @@ struct Line::Attachment final : EventTarget {
   Ticks deadline = kNever;
   Ticks next_event = kNever;
   std::uint64_t timer_gen = 0;
+  Scheduler::TimerSlot timer_slot;
   std::vector<Pending> pending;
   std::uint64_t pending_seq = 0;
   std::uint64_t power_epoch = 0;
@@ -148,9 +157,9 @@ void Line::Port::transmit(Ticks start, std::span<const std::uint8_t> bytes) {
   if (start < now) start = now;
   // Always through the queue, even at `now`: a device answering from inside on_frame() must not
   // start a transmission while the line is still delivering the previous one.
-  std::vector<std::uint8_t> buf = m_line.take_buffer();
-  buf.assign(bytes.begin(), bytes.end());
-  m_att.pending.push_back({start, m_att.pending_seq++, std::move(buf)});
+  std::unique_ptr<Transmission> t = m_line.take_transmission();
+  t->bytes.assign(bytes.begin(), bytes.end());
+  m_att.pending.push_back({start, m_att.pending_seq++, std::move(t)});
   m_line.m_sched.schedule(start, m_att, (m_att.power_epoch << 2) | kTagTxStart);
 }
 
@@ -176,7 +185,11 @@ Line::Line(Scheduler& sched, std::string name, Baud baud, std::uint64_t seed)
     : m_sched(sched), m_name(std::move(name)), m_baud(baud),
       m_rng(seed ^ 0x9E3779B97F4A7C15ULL) {}
 
-Line::~Line() = default;
+Line::~Line() {
+  // Queued timer entries point at their attachments' slots: withdraw them (the scheduler
+  // outlives its lines).
+  for (auto& a : m_atts) m_sched.cancel(a->timer_slot);
+}
 
 AttachmentId Line::attach(Device& dev, std::string label) {
   if (m_atts.size() >= kMaxAttachments) throw std::length_error("line " + m_name + ": too many attachments");
@@ -264,20 +277,15 @@ Ticks Line::earliest_start_in_flight() const {
   return t;
 }
 
-std::vector<std::uint8_t> Line::take_buffer() {
-  if (m_buffers.empty()) {
-    std::vector<std::uint8_t> b;
-    b.reserve(256);  // the longest FDL telegram (SD2, LE = 249) is 255 octets
-    return b;
+std::unique_ptr<Line::Transmission> Line::take_transmission() {
+  if (m_pool.empty()) {
+    auto t = std::make_unique<Transmission>();
+    t->bytes.reserve(256);  // the longest FDL telegram (SD2, LE = 249) is 255 octets
+    return t;
   }
-  std::vector<std::uint8_t> b = std::move(m_buffers.back());
-  m_buffers.pop_back();
-  return b;
-}
-
-void Line::give_buffer(std::vector<std::uint8_t>&& b) {
-  b.clear();
-  m_buffers.push_back(std::move(b));
+  std::unique_ptr<Transmission> t = std::move(m_pool.back());
+  m_pool.pop_back();
+  return t;
 }
 
 std::uint64_t Line::next_random() {
@@ -390,34 +398,25 @@ void Line::apply_noise(Transmission& t) {
   if (any) ++m_stats.noisy;
 }
 
-void Line::start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes, bool babble) {
+void Line::start_transmission(Attachment& from, std::unique_ptr<Transmission> t, bool babble) {
   if (!from.powered) {
-    give_buffer(std::move(bytes));
+    m_pool.push_back(std::move(t));
     return;
   }
   const Ticks now = m_sched.now();
   const Ticks char_ticks = chars_to_ticks(1, m_baud);
-  const Ticks end = now + static_cast<Ticks>(bytes.size()) * char_ticks;
+  const Ticks end = now + static_cast<Ticks>(t->bytes.size()) * char_ticks;
   ++m_stats.frames;
-  m_stats.octets += bytes.size();
+  m_stats.octets += t->bytes.size();
   if (!babble) from.uart_busy_until = end;
   if (m_short || !from.xcvr_ok) {
     // Nothing reaches the cable (or the cable carries nothing readable).
     ++m_stats.lost;
-    give_buffer(std::move(bytes));
+    m_pool.push_back(std::move(t));
     return;
-  }
-  std::unique_ptr<Transmission> t;
-  if (!m_pool.empty()) {
-    t = std::move(m_pool.back());
-    m_pool.pop_back();
-  } else {
-    t = std::make_unique<Transmission>();
   }
   t->id = ++m_next_tx_id;
   t->from = &from;
-  std::swap(t->bytes, bytes);
-  give_buffer(std::move(bytes));
   t->sent_len = t->bytes.size();
   t->start = now;
   t->end = end;
@@ -512,7 +511,9 @@ void Line::end_transmission(std::uint64_t id) {
   // Receivers whose filter takes this frame: receive-all, its DA, or everyone for DA 127.
   const int da = frame_da(owned->bytes);
   Mask to;
-  for (std::size_t k = 0; k < to.w.size(); ++k) {
+  // Only the words that hold attachments (one up to 64 stations).
+  const std::size_t words = (m_devs.size() + 63) / 64;
+  for (std::size_t k = 0; k < words; ++k) {
     std::uint64_t want = m_receive_all.w[k];
     if (da >= 0) want |= m_by_addr[static_cast<std::size_t>(da)].w[k];
     if (da == 127) want |= m_filtered.w[k];
@@ -666,7 +667,7 @@ void Line::set_power(AttachmentId id, bool on) {
   if (!on) {
     a.powered = false;
     refresh_listening();
-    for (auto& p : a.pending) give_buffer(std::move(p.bytes));
+    for (auto& p : a.pending) m_pool.push_back(std::move(p.tx));
     a.pending.clear();
     ++a.power_epoch;
     ++a.timer_gen;
@@ -712,11 +713,11 @@ void Line::set_babbling(AttachmentId id, bool on) {
 void Line::babble_burst(Attachment& a) {
   if (!a.babbling || !a.powered) return;
   // Garbage in bursts, back to back: the line never goes idle while it lasts.
-  std::vector<std::uint8_t> junk = take_buffer();
-  junk.resize(kBabbleBurst);
-  for (auto& b : junk) b = static_cast<std::uint8_t>(next_random());
-  const Ticks end = m_sched.now() + chars_to_ticks(static_cast<std::int64_t>(junk.size()), m_baud);
-  start_transmission(a, junk, true);
+  std::unique_ptr<Transmission> junk = take_transmission();
+  junk->bytes.resize(kBabbleBurst);
+  for (auto& b : junk->bytes) b = static_cast<std::uint8_t>(next_random());
+  const Ticks end = m_sched.now() + chars_to_ticks(static_cast<std::int64_t>(kBabbleBurst), m_baud);
+  start_transmission(a, std::move(junk), true);
   m_sched.schedule(end, a, (a.babble_epoch << 2) | kTagBabble);
 }
 

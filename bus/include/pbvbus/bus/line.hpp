@@ -173,10 +173,11 @@ class Line final : private EventTarget {
   friend class Port;
 
   void on_event(Ticks now, std::uint64_t tag) override;  // end of transmission `tag`
-  /// Puts `bytes` on the wire now; takes the buffer (it goes back to the pool afterwards).
-  void start_transmission(Attachment& from, std::vector<std::uint8_t>& bytes, bool babble);
-  std::vector<std::uint8_t> take_buffer();
-  void give_buffer(std::vector<std::uint8_t>&& b);
+  /// Puts `t`'s bytes on the wire now (it goes back to the pool afterwards).
+  void start_transmission(Attachment& from, std::unique_ptr<Transmission> t, bool babble);
+  /// A transmission from the pool (bytes to be filled in); pending transmissions are pooled
+  /// objects too, so a frame's bytes are copied once, from the device into the line.
+  std::unique_ptr<Transmission> take_transmission();
   /// After a repair that joins segments or revives a transceiver: receivers start hearing the
   /// rest of frames already on the wire (as garbage), and frames that now share the cable
   /// corrupt each other from here on.
@@ -230,10 +231,9 @@ class Line final : private EventTarget {
   /// Start of the frame whose end the taps are being told about (kNever otherwise).
   Ticks m_tapping_start = kNever;
   std::vector<std::unique_ptr<Transmission>> m_in_flight;
+  /// Transmissions recycled (pending, on the wire, done), so that the per-frame path does not
+  /// allocate once the line has warmed up.
   std::vector<std::unique_ptr<Transmission>> m_pool;
-  /// Byte buffers recycled between pending transmissions and transmissions, so that the
-  /// per-frame path does not allocate once the line has warmed up.
-  std::vector<std::vector<std::uint8_t>> m_buffers;
   // Hot per-attachment state, indexed by attachment id, kept contiguous for the per-frame loops.
   std::vector<Device*> m_devs;
   /// End of the last activity an attachment has heard or is hearing (frames received, cut

@@ -173,6 +173,10 @@ SwitchedStationBuild SwitchedStationModel::build(const GsdFile& gsd,
   m->m_rs->on_event([raw](const redundancy::RedEvent& e) { raw->m_events.push_back(e); });
   for (int i = 0; i < 2; ++i) m->m_if[i] = std::make_unique<Iface>(*m, i, options.bus_params);
   m->sync_addresses();  // Flying: interface 1 at A + 64
+  if (gsd.dpv1().c1_read_write_supp) {  // F3: the modules' parameter records, both interfaces
+    m->m_records = std::make_unique<ModuleRecords>(m->m_rs->engine(0).layout().modules.size());
+    for (int i = 0; i < 2; ++i) m->m_records->install(m->m_rs->engine(i).application());
+  }
   const auto& layout = m->m_rs->engine(0).layout();
   m->m_channels.resize(layout.modules.size());
   std::size_t max_in = 0;

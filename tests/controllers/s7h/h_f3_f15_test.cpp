@@ -54,8 +54,11 @@ struct DiagTap final : bus::Tap {
   };
   std::vector<Resp> seen;
   std::vector<Resp> to_sw;  ///< SD2/SD3 requests to station 5 (DA 0x85): `station` = the DSAP, DU after the SAPs
+  std::vector<Resp> from_sw_c1;  ///< SD2 responses of station 5 from SAP 51 to SAP 51 (MSAC_C1 Read/Write): whole frame
   void on_frame(const bus::TapFrame& f) override {
     const auto b = f.bytes;
+    if (b.size() >= 11 && b[0] == 0x68 && b[5] == (0x80 | 5) && b[7] == 0x33 && b[8] == 0x33)
+      from_sw_c1.push_back({f.end, b[4], Bytes(b.begin(), b.end())});
     if (b.size() >= 11 && b[0] == 0x68 && b[4] == (0x80 | 5) && (b[5] & 0x80) != 0)
       to_sw.push_back({f.end, b[7], Bytes(b.begin() + 9, b.end() - 2)});
     // SD3 (A2 DA SA FC DSAP SSAP DU[6] FCS 16): a request with exactly 6 DU octets, e.g. an
@@ -383,7 +386,9 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   // Re-parameterisation after the plug: the MSAC_C1 Write (slot 2, index 1, 12 34) on the active
   // channel, once (after the plug, not after the pull). On the wire it is an SD3 frame (six DU
   // octets): DSAP 51 (0x33, MSAC_C1), DU = Function_Num 5F, Slot_Number 02, Index 01, Length 02,
-  // data 12 34. The station model keeps no parameter records and answers negatively (DF ...).
+  // data 12 34. The station (module_records.hpp) takes it: the positive response `5F 02 01 02`
+  // from station 5 to master 1 (SD2: 68 09 09 68 DA=81 SA=85 FC=08 DSAP=33 SSAP=33 DU; FCS =
+  // 81+85+08+33+33+5F+02+01+02 = 0x1D8 -> D8) and the record is the module's.
   EXPECT_EQ(f.h->reparameterisations(), 1u);
   std::vector<DiagTap::Resp> writes;
   for (const auto& r : f.tap.to_sw)
@@ -392,6 +397,14 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   EXPECT_EQ(writes[0].du, (Bytes{0x5F, 0x02, 0x01, 0x02, 0x12, 0x34}));
   EXPECT_GT(writes[0].end, o83[1].time);  // after the plug's OB 83
   EXPECT_LT(writes[0].end, o83[1].time + 10 * kMs);
+  ASSERT_EQ(f.tap.from_sw_c1.size(), 1u);
+  EXPECT_EQ(f.tap.from_sw_c1[0].du,
+            (Bytes{0x68, 0x09, 0x09, 0x68, 0x81, 0x85, 0x08, 0x33, 0x33, 0x5F, 0x02, 0x01, 0x02,
+                   0xD8, 0x16}));
+  EXPECT_GT(f.tap.from_sw_c1[0].end, writes[0].end);
+  ASSERT_NE(f.sw->module_records(), nullptr);
+  EXPECT_EQ(f.sw->module_records()->record(1, 1), (Bytes{0x12, 0x34}));
+  EXPECT_EQ(f.sw->module_records()->writes_accepted(), 1u);
 
   EXPECT_EQ(f.obs(82).size(), 1u);
   EXPECT_EQ(f.obs(83).size(), 2u);

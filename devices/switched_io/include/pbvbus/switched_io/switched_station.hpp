@@ -141,6 +141,10 @@ class SwitchedStationModel {
                               std::uint8_t* seq_nr = nullptr);
   std::size_t alarms_outstanding() const { return m_rs->alarms_outstanding(); }
 
+  /// The modules' parameter data records (MSAC_C1 Write/Read on either interface; one
+  /// backplane, one store: slaves/module_records.hpp); null without C1_Read_Write_supp.
+  const ModuleRecords* module_records() const { return m_records.get(); }
+
  private:
   class Iface;
   class User;
@@ -163,6 +167,7 @@ class SwitchedStationModel {
   std::uint32_t m_tsdr = 0;
   GsdBytes m_default_prm;
   std::optional<bus::Ticks> m_t_slave_um;
+  std::unique_ptr<ModuleRecords> m_records;  ///< before m_rs: outlives the handlers it installs
   std::unique_ptr<redundancy::RedundantSlave> m_rs;
   std::unique_ptr<Iface> m_if[2];
   std::vector<std::vector<ChannelBehaviour>> m_channels;  ///< per module

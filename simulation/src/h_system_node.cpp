@@ -94,6 +94,21 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
       if (std::string e = m_model->add_cp(c); !e.empty()) throw std::invalid_argument(e);
     for (const devices::ConnectionConfig& c : rt.connections)
       if (std::string e = m_model->add_connection(c); !e.empty()) throw std::invalid_argument(e);
+    // F3: the modules' parameter records, written after a plug (docs/h-reparameterisation.md):
+    // every station of each master system, a switched station once (through line A's entry).
+    for (std::size_t i = 0; i < rt.systems.size(); ++i) {
+      const RedundancyPlan& rp = plan.redundant_systems.at(static_cast<std::size_t>(rt.systems[i]));
+      for (int side = 0; side < 2; ++side)
+        for (int si : plan.dp_masters.at(static_cast<std::size_t>(rp.master[side])).slaves) {
+          const DpSlavePlan& d = plan.dp_slaves.at(static_cast<std::size_t>(si));
+          if (d.switched >= 0 && d.side != 0) continue;
+          for (const DpPrmRecordPlan& r : d.prm_records)
+            if (!m_model->set_module_parameters(i, d.address, r.module, r.index, r.data))
+              throw std::invalid_argument("parameter_record of station " +
+                                          std::to_string(d.address) + " module " +
+                                          std::to_string(r.module) + " not taken");
+        }
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error("h_system \"" + hp.name + "\": " + e.what());
   }

@@ -208,7 +208,8 @@ bool HSystemModel::set_module_parameters(std::size_t system, std::uint8_t statio
       m_map.find(static_cast<int>(system), station, module) == nullptr)
     return false;
   const auto key = module_key(static_cast<int>(system), station, module);
-  std::erase_if(m_module_prm, [&](const ModulePrm& p) { return p.key == key; });
+  // One entry per (module, index): a module may have several records (S7 modules: 0 and 1).
+  std::erase_if(m_module_prm, [&](const ModulePrm& p) { return p.key == key && p.index == index; });
   m_module_prm.push_back({key, index, std::move(record)});
   return true;
 }

@@ -490,7 +490,8 @@ class HSystemModel final : public bus::EventTarget {
   //   record gets none (the model knows no parameters for it). The result is not an OB.
  public:
   /// Registers module `module`'s parameter data record (index, octets <= 240) written after
-  /// each plug. False: bad system/station/module or record length.
+  /// each plug (one per index, written in registration order; the same index again replaces
+  /// it). False: bad system/station/module or record length.
   bool set_module_parameters(std::size_t system, std::uint8_t station, std::size_t module,
                              std::uint8_t index, std::vector<std::uint8_t> record);
   /// Parameter records written after plugs so far (the jobs started).

@@ -7,6 +7,7 @@
 #include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/s7h/h_update_timing.hpp"
+#include "pbvbus/scenario/h_config_rules.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
 #include "pbvbus/simulation/redundancy_system.hpp"
 
@@ -75,6 +76,10 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   try {
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
     m_model->set_max_cycle_time(rt.max_cycle_time);
+    // D1: diagnostic addresses from the top of the CPU type's I/O address area (001 Table 4-5).
+    if (const auto& hs = plan.proto.h_system(hp.source); hs.has_cpu())
+      m_model->set_diag_address_top(
+          static_cast<std::uint16_t>(h_cpu_limits(hs.cpu().cpu_type()).process_image_max - 1));
     m_model->set_param_transfer_time(rt.param_transfer_time_100ms);  // W#16#6547
     setup_changes();  // docs/h-scenario-changes.md
     if (has_networks(rt.program)) m_model->set_program(rt.program);
@@ -289,7 +294,8 @@ HSystemReport HSystemNode::report() const {
     x.ob = e.ob;
     x.code = e.code;
     x.text = io_event_text(e);
-    if (e.ob == 82 || e.ob == 83 || e.ob == 122) {
+    if (e.ob == 82 || e.ob == 83 || e.ob == 122 ||
+        (e.ob == 86 && e.source == devices::HSystemEvent::Source::Io)) {  // D1: diagnostic address
       x.mdl_addr = e.mdl_addr;
       x.mdl_stop = e.mdl_stop;
     }

@@ -111,13 +111,14 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
   ASSERT_NE(stop, nullptr);
   EXPECT_TRUE(within(stop, 5 * kS)) << stop->at;
   EXPECT_EQ(stop->racks, both);
-  EXPECT_EQ(stop->mdl_addr, std::optional<std::uint16_t>(2));
+  // D1/D2: station 20's diagnostic address (master system 16383, station 3 16382, 20 16381).
+  EXPECT_EQ(stop->mdl_addr, std::optional<std::uint16_t>(16381));
   EXPECT_TRUE(stop->mdl_stop);
   const HIoEvent* run = find(82, 0x3842, 6 * kS);
   ASSERT_NE(run, nullptr);
   EXPECT_TRUE(within(run, 6 * kS)) << run->at;
   EXPECT_FALSE(run->mdl_stop);
-  EXPECT_EQ(run->mdl_addr, std::optional<std::uint16_t>(2));
+  EXPECT_EQ(run->mdl_addr, std::optional<std::uint16_t>(16381));
 
   const HIoEvent* diag = find(82, 0x3942, 7 * kS);
   ASSERT_NE(diag, nullptr);
@@ -140,6 +141,10 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
 
   const HIoEvent* failure = find(86, 0x39C4, 11 * kS);
   ASSERT_NE(failure, nullptr);
+  EXPECT_EQ(failure->racks, both);  // F12: OB 86 on both CPUs
+  // D1: the slave's diagnostic address (docs/h-diag-address.md): a 417-4H (the default
+  // cpu_type) counts down from 16383: master system S 16383, station 3 16382, 20 16381.
+  EXPECT_EQ(failure->mdl_addr, std::optional<std::uint16_t>(16381));
   const HIoEvent* rd = find(122, 0x2942, 11 * kS);
   const HIoEvent* wr = find(122, 0x2943, 11 * kS);
   ASSERT_NE(rd, nullptr);
@@ -162,8 +167,9 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
   std::ostringstream os;
   write_h_json(rep.h_systems, os);
   const std::string json = os.str();
-  EXPECT_NE(json.find("\"ob\":82,\"code\":14658,\"mdl_addr\":2,\"mdl_stop\":true"),
+  EXPECT_NE(json.find("\"ob\":82,\"code\":14658,\"mdl_addr\":16381,\"mdl_stop\":true"),
             std::string::npos);
+  EXPECT_NE(json.find("\"ob\":86,\"code\":14788,\"mdl_addr\":16381"), std::string::npos);  // 39C4
 }
 
 // F3 automatic re-parameterisation from a scenario (docs/h-reparameterisation.md): station 21's

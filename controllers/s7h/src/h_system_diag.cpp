@@ -79,6 +79,10 @@ DiagView view(std::span<const std::uint8_t> diag, bool dpv1) {
 }  // namespace
 
 std::uint16_t HSystemModel::module_address(int system, std::uint8_t station, int module) const {
+  // A station-level event (F15, module -1): the slave's diagnostic address (D1/D2, 001 Table 4-8
+  // L3072-3081, example OB82_MDL_ADDR := 1022 L3103-3110).
+  if (module < 0 && system >= 0)
+    if (const auto d = m_diag.slave(static_cast<std::size_t>(system), station)) return *d;
   for (const HIoEntry& e : m_map.entries()) {
     if (e.system != system || e.address != station) continue;
     if (module >= 0 && e.module != static_cast<std::size_t>(module)) continue;

@@ -291,7 +291,9 @@ TEST(HF15Model, DpV0SlaveStopRunIsOb82WithMdlStop) {
   EXPECT_EQ(ob[0].code, 0x3942);  // EV_CLASS 39
   EXPECT_TRUE(ob[0].mdl_stop);
   EXPECT_EQ(ob[0].module, -1);
-  EXPECT_EQ(ob[0].mdl_addr, 2);  // the station's first module
+  // The slave's diagnostic address (D1/D2, 001 Table 4-8): 16383 the master system, 5 16382,
+  // 20 16381.
+  EXPECT_EQ(ob[0].mdl_addr, 16381);
   EXPECT_EQ(ob[0].rack, -1);
   EXPECT_EQ(ob[0].time, r->end);
   // The slave stays in data exchange (no OB 86), its inputs read 0: the direct copy sends 0.
@@ -331,7 +333,7 @@ TEST(HF15Model, DpV1SlaveStopIsStatusPduWithMdlStop) {
   ASSERT_EQ(ob.size(), 1u);
   EXPECT_EQ(ob[0].code, 0x3942);
   EXPECT_TRUE(ob[0].mdl_stop);
-  EXPECT_EQ(ob[0].mdl_addr, 3);
+  EXPECT_EQ(ob[0].mdl_addr, 16380);  // 21's diagnostic address (5 16382, 20 16381, 21 16380)
   EXPECT_EQ(ob[0].time, r->end);
   ASSERT_EQ(f.v1->apply(SlaveFault::slave_run()), "");
   f.at(t1 + 300 * kMs);
@@ -421,6 +423,17 @@ TEST(HOb122Model, DirectAccessToFailedStationOncePerNetworkAndScan) {
   const auto o86 = f.obs(86);
   ASSERT_EQ(o86.size(), 1u);
   EXPECT_EQ(o86[0].code, 0x39C4);
+  // D1: the slave's diagnostic address (h_diag_address.hpp): from 16383 (417-4H, 001 Table 4-5)
+  // down: the master system 16383, then its slaves by address: 5 -> 16382, 20 -> 16381,
+  // 21 -> 16380.
+  EXPECT_EQ(o86[0].mdl_addr, 16381);
+  EXPECT_EQ(f.h->diag_addresses().master(0), std::optional<std::uint16_t>(16383));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kSw), std::optional<std::uint16_t>(16382));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kV1), std::optional<std::uint16_t>(16380));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, 22), std::nullopt);
+  f.h->set_diag_address_top(8191);  // a 414-4H
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kV0), std::optional<std::uint16_t>(8189));
+  f.h->set_diag_address_top(16383);
   const auto o122 = f.obs(122);
   ASSERT_GE(o122.size(), 4u);
   // From the first scan after the failure: one read (2942) and one write (2943) per scan, the
@@ -446,6 +459,13 @@ TEST(HOb122Model, DirectAccessToFailedStationOncePerNetworkAndScan) {
   // Back: no more OB 122.
   ASSERT_EQ(f.v0->apply(SlaveFault::unmute()), "");
   f.at(t1 + 2000 * kMs);
+  bool back = false;
+  for (const auto& e : f.obs(86))
+    if (e.code == 0x38C4) {
+      back = true;
+      EXPECT_EQ(e.mdl_addr, 16381);  // the return names the same diagnostic address
+    }
+  EXPECT_TRUE(back);
   const auto n = f.obs(122).size();
   f.at(t1 + 2500 * kMs);
   EXPECT_EQ(f.obs(122).size(), n);

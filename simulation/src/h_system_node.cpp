@@ -295,7 +295,7 @@ HSystemReport HSystemNode::report() const {
     x.code = e.code;
     x.text = io_event_text(e);
     if (e.ob == 82 || e.ob == 83 || e.ob == 122 ||
-        (e.ob == 86 && e.source == devices::HSystemEvent::Source::Io)) {  // D1: diagnostic address
+        (e.ob == 86 && e.source == devices::HSystemEvent::Source::Io && e.system >= 0)) {  // D1
       x.mdl_addr = e.mdl_addr;
       x.mdl_stop = e.mdl_stop;
     }

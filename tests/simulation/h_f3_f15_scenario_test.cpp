@@ -188,7 +188,13 @@ TEST(HF3F15Scenario, PlugWritesTheModulesParameterRecordsAndTheStationTakesThem)
   parameter_record { module: "8DO DC24V/0.5A" index: 1 data: "12 34" }
   parameter_record { module_index: 1 index: 2 data: "AB" } })");
   text.replace(text.find("duration: \"14s\""), 15, "duration: \"2500ms\"");
+  // Switched station 3: its 16DO (module 1, slot 2) has record 1 = 00 01 and is pulled too.
+  const std::string sw = R"(modules: ["16DI DC24V", "16DO DC24V/0.5A"] })";
+  ASSERT_NE(text.find(sw), std::string::npos);
+  text.replace(text.find(sw), sw.size(),
+               R"(modules: ["16DI DC24V", "16DO DC24V/0.5A"] parameter_record { module_index: 1 index: 1 data: "00 01" } })");
   text += R"(fault { at: "1500ms" repair_at: "2s" module_pull { line: "DP_A" address: 21 module_index: 1 } }
+fault { at: "1500ms" repair_at: "2s" module_pull { line: "DP_B" address: 3 module_index: 1 } }
 )";
   const auto loaded = parse_scenario(text, kFile);
   ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
@@ -201,11 +207,12 @@ TEST(HF3F15Scenario, PlugWritesTheModulesParameterRecordsAndTheStationTakesThem)
   EXPECT_EQ(sp->prm_records, (std::vector<DpPrmRecordPlan>{{1, 1, {0x12, 0x34}}, {1, 2, {0xAB}}}));
 
   struct C1Tap final : bus::Tap {
-    std::vector<std::pair<bus::Ticks, std::vector<std::uint8_t>>> from21;  // SAP 51 -> 51
+    std::vector<std::pair<bus::Ticks, std::vector<std::uint8_t>>> from21, from3;  // SAP 51 -> 51
     void on_frame(const bus::TapFrame& f) override {
       const auto b = f.bytes;
-      if (b.size() >= 11 && b[0] == 0x68 && b[5] == 0x95 && b[7] == 0x33 && b[8] == 0x33)
-        from21.emplace_back(f.end, std::vector<std::uint8_t>(b.begin(), b.end()));
+      if (b.size() < 11 || b[0] != 0x68 || b[7] != 0x33 || b[8] != 0x33) return;
+      if (b[5] == 0x95) from21.emplace_back(f.end, std::vector<std::uint8_t>(b.begin(), b.end()));
+      if (b[5] == 0x83) from3.emplace_back(f.end, std::vector<std::uint8_t>(b.begin(), b.end()));
     }
   } tap;
   Simulation sim(*loaded.plan);
@@ -214,9 +221,23 @@ TEST(HF3F15Scenario, PlugWritesTheModulesParameterRecordsAndTheStationTakesThem)
   sim.run_until(*sim.duration());
   const Report rep = sim.report(1.0);
   const HIoEvent* plug = nullptr;
-  for (const auto& e : rep.h_systems.at(0).io_events)
-    if (e.ob == 83 && e.code == 0x3861) plug = &e;
+  const HIoEvent* plug3 = nullptr;
+  int pulls = 0;
+  for (const auto& e : rep.h_systems.at(0).io_events) {
+    pulls += e.ob == 83 && e.code == 0x3961;
+    if (e.ob == 83 && e.code == 0x3861) (e.text.find("station 3") != std::string::npos ? plug3 : plug) = &e;
+  }
+  EXPECT_EQ(pulls, 2);
   ASSERT_NE(plug, nullptr);
+  ASSERT_NE(plug3, nullptr);
+  // Station 3 (switched; line A its active channel): `5F 02 01 02` from SA 83, FCS = 81+83+08+
+  // 33+33+5F+02+01+02 = 0x1D6 -> D6. The module's MDL_ADDR: the 16DO's QB 0.
+  EXPECT_EQ(plug3->mdl_addr, std::optional<std::uint16_t>(0));
+  ASSERT_EQ(tap.from3.size(), 1u);
+  EXPECT_EQ(tap.from3[0].second, (std::vector<std::uint8_t>{0x68, 0x09, 0x09, 0x68, 0x81, 0x83,
+                                                            0x08, 0x33, 0x33, 0x5F, 0x02, 0x01,
+                                                            0x02, 0xD6, 0x16}));
+  EXPECT_GT(tap.from3[0].first, plug3->at);
   ASSERT_EQ(tap.from21.size(), 2u);
   EXPECT_EQ(tap.from21[0].second, (std::vector<std::uint8_t>{0x68, 0x09, 0x09, 0x68, 0x81, 0x95,
                                                              0x08, 0x33, 0x33, 0x5F, 0x02, 0x01,

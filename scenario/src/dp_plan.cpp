@@ -329,6 +329,13 @@ class DpPlanner {
       return;
     }
     if (!plan_io(i, s, sp)) return;
+    {  // F3 parameter records (prm_record_plan.hpp)
+      std::vector<std::pair<int, std::string>> errs;
+      sp.prm_records = plan_prm_records(s, sp.module_names,
+                                        g.dpv1().dpv1_slave && g.dpv1().c1_read_write_supp, errs);
+      for (auto& [k, msg] : errs) error(m_rep, i, "parameter_record", k, std::move(msg));
+      if (!errs.empty()) return;
+    }
     sp.gsd = std::make_shared<const devices::GsdFile>(g);
     if (mi >= 0)
       m_plan.dp_masters[static_cast<std::size_t>(mi)].slaves.push_back(
@@ -607,6 +614,7 @@ class DpPlanner {
       if (w.has_tsdr_bits()) d.set_tsdr_bits(w.tsdr_bits());
       d.set_inputs(w.inputs());
       for (const auto& io : w.io()) *d.add_io() = io;
+      for (const auto& r : w.parameter_record()) *d.add_parameter_record() = r;
       const std::size_t before = m_plan.dp_slaves.size();
       const std::size_t errors_before = m_errors.size();
       plan_slave(d, rep, i, base, index, side);

@@ -649,6 +649,15 @@ class Planner {
     const DpSlavePlan* sp = nullptr;
     for (const auto& d : plan.dp_slaves)
       if (d.switched < 0 && d.line == li && d.address == s.address()) sp = &d;
+    // A switched station's module (F3, docs/h-reparameterisation.md): module_pull only, on
+    // either of its lines; the station is one backplane.
+    if (sp == nullptr && pf.kind == K::ModulePull)
+      for (const auto& d : plan.dp_slaves)
+        if (d.switched >= 0 && d.line == li && d.address == s.address() &&
+            plan.switched[static_cast<std::size_t>(d.switched)].link < 0) {
+          sp = &d;
+          pf.switched = d.switched;
+        }
     if (sp == nullptr) {
       error(at_field(kw, kd, "address"), std::string(kind_field) + ": no dp_slave " +
                                              std::to_string(s.address()) + " on line " + in_quotes(ln));

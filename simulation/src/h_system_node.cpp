@@ -7,6 +7,7 @@
 #include "pbvbus/captures/cpu_event.hpp"
 #include "pbvbus/captures/pcapng_writer.hpp"
 #include "pbvbus/s7h/h_update_timing.hpp"
+#include "pbvbus/scenario/h_config_rules.hpp"
 #include "pbvbus/scenario/h_plan.hpp"
 #include "pbvbus/simulation/redundancy_system.hpp"
 
@@ -76,6 +77,10 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
   try {
     m_model = std::make_unique<devices::HSystemModel>(sched, rt.pair, std::move(models), rt.racks);
     m_model->set_max_cycle_time(rt.max_cycle_time);
+    // D1: diagnostic addresses from the top of the CPU type's I/O address area (001 Table 4-5).
+    if (const auto& hs = plan.proto.h_system(hp.source); hs.has_cpu())
+      m_model->set_diag_address_top(
+          static_cast<std::uint16_t>(h_cpu_limits(hs.cpu().cpu_type()).process_image_max - 1));
     m_model->set_param_transfer_time(rt.param_transfer_time_100ms);  // W#16#6547
     setup_changes();  // docs/h-scenario-changes.md
     if (has_networks(rt.program)) m_model->set_program(rt.program);
@@ -95,6 +100,21 @@ HSystemNode::HSystemNode(const ScenarioPlan& plan, int index, bus::Scheduler& sc
       if (std::string e = m_model->add_cp(c); !e.empty()) throw std::invalid_argument(e);
     for (const devices::ConnectionConfig& c : rt.connections)
       if (std::string e = m_model->add_connection(c); !e.empty()) throw std::invalid_argument(e);
+    // F3: the modules' parameter records, written after a plug (docs/h-reparameterisation.md):
+    // every station of each master system, a switched station once (through line A's entry).
+    for (std::size_t i = 0; i < rt.systems.size(); ++i) {
+      const RedundancyPlan& rp = plan.redundant_systems.at(static_cast<std::size_t>(rt.systems[i]));
+      for (int side = 0; side < 2; ++side)
+        for (int si : plan.dp_masters.at(static_cast<std::size_t>(rp.master[side])).slaves) {
+          const DpSlavePlan& d = plan.dp_slaves.at(static_cast<std::size_t>(si));
+          if (d.switched >= 0 && d.side != 0) continue;
+          for (const DpPrmRecordPlan& r : d.prm_records)
+            if (!m_model->set_module_parameters(i, d.address, r.module, r.index, r.data))
+              throw std::invalid_argument("parameter_record of station " +
+                                          std::to_string(d.address) + " module " +
+                                          std::to_string(r.module) + " not taken");
+        }
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error("h_system \"" + hp.name + "\": " + e.what());
   }
@@ -275,7 +295,8 @@ HSystemReport HSystemNode::report() const {
     x.ob = e.ob;
     x.code = e.code;
     x.text = io_event_text(e);
-    if (e.ob == 82 || e.ob == 83 || e.ob == 122) {
+    if (e.ob == 82 || e.ob == 83 || e.ob == 122 ||
+        (e.ob == 86 && e.source == devices::HSystemEvent::Source::Io && e.system >= 0)) {  // D1
       x.mdl_addr = e.mdl_addr;
       x.mdl_stop = e.mdl_stop;
     }

@@ -550,6 +550,16 @@ void Simulation::apply_fault(const PlanFault& f, bool on) {
 
 void Simulation::apply_slave_fault(const PlanFault& f, bool on) {
   LineState& ls = *m_lines.at(static_cast<std::size_t>(f.line));
+  if (f.kind == PlanFault::Kind::ModulePull && f.switched >= 0) {  // a switched station's module
+    for (auto& r : m_redundant)
+      if (devices::SwitchedStationModel* st = r->station(f.switched)) {
+        std::string text = on ? f.description : "plugged" + f.description.substr(6);
+        if (std::string why = st->set_module_pulled(f.module, on); !why.empty())
+          text += " (refused: " + why + ")";
+        ls.stats.faults.push_back({m_sched.now(), std::move(text)});
+      }
+    return;
+  }
   DpSlaveNode* node = nullptr;
   for (auto& s : ls.stations)
     if (s.dp_slave && s.address == f.slave) node = s.dp_slave.get();

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "scenario_run_support.hpp"
+#include "pbvbus/bus/tap.hpp"
 #include "pbvbus/simulation/h_report.hpp"
 #include "pbvbus/scenario/scenario.hpp"
 #include "pbvbus/simulation/simulation.hpp"
@@ -110,13 +111,14 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
   ASSERT_NE(stop, nullptr);
   EXPECT_TRUE(within(stop, 5 * kS)) << stop->at;
   EXPECT_EQ(stop->racks, both);
-  EXPECT_EQ(stop->mdl_addr, std::optional<std::uint16_t>(2));
+  // D1/D2: station 20's diagnostic address (master system 16383, station 3 16382, 20 16381).
+  EXPECT_EQ(stop->mdl_addr, std::optional<std::uint16_t>(16381));
   EXPECT_TRUE(stop->mdl_stop);
   const HIoEvent* run = find(82, 0x3842, 6 * kS);
   ASSERT_NE(run, nullptr);
   EXPECT_TRUE(within(run, 6 * kS)) << run->at;
   EXPECT_FALSE(run->mdl_stop);
-  EXPECT_EQ(run->mdl_addr, std::optional<std::uint16_t>(2));
+  EXPECT_EQ(run->mdl_addr, std::optional<std::uint16_t>(16381));
 
   const HIoEvent* diag = find(82, 0x3942, 7 * kS);
   ASSERT_NE(diag, nullptr);
@@ -139,6 +141,10 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
 
   const HIoEvent* failure = find(86, 0x39C4, 11 * kS);
   ASSERT_NE(failure, nullptr);
+  EXPECT_EQ(failure->racks, both);  // F12: OB 86 on both CPUs
+  // D1: the slave's diagnostic address (docs/h-diag-address.md): a 417-4H (the default
+  // cpu_type) counts down from 16383: master system S 16383, station 3 16382, 20 16381.
+  EXPECT_EQ(failure->mdl_addr, std::optional<std::uint16_t>(16381));
   const HIoEvent* rd = find(122, 0x2942, 11 * kS);
   const HIoEvent* wr = find(122, 0x2943, 11 * kS);
   ASSERT_NE(rd, nullptr);
@@ -161,7 +167,131 @@ TEST(HF3F15Scenario, RunShowsOb82MdlStopOb83AndOb122) {
   std::ostringstream os;
   write_h_json(rep.h_systems, os);
   const std::string json = os.str();
-  EXPECT_NE(json.find("\"ob\":82,\"code\":14658,\"mdl_addr\":2,\"mdl_stop\":true"),
+  EXPECT_NE(json.find("\"ob\":82,\"code\":14658,\"mdl_addr\":16381,\"mdl_stop\":true"),
+            std::string::npos);
+  EXPECT_NE(json.find("\"ob\":86,\"code\":14788,\"mdl_addr\":16381"), std::string::npos);  // 39C4
+}
+
+// F3 automatic re-parameterisation from a scenario (docs/h-reparameterisation.md): station 21's
+// 8DO (module 1 = slot 2) has the records 1 = 12 34 and 2 = AB; the module is pulled at 1.5 s
+// and plugged at 2 s (the master CPU runs Solo from 1 s). After the plug's OB 83 the master writes
+// both records over MSAC_C1 and the station takes them. Responses by hand (SD2, DA 81, SA 95 =
+// 0x80 | 21, FC 08, DSAP = SSAP = 33): `5F 02 01 02` and `5F 02 02 01`, FCS = 81+95+08+33+33 =
+// 0x184, + 5F+02+01+02 = 0x1E8 -> E8 and + 5F+02+02+01 = 0x1E8 -> E8.
+TEST(HF3F15Scenario, PlugWritesTheModulesParameterRecordsAndTheStationTakesThem) {
+  std::string text = kHead;
+  const std::string v1 = R"(modules: ["8DI with process alarm", "8DO DC24V/0.5A"] })";
+  const auto at = text.find(v1);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, v1.size(),
+               R"(modules: ["8DI with process alarm", "8DO DC24V/0.5A"]
+  parameter_record { module: "8DO DC24V/0.5A" index: 1 data: "12 34" }
+  parameter_record { module_index: 1 index: 2 data: "AB" } })");
+  text.replace(text.find("duration: \"14s\""), 15, "duration: \"2500ms\"");
+  // Switched station 3: its 16DO (module 1, slot 2) has record 1 = 00 01 and is pulled too.
+  const std::string sw = R"(modules: ["16DI DC24V", "16DO DC24V/0.5A"] })";
+  ASSERT_NE(text.find(sw), std::string::npos);
+  text.replace(text.find(sw), sw.size(),
+               R"(modules: ["16DI DC24V", "16DO DC24V/0.5A"] parameter_record { module_index: 1 index: 1 data: "00 01" } })");
+  text += R"(fault { at: "1500ms" repair_at: "2s" module_pull { line: "DP_A" address: 21 module_index: 1 } }
+fault { at: "1500ms" repair_at: "2s" module_pull { line: "DP_B" address: 3 module_index: 1 } }
+)";
+  const auto loaded = parse_scenario(text, kFile);
+  ASSERT_TRUE(loaded.ok()) << loaded.errors[0].str();
+  const auto* sp = [&]() -> const DpSlavePlan* {
+    for (const auto& d : loaded.plan->dp_slaves)
+      if (d.address == 21) return &d;
+    return nullptr;
+  }();
+  ASSERT_NE(sp, nullptr);
+  EXPECT_EQ(sp->prm_records, (std::vector<DpPrmRecordPlan>{{1, 1, {0x12, 0x34}}, {1, 2, {0xAB}}}));
+
+  struct C1Tap final : bus::Tap {
+    std::vector<std::pair<bus::Ticks, std::vector<std::uint8_t>>> from21, from3;  // SAP 51 -> 51
+    void on_frame(const bus::TapFrame& f) override {
+      const auto b = f.bytes;
+      if (b.size() < 11 || b[0] != 0x68 || b[7] != 0x33 || b[8] != 0x33) return;
+      if (b[5] == 0x95) from21.emplace_back(f.end, std::vector<std::uint8_t>(b.begin(), b.end()));
+      if (b[5] == 0x83) from3.emplace_back(f.end, std::vector<std::uint8_t>(b.begin(), b.end()));
+    }
+  } tap;
+  Simulation sim(*loaded.plan);
+  sim.line(0).add_tap(tap);
+  sim.start();
+  sim.run_until(*sim.duration());
+  const Report rep = sim.report(1.0);
+  const HIoEvent* plug = nullptr;
+  const HIoEvent* plug3 = nullptr;
+  int pulls = 0;
+  for (const auto& e : rep.h_systems.at(0).io_events) {
+    pulls += e.ob == 83 && e.code == 0x3961;
+    if (e.ob == 83 && e.code == 0x3861) (e.text.find("station 3") != std::string::npos ? plug3 : plug) = &e;
+  }
+  EXPECT_EQ(pulls, 2);
+  ASSERT_NE(plug, nullptr);
+  ASSERT_NE(plug3, nullptr);
+  // Station 3 (switched; line A its active channel): `5F 02 01 02` from SA 83, FCS = 81+83+08+
+  // 33+33+5F+02+01+02 = 0x1D6 -> D6. The module's MDL_ADDR: the 16DO's QB 0.
+  EXPECT_EQ(plug3->mdl_addr, std::optional<std::uint16_t>(0));
+  ASSERT_EQ(tap.from3.size(), 1u);
+  EXPECT_EQ(tap.from3[0].second, (std::vector<std::uint8_t>{0x68, 0x09, 0x09, 0x68, 0x81, 0x83,
+                                                            0x08, 0x33, 0x33, 0x5F, 0x02, 0x01,
+                                                            0x02, 0xD6, 0x16}));
+  EXPECT_GT(tap.from3[0].first, plug3->at);
+  ASSERT_EQ(tap.from21.size(), 2u);
+  EXPECT_EQ(tap.from21[0].second, (std::vector<std::uint8_t>{0x68, 0x09, 0x09, 0x68, 0x81, 0x95,
+                                                             0x08, 0x33, 0x33, 0x5F, 0x02, 0x01,
+                                                             0x02, 0xE8, 0x16}));
+  EXPECT_EQ(tap.from21[1].second, (std::vector<std::uint8_t>{0x68, 0x09, 0x09, 0x68, 0x81, 0x95,
+                                                             0x08, 0x33, 0x33, 0x5F, 0x02, 0x02,
+                                                             0x01, 0xE8, 0x16}));
+  EXPECT_GT(tap.from21[0].first, plug->at);
+  EXPECT_LT(tap.from21[1].first, plug->at + 20 * kMs);
+}
+
+// Columns by hand: the dp_slave line 10 of kHead; `parameter_record` refusals at the entry.
+TEST(HF3F15Scenario, ParameterRecordRefusals) {
+  const std::string v0 = R"(modules: ["8DI DC24V", "8DO DC24V/0.5A"] })";
+  auto with = [&](const std::string& rec) {
+    std::string text = kHead;
+    text.replace(text.find(v0), v0.size(), R"(modules: ["8DI DC24V", "8DO DC24V/0.5A"] )" + rec + " }");
+    return errors_of(text);
+  };
+  // Station 20 (PBVB0A02) is DP-V0: no data records.
+  auto e = with(R"(parameter_record { module_index: 0 index: 1 data: "01" })");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_NE(e[0].find("parameter_record: the station is not a DP-V1 slave with C1_Read_Write_supp"),
+            std::string::npos) << e[0];
+  const std::string v1 = R"(modules: ["8DI with process alarm", "8DO DC24V/0.5A"] })";
+  auto with21 = [&](const std::string& rec) {
+    std::string text = kHead;
+    text.replace(text.find(v1), v1.size(),
+                 R"(modules: ["8DI with process alarm", "8DO DC24V/0.5A"] )" + rec + " }");
+    return errors_of(text);
+  };
+  auto one = [](const std::vector<std::string>& v) { return v.size() == 1 ? v[0] : std::string("?"); };
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 2 index: 1 data: "01" })"))
+                .find("module_index 2 is not below the 2 modules of the station"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { module: "16DO" index: 1 data: "01" })"))
+                .find("module \"16DO\" is not one of the station's modules"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 1 index: 255 data: "01" })"))
+                .find("index 255 is above 254"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 1 index: 1 data: "1" })"))
+                .find("data \"1\": octet at 1 needs two hex digits"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 1 index: 1 })")).find("no octets"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { index: 1 data: "01" })")).find("needs a module"),
+            std::string::npos);
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 1 index: 1 data: "01" } parameter_record { module_index: 1 index: 1 data: "02" })"))
+                .find("module 1 record 1 is given twice"),
+            std::string::npos);
+  // 241 octets: above C1_Max_Data_Len.
+  EXPECT_NE(one(with21(R"(parameter_record { module_index: 1 index: 1 data: ")" + std::string(482, 'A') + "\" }"))
+                .find("241 octets, at most 240"),
             std::string::npos);
 }
 

@@ -39,6 +39,7 @@ HSystemModel::HSystemModel(bus::Scheduler& sched, HCpuPairParams params,
     if (s != nullptr) m_systems.push_back(s);
   m_side.resize(m_systems.size());
   m_map = HIoMap(m_systems);
+  set_diag_address_top(kDiagTop417);
   m_pii.assign(m_map.pii_size(), 0);
   m_piq.assign(m_map.piq_size(), 0);
   m_pair.on_event([this](const HEvent& e) { on_pair_event(e); });
@@ -385,7 +386,21 @@ void HSystemModel::on_io_event(std::size_t s, const redundancy::SystemEvent& e) 
   h.line = e.line;
   h.station = e.station;
   h.original_time = h.time;
+  // D1 (001 Table 4-8 L3064-3068): the slave's diagnostic address as the master sees it; an
+  // event of the whole master system: its master's.
+  const auto diag = e.station == 0xFF ? m_diag.master(s) : m_diag.slave(s, e.station);
+  if (diag) h.mdl_addr = *diag;
   add_event(std::move(h));
+}
+
+void HSystemModel::set_diag_address_top(std::uint16_t top) {
+  std::vector<std::vector<std::uint8_t>> st;
+  for (RedundantMasterSystemModel* m : m_systems) {
+    st.emplace_back();
+    if (m == nullptr) continue;
+    for (std::uint8_t a : m->system().addresses()) st.back().push_back(a);
+  }
+  m_diag = HDiagAddresses(top, st);
 }
 
 std::vector<DiagEntry> HSystemModel::diag_buffer(int r) const {

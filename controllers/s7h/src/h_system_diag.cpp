@@ -79,6 +79,10 @@ DiagView view(std::span<const std::uint8_t> diag, bool dpv1) {
 }  // namespace
 
 std::uint16_t HSystemModel::module_address(int system, std::uint8_t station, int module) const {
+  // A station-level event (F15, module -1): the slave's diagnostic address (D1/D2, 001 Table 4-8
+  // L3072-3081, example OB82_MDL_ADDR := 1022 L3103-3110).
+  if (module < 0 && system >= 0)
+    if (const auto d = m_diag.slave(static_cast<std::size_t>(system), station)) return *d;
   for (const HIoEntry& e : m_map.entries()) {
     if (e.system != system || e.address != station) continue;
     if (module >= 0 && e.module != static_cast<std::size_t>(module)) continue;
@@ -208,7 +212,8 @@ bool HSystemModel::set_module_parameters(std::size_t system, std::uint8_t statio
       m_map.find(static_cast<int>(system), station, module) == nullptr)
     return false;
   const auto key = module_key(static_cast<int>(system), station, module);
-  std::erase_if(m_module_prm, [&](const ModulePrm& p) { return p.key == key; });
+  // One entry per (module, index): a module may have several records (S7 modules: 0 and 1).
+  std::erase_if(m_module_prm, [&](const ModulePrm& p) { return p.key == key && p.index == index; });
   m_module_prm.push_back({key, index, std::move(record)});
   return true;
 }

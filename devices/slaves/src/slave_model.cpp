@@ -362,6 +362,10 @@ SlaveModelBuild SlaveModel::build(const GsdFile& gsd, const std::vector<ModuleCh
   m->m_default_prm = std::move(prm);
   m->m_dpv1 = v1.dpv1_slave;
   m->m_dpv1_pull_plug = v1.dpv1_slave && v1.pull_plug_alarm_supp;
+  if (v1.dpv1_slave && v1.c1_read_write_supp) {  // F3: the modules' parameter records
+    m->m_records = std::make_unique<ModuleRecords>(chosen.size());
+    m->m_records->install(m->m_engine->application());
+  }
   m->m_user = std::make_unique<User>(*m);
   m->m_port = std::make_unique<Port>(*m);
   m->m_station = std::make_unique<fdl::PassiveStation>(options.address, bp, *m->m_user, tsdr);
@@ -546,6 +550,7 @@ void SlaveModel::do_apply(const SlaveFault& f) {
       if (m_modules[f.module].pulled == pulled) break;
       m_modules[f.module].pulled = pulled;
       app.set_module_state(f.module, pulled ? dp::ModuleState::NoModule : dp::ModuleState::Ok);
+      if (m_records) m_records->set_pulled(f.module, pulled);
       if (pulled && bound()) refresh_inputs(port().now());  // zero now, not at the next request
       if (m_dpv1_pull_plug)
         app.raise_alarm(static_cast<std::uint8_t>(pulled ? dp::AlarmType::Pull : dp::AlarmType::Plug), slot,

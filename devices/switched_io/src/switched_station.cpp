@@ -173,8 +173,13 @@ SwitchedStationBuild SwitchedStationModel::build(const GsdFile& gsd,
   m->m_rs->on_event([raw](const redundancy::RedEvent& e) { raw->m_events.push_back(e); });
   for (int i = 0; i < 2; ++i) m->m_if[i] = std::make_unique<Iface>(*m, i, options.bus_params);
   m->sync_addresses();  // Flying: interface 1 at A + 64
+  if (gsd.dpv1().c1_read_write_supp) {  // F3: the modules' parameter records, both interfaces
+    m->m_records = std::make_unique<ModuleRecords>(m->m_rs->engine(0).layout().modules.size());
+    for (int i = 0; i < 2; ++i) m->m_records->install(m->m_rs->engine(i).application());
+  }
   const auto& layout = m->m_rs->engine(0).layout();
   m->m_channels.resize(layout.modules.size());
+  m->m_pulled.assign(layout.modules.size(), false);
   std::size_t max_in = 0;
   for (const auto& ml : layout.modules) max_in = std::max(max_in, ml.in_len);
   m->m_scratch.resize(max_in);
@@ -221,8 +226,14 @@ void SwitchedStationModel::refresh_inputs(bus::Ticks now) {
   const std::span<const std::uint8_t> out = m_rs->outputs();
   for (std::size_t m = 0; m < m_channels.size(); ++m) {
     const std::size_t len = layout.modules[m].in_len;
-    if (len == 0 || m_channels[m].empty()) continue;
+    if (len == 0) continue;
     std::span<std::uint8_t> buf(m_scratch.data(), len);
+    if (m_pulled[m]) {  // a pulled module's inputs read 0, its behaviours wait for the plug
+      std::fill(buf.begin(), buf.end(), std::uint8_t{0});
+      m_rs->write_inputs(m, buf);
+      continue;
+    }
+    if (m_channels[m].empty()) continue;
     app.image().inputs(m).read(buf);
     apply_channel_behaviours(buf, m, m_channels[m], now, m_dp_cycles, [&](std::size_t src) {
       const auto& ml = layout.modules[src];
@@ -300,6 +311,27 @@ void SwitchedStationModel::power_on_station() {
   }
   if (!m_rs->powered()) m_rs->power_on(t);  // no attachment powered: the backplane still starts
   after_call();
+}
+
+std::string SwitchedStationModel::set_module_pulled(std::size_t module, bool pulled) {
+  const auto& layout = m_rs->engine(0).layout();
+  if (module >= layout.modules.size()) return "module " + std::to_string(module) + " does not exist";
+  if (m_pulled[module] == pulled) return {};
+  m_pulled[module] = pulled;
+  for (int i = 0; i < 2; ++i)
+    m_rs->engine(i).application().set_module_state(
+        module, pulled ? dp::ModuleState::NoModule : dp::ModuleState::Ok);
+  if (m_records) m_records->set_pulled(module, pulled);
+  if (pulled && layout.modules[module].in_len > 0) {
+    std::span<std::uint8_t> buf(m_scratch.data(), layout.modules[module].in_len);
+    std::fill(buf.begin(), buf.end(), std::uint8_t{0});
+    m_rs->write_inputs(module, buf);
+  }
+  // Not enabled (or closed): the Module_Status alone tells the master (OB 83 from the diagnosis).
+  (void)raise_alarm(static_cast<std::uint8_t>(pulled ? dp::AlarmType::Pull : dp::AlarmType::Plug),
+                    static_cast<std::uint8_t>(module + 1),
+                    pulled ? dp::AlarmSpec::Appears : dp::AlarmSpec::Disappears, false);
+  return {};
 }
 
 dp::AlarmResult SwitchedStationModel::raise_alarm(std::uint8_t type, std::uint8_t slot,

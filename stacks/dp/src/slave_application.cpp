@@ -176,6 +176,11 @@ void SlaveApplication::on_write(std::uint8_t slot, std::uint8_t index, RecordWri
   m_write_handlers[record_key(slot, index)] = std::move(h);
 }
 
+void SlaveApplication::on_write_any(RecordWriteHandler h) {
+  std::lock_guard lk(m_mu);
+  m_write_any = std::move(h);
+}
+
 void SlaveApplication::complete_read(std::uint32_t id, std::span<const std::uint8_t> data) {
   std::lock_guard lk(m_mu);
   m_completions[id] = Completion{false, {}, {data.begin(), data.end()}};

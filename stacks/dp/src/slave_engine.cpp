@@ -565,6 +565,7 @@ void SlaveEngine::record_request(std::span<const std::uint8_t> pdu, std::uint8_t
     } else {
       const auto it = m_app.m_write_handlers.find(record_key(rq.slot, rq.index));
       if (it != m_app.m_write_handlers.end()) wh = it->second;
+      else wh = m_app.m_write_any;  // empty unless the device set one
     }
   }
   if (!rh && !wh && fn == kFnRead && rq.slot <= m_layout.modules.size() &&

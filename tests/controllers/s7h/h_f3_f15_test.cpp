@@ -54,8 +54,11 @@ struct DiagTap final : bus::Tap {
   };
   std::vector<Resp> seen;
   std::vector<Resp> to_sw;  ///< SD2/SD3 requests to station 5 (DA 0x85): `station` = the DSAP, DU after the SAPs
+  std::vector<Resp> from_sw_c1;  ///< SD2 responses of station 5 from SAP 51 to SAP 51 (MSAC_C1 Read/Write): whole frame
   void on_frame(const bus::TapFrame& f) override {
     const auto b = f.bytes;
+    if (b.size() >= 11 && b[0] == 0x68 && b[5] == (0x80 | 5) && b[7] == 0x33 && b[8] == 0x33)
+      from_sw_c1.push_back({f.end, b[4], Bytes(b.begin(), b.end())});
     if (b.size() >= 11 && b[0] == 0x68 && b[4] == (0x80 | 5) && (b[5] & 0x80) != 0)
       to_sw.push_back({f.end, b[7], Bytes(b.begin() + 9, b.end() - 2)});
     // SD3 (A2 DA SA FC DSAP SSAP DU[6] FCS 16): a request with exactly 6 DU octets, e.g. an
@@ -288,7 +291,9 @@ TEST(HF15Model, DpV0SlaveStopRunIsOb82WithMdlStop) {
   EXPECT_EQ(ob[0].code, 0x3942);  // EV_CLASS 39
   EXPECT_TRUE(ob[0].mdl_stop);
   EXPECT_EQ(ob[0].module, -1);
-  EXPECT_EQ(ob[0].mdl_addr, 2);  // the station's first module
+  // The slave's diagnostic address (D1/D2, 001 Table 4-8): 16383 the master system, 5 16382,
+  // 20 16381.
+  EXPECT_EQ(ob[0].mdl_addr, 16381);
   EXPECT_EQ(ob[0].rack, -1);
   EXPECT_EQ(ob[0].time, r->end);
   // The slave stays in data exchange (no OB 86), its inputs read 0: the direct copy sends 0.
@@ -328,7 +333,7 @@ TEST(HF15Model, DpV1SlaveStopIsStatusPduWithMdlStop) {
   ASSERT_EQ(ob.size(), 1u);
   EXPECT_EQ(ob[0].code, 0x3942);
   EXPECT_TRUE(ob[0].mdl_stop);
-  EXPECT_EQ(ob[0].mdl_addr, 3);
+  EXPECT_EQ(ob[0].mdl_addr, 16380);  // 21's diagnostic address (5 16382, 20 16381, 21 16380)
   EXPECT_EQ(ob[0].time, r->end);
   ASSERT_EQ(f.v1->apply(SlaveFault::slave_run()), "");
   f.at(t1 + 300 * kMs);
@@ -383,7 +388,9 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   // Re-parameterisation after the plug: the MSAC_C1 Write (slot 2, index 1, 12 34) on the active
   // channel, once (after the plug, not after the pull). On the wire it is an SD3 frame (six DU
   // octets): DSAP 51 (0x33, MSAC_C1), DU = Function_Num 5F, Slot_Number 02, Index 01, Length 02,
-  // data 12 34. The station model keeps no parameter records and answers negatively (DF ...).
+  // data 12 34. The station (module_records.hpp) takes it: the positive response `5F 02 01 02`
+  // from station 5 to master 1 (SD2: 68 09 09 68 DA=81 SA=85 FC=08 DSAP=33 SSAP=33 DU; FCS =
+  // 81+85+08+33+33+5F+02+01+02 = 0x1D8 -> D8) and the record is the module's.
   EXPECT_EQ(f.h->reparameterisations(), 1u);
   std::vector<DiagTap::Resp> writes;
   for (const auto& r : f.tap.to_sw)
@@ -392,6 +399,14 @@ TEST(HF3Model, SwitchedStationAlarmsOb82AndPullPlugOb83Synchronously) {
   EXPECT_EQ(writes[0].du, (Bytes{0x5F, 0x02, 0x01, 0x02, 0x12, 0x34}));
   EXPECT_GT(writes[0].end, o83[1].time);  // after the plug's OB 83
   EXPECT_LT(writes[0].end, o83[1].time + 10 * kMs);
+  ASSERT_EQ(f.tap.from_sw_c1.size(), 1u);
+  EXPECT_EQ(f.tap.from_sw_c1[0].du,
+            (Bytes{0x68, 0x09, 0x09, 0x68, 0x81, 0x85, 0x08, 0x33, 0x33, 0x5F, 0x02, 0x01, 0x02,
+                   0xD8, 0x16}));
+  EXPECT_GT(f.tap.from_sw_c1[0].end, writes[0].end);
+  ASSERT_NE(f.sw->module_records(), nullptr);
+  EXPECT_EQ(f.sw->module_records()->record(1, 1), (Bytes{0x12, 0x34}));
+  EXPECT_EQ(f.sw->module_records()->writes_accepted(), 1u);
 
   EXPECT_EQ(f.obs(82).size(), 1u);
   EXPECT_EQ(f.obs(83).size(), 2u);
@@ -408,6 +423,17 @@ TEST(HOb122Model, DirectAccessToFailedStationOncePerNetworkAndScan) {
   const auto o86 = f.obs(86);
   ASSERT_EQ(o86.size(), 1u);
   EXPECT_EQ(o86[0].code, 0x39C4);
+  // D1: the slave's diagnostic address (h_diag_address.hpp): from 16383 (417-4H, 001 Table 4-5)
+  // down: the master system 16383, then its slaves by address: 5 -> 16382, 20 -> 16381,
+  // 21 -> 16380.
+  EXPECT_EQ(o86[0].mdl_addr, 16381);
+  EXPECT_EQ(f.h->diag_addresses().master(0), std::optional<std::uint16_t>(16383));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kSw), std::optional<std::uint16_t>(16382));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kV1), std::optional<std::uint16_t>(16380));
+  EXPECT_EQ(f.h->diag_addresses().slave(0, 22), std::nullopt);
+  f.h->set_diag_address_top(8191);  // a 414-4H
+  EXPECT_EQ(f.h->diag_addresses().slave(0, kV0), std::optional<std::uint16_t>(8189));
+  f.h->set_diag_address_top(16383);
   const auto o122 = f.obs(122);
   ASSERT_GE(o122.size(), 4u);
   // From the first scan after the failure: one read (2942) and one write (2943) per scan, the
@@ -433,6 +459,13 @@ TEST(HOb122Model, DirectAccessToFailedStationOncePerNetworkAndScan) {
   // Back: no more OB 122.
   ASSERT_EQ(f.v0->apply(SlaveFault::unmute()), "");
   f.at(t1 + 2000 * kMs);
+  bool back = false;
+  for (const auto& e : f.obs(86))
+    if (e.code == 0x38C4) {
+      back = true;
+      EXPECT_EQ(e.mdl_addr, 16381);  // the return names the same diagnostic address
+    }
+  EXPECT_TRUE(back);
   const auto n = f.obs(122).size();
   f.at(t1 + 2500 * kMs);
   EXPECT_EQ(f.obs(122).size(), n);

@@ -412,6 +412,76 @@ TEST(SlaveModelLine, Dpv1ChannelDiagnosisWithDiagnosticAlarm) {
   EXPECT_EQ(b.master->slave_state(7), dp::SlaveStatusState::DataExchange);
 }
 
+// --- F3: module parameter data records (module_records.hpp) -------------------------------------
+
+TEST(SlaveModelLine, Dpv1ModuleParameterRecordWrittenReadAndForgottenWhenPulled) {
+  const GsdFile gsd = load("PBVB0A03.gsd");  // DPV1_Slave, C1_Read_Write_supp
+  Bench b(gsd, dv4_modules(), 7);
+  ASSERT_NE(b.model->module_records(), nullptr);
+  std::vector<dp::AcyclicResult> res;
+  auto keep = [&](const dp::AcyclicResult& r) { res.push_back(r); };
+  b.start();
+  b.run_until(20 * kMs);
+  ASSERT_EQ(b.master->slave_state(7), dp::SlaveStatusState::DataExchange);
+  const Bytes rec{0x12, 0x34};
+  // Write record 1 of the 8DO (module 1 = slot 2): accepted. Response (SD2, DSAP = SSAP = 51 =
+  // 0x33, FC 08 DL) `5F 02 01 02`; FCS = 81+87+08+33+33+5F+02+01+02 = 0x1DA -> DA.
+  ASSERT_NE(b.master->write(7, 2, 1, rec, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 1u);
+  EXPECT_EQ(res[0].status, dp::AcyclicStatus::Ok);
+  EXPECT_TRUE(on_wire(b.rec, "68 09 09 68 81 87 08 33 33 5F 02 01 02 DA 16"));
+  EXPECT_EQ(b.model->module_records()->record(1, 1), rec);
+  EXPECT_EQ(b.model->module_records()->writes_accepted(), 1u);
+  // Read it back: `5E 02 01 02 12 34`; DSAP, SSAP and six DU octets are exactly the eight data
+  // octets of an SD3 frame. FCS = 0x176+5E+02+01+02+12+34 = 0x21F -> 1F.
+  ASSERT_NE(b.master->read(7, 2, 1, 240, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 2u);
+  EXPECT_EQ(res[1].status, dp::AcyclicStatus::Ok);
+  EXPECT_EQ(res[1].data, rec);
+  EXPECT_TRUE(on_wire(b.rec, "A2 81 87 08 33 33 5E 02 01 02 12 34 1F 16"));
+  // A record never written: invalid index `DE 80 B0 00`.
+  ASSERT_NE(b.master->read(7, 2, 2, 4, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 3u);
+  EXPECT_EQ(res[2].status, dp::AcyclicStatus::Negative);
+  EXPECT_EQ(res[2].error.code_1, 0xB0);
+  // Slot 5 (4 modules): invalid slot `DF 80 B2 00`; LE = 5 + 4 = 9; FCS = 0x176+DF+80+B2+00 =
+  // 0x387 -> 87.
+  ASSERT_NE(b.master->write(7, 5, 1, rec, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 4u);
+  EXPECT_EQ(res[3].status, dp::AcyclicStatus::Negative);
+  EXPECT_EQ(res[3].error.code_1, 0xB2);
+  EXPECT_TRUE(on_wire(b.rec, "68 09 09 68 81 87 08 33 33 DF 80 B2 00 87 16"));
+  // Pulled: the record is gone and a write to the empty slot is "invalid slot".
+  ASSERT_EQ(b.model->apply(SlaveFault::pulled(1)), "");
+  EXPECT_EQ(b.model->module_records()->record(1, 1), std::nullopt);
+  ASSERT_NE(b.master->write(7, 2, 1, rec, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 5u);
+  EXPECT_EQ(res[4].status, dp::AcyclicStatus::Negative);
+  EXPECT_EQ(res[4].error.code_1, 0xB2);
+  // Plugged: a new module without parameters (read: invalid index) until the record is written.
+  ASSERT_EQ(b.model->apply(SlaveFault::plugged(1)), "");
+  b.run_for(5 * kMs);
+  ASSERT_NE(b.master->read(7, 2, 1, 240, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 6u);
+  EXPECT_EQ(res[5].error.code_1, 0xB0);
+  ASSERT_NE(b.master->write(7, 2, 1, Bytes{0x56}, keep), 0u);
+  b.run_for(5 * kMs);
+  ASSERT_EQ(res.size(), 7u);
+  EXPECT_EQ(res[6].status, dp::AcyclicStatus::Ok);
+  EXPECT_EQ(b.model->module_records()->record(1, 1), Bytes{0x56});
+  EXPECT_EQ(b.model->module_records()->writes_accepted(), 2u);
+  // A DP-V0 station has no records (no MSAC_C1).
+  const GsdFile v0 = load("PBVB0A02.gsd");
+  Bench c(v0, {ModuleChoice::named("8DI DC24V")}, 8);
+  EXPECT_EQ(c.model->module_records(), nullptr);
+}
+
 // --- mute ---------------------------------------------------------------------------------------
 
 TEST(SlaveModelLine, MutedSlaveIsSilentThenReturns) {

@@ -815,6 +815,48 @@ bool contains(const Bytes& hay, const Bytes& needle) {
   return std::search(hay.begin(), hay.end(), needle.begin(), needle.end()) != hay.end();
 }
 
+// F3 (docs/h-reparameterisation.md): the backplane's parameter records, written through the
+// primary; a pulled module (set_module_pulled) has none and its slot is "invalid slot".
+TEST(SwitchedStation, ModuleParameterRecordsAndPullPlug) {
+  TwoLines t(100);
+  set_up_io(t);
+  t.start();
+  t.run_until(50 * kMs);
+  ASSERT_EQ(t.model->primary(), 0);
+  ASSERT_NE(t.model->module_records(), nullptr);
+  std::vector<dp::AcyclicResult> res;
+  auto keep = [&](const dp::AcyclicResult& r) { res.push_back(r); };
+  ASSERT_NE(t.master[0]->write(kAddr, 2, 1, Bytes{0x12, 0x34}, keep), 0u);
+  t.run_until(60 * kMs);
+  ASSERT_EQ(res.size(), 1u);
+  EXPECT_EQ(res[0].status, dp::AcyclicStatus::Ok);
+  EXPECT_EQ(t.model->module_records()->record(1, 1), (Bytes{0x12, 0x34}));
+  // The 16DI (module 0) pulled: its inputs read 0 (constant 12 34 before).
+  ASSERT_EQ(t.model->set_module_pulled(0, true), "");
+  EXPECT_TRUE(t.model->module_pulled(0));
+  ASSERT_EQ(t.model->set_module_pulled(1, true), "");
+  EXPECT_EQ(t.model->module_records()->record(1, 1), std::nullopt);
+  t.run_until(70 * kMs);
+  Bytes in(2, 0xFF);
+  ASSERT_EQ(t.master[0]->image(kAddr).read_inputs(0, in), dp::ImageAccess::Ok);
+  EXPECT_EQ(in, (Bytes{0x00, 0x00}));
+  ASSERT_NE(t.master[0]->write(kAddr, 2, 1, Bytes{0x12, 0x34}, keep), 0u);
+  t.run_until(80 * kMs);
+  ASSERT_EQ(res.size(), 2u);
+  EXPECT_EQ(res[1].status, dp::AcyclicStatus::Negative);
+  EXPECT_EQ(res[1].error.code_1, 0xB2);  // invalid slot: DF 80 B2 00
+  // Plugged: the behaviour is back and the record can be written again.
+  ASSERT_EQ(t.model->set_module_pulled(0, false), "");
+  ASSERT_EQ(t.model->set_module_pulled(1, false), "");
+  ASSERT_NE(t.master[0]->write(kAddr, 2, 1, Bytes{0x56}, keep), 0u);
+  t.run_until(100 * kMs);
+  ASSERT_EQ(res.size(), 3u);
+  EXPECT_EQ(res[2].status, dp::AcyclicStatus::Ok);
+  ASSERT_EQ(t.master[0]->image(kAddr).read_inputs(0, in), dp::ImageAccess::Ok);
+  EXPECT_EQ(in, (Bytes{0x12, 0x34}));
+  EXPECT_EQ(t.model->set_module_pulled(2, true), "module 2 does not exist");
+}
+
 TEST(SwitchedStation, AlarmIsRaisedOnThePrimaryOnly) {
   using K = dp::MasterEvent::Kind;
   TwoLines t(100);

@@ -2,6 +2,9 @@
 // status, MSAC_C2 connections. Expected octets by hand from protocol-facts.md §D.2, §D.5, §E.
 #include <gtest/gtest.h>
 
+#include <utility>
+#include <vector>
+
 #include "pbvbus/dp/slave_engine.hpp"
 #include "slave_harness.hpp"
 
@@ -106,6 +109,31 @@ TEST(SlaveDpv1, C1WriteAndErrors) {
   // Another master may not use MSAC_C1.
   h.req(kM2, kS, kSapC1ReadWrite, {0x5E, 0x01, 0x02, 0x04});
   EXPECT_EQ(h.last.status, ResponseStatus::RS);
+}
+
+TEST(SlaveDpv1, C1WriteAnyTakesWritesWithoutAHandlerOfTheirOwn) {
+  SlaveEngine e(dpv1_config());
+  std::vector<std::pair<int, int>> any;  // (slot, index) the fallback saw
+  e.application().on_write(1, 2, [&](const RecordCall&, std::span<const std::uint8_t>) {
+    return RecordResult::ok();
+  });
+  e.application().on_write_any([&](const RecordCall& c, std::span<const std::uint8_t>) {
+    any.emplace_back(c.slot, c.index);
+    return c.slot == 2 ? RecordResult::ok() : RecordResult::fail(dpv1_err::kInvalidSlot);
+  });
+  Harness h(e);
+  start(h, prm(0x80, 0x00, 0x00));
+  // (1, 2) has its own handler; (2, 7) and (9, 1) go to the fallback.
+  EXPECT_EQ(h.du(kM1, kS, kSapC1ReadWrite, {0x5F, 0x01, 0x02, 0x01, 0x11}),
+            (Bytes{0x5F, 0x01, 0x02, 0x01}));
+  EXPECT_EQ(h.du(kM1, kS, kSapC1ReadWrite, {0x5F, 0x02, 0x07, 0x01, 0x11}),
+            (Bytes{0x5F, 0x02, 0x07, 0x01}));
+  EXPECT_EQ(h.du(kM1, kS, kSapC1ReadWrite, {0x5F, 0x09, 0x01, 0x01, 0x11}),
+            (Bytes{0xDF, 0x80, 0xB2, 0x00}));
+  EXPECT_EQ(any, (std::vector<std::pair<int, int>>{{2, 7}, {9, 1}}));
+  // Reads never reach it: still "invalid index".
+  EXPECT_EQ(h.du(kM1, kS, kSapC1ReadWrite, {0x5E, 0x02, 0x07, 0x04}),
+            (Bytes{0xDE, 0x80, 0xB0, 0x00}));
 }
 
 TEST(SlaveDpv1, C1PendingAnswerGoesOutOnPoll) {

@@ -46,6 +46,7 @@
 #include "pbvbus/dp/master.hpp"
 #include "pbvbus/dp/slave_config.hpp"
 #include "pbvbus/fdl/bus_params.hpp"
+#include "pbvbus/scenario/prm_record_plan.hpp"
 #include "scenario.pb.h"
 
 namespace pbvbus::devices {
@@ -88,6 +89,7 @@ struct DpSlavePlan {
   std::size_t outputs = 0;
   scenario::DpSlave::Inputs io = scenario::DpSlave::COUNTER;
   std::vector<DpIoPlan> io_behaviours;  ///< the `io` entries, in file order
+  std::vector<DpPrmRecordPlan> prm_records;  ///< F3 `parameter_record` (prm_record_plan.hpp)
   /// Test-only: the `mutant` it was asked to be (devices/slave_mutant.hpp); none = conformant.
   std::optional<devices::SlaveMutant> mutant;
   /// One interface of a switched_station (source = its index there, not a dp_slave's): the

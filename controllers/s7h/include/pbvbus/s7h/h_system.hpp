@@ -101,6 +101,7 @@
 #include "pbvbus/s7h/h_connections.hpp"
 #include "pbvbus/s7h/h_cpu_pair.hpp"
 #include "pbvbus/s7h/h_expansion_rack.hpp"
+#include "pbvbus/s7h/h_diag_address.hpp"
 #include "pbvbus/s7h/h_io_map.hpp"
 #include "pbvbus/s7h/h_program_spec.hpp"
 #include "pbvbus/s7h/h_rack_power.hpp"
@@ -253,6 +254,11 @@ class HSystemModel final : public bus::EventTarget {
     return system < m_systems.size() ? m_systems[system] : nullptr;
   }
   const HIoMap& io_map() const { return m_map; }
+  /// D1: the DP diagnostic addresses (h_diag_address.hpp), from the top of the CPU's I/O
+  /// address area (default 16383, a 417-4H). An OB 86 of a station (39C4/38C4 ...) carries
+  /// the slave's one in mdl_addr, one of the whole master system its master's.
+  void set_diag_address_top(std::uint16_t top);
+  const HDiagAddresses& diag_addresses() const { return m_diag; }
   /// OB 1 scans run so far.
   std::uint64_t scans() const { return m_scans; }
   std::span<const std::uint8_t> pii() const { return m_pii; }
@@ -403,6 +409,7 @@ class HSystemModel final : public bus::EventTarget {
   std::vector<RedundantMasterSystemModel*> m_systems;
   std::vector<std::array<Side, 2>> m_side;
   HIoMap m_map;
+  HDiagAddresses m_diag;  ///< D1
   std::vector<std::uint8_t> m_pii, m_piq;
   Program m_program;
   std::unique_ptr<RedundantExecution> m_exec;
@@ -490,7 +497,8 @@ class HSystemModel final : public bus::EventTarget {
   //   record gets none (the model knows no parameters for it). The result is not an OB.
  public:
   /// Registers module `module`'s parameter data record (index, octets <= 240) written after
-  /// each plug. False: bad system/station/module or record length.
+  /// each plug (one per index, written in registration order; the same index again replaces
+  /// it). False: bad system/station/module or record length.
   bool set_module_parameters(std::size_t system, std::uint8_t station, std::size_t module,
                              std::uint8_t index, std::vector<std::uint8_t> record);
   /// Parameter records written after plugs so far (the jobs started).

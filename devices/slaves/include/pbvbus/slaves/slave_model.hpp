@@ -73,6 +73,7 @@
 #include "pbvbus/bus/device.hpp"
 #include "pbvbus/gsd/gsd.hpp"
 #include "pbvbus/slaves/io_behaviour.hpp"
+#include "pbvbus/slaves/module_records.hpp"
 #include "pbvbus/slaves/slave_fault.hpp"
 #include "pbvbus/slaves/slave_mutant.hpp"
 #include "pbvbus/dp/master.hpp"
@@ -196,6 +197,9 @@ class SlaveModel final : public bus::Device {
   std::string schedule(bus::Ticks at, SlaveFault f);
   bool muted() const { return m_muted; }
   bool module_pulled(std::size_t m) const { return m_modules[m].pulled; }
+  /// The modules' parameter data records (MSAC_C1 Write/Read; module_records.hpp); null unless
+  /// the GSD has DPV1_Slave and C1_Read_Write_supp.
+  const ModuleRecords* module_records() const { return m_records.get(); }
   /// F15: the slave's own CPU is in STOP.
   bool stopped() const { return m_stopped; }
 
@@ -234,6 +238,7 @@ class SlaveModel final : public bus::Device {
   bool m_dpv1_pull_plug = false;
   bool m_dpv1 = false;
   std::optional<SlaveMutant> m_mutant;
+  std::unique_ptr<ModuleRecords> m_records;  ///< before m_engine: outlives its handlers
   std::unique_ptr<dp::SlaveEngine> m_engine;
   std::unique_ptr<User> m_user;
   std::unique_ptr<Port> m_port;

@@ -141,6 +141,18 @@ class SwitchedStationModel {
                               std::uint8_t* seq_nr = nullptr);
   std::size_t alarms_outstanding() const { return m_rs->alarms_outstanding(); }
 
+  /// Pulls (true) or plugs module `module` on the backplane (F3; as SlaveModel's ModulePulled):
+  /// Module_Status "no module" on both interfaces, its inputs 0 and its behaviours suspended
+  /// while pulled, its parameter records forgotten, and a Pull (Plug) alarm over the active
+  /// channel when the master enabled them. Empty string = done; else why not.
+  std::string set_module_pulled(std::size_t module, bool pulled);
+  bool module_pulled(std::size_t module) const {
+    return module < m_pulled.size() && m_pulled[module];
+  }
+  /// The modules' parameter data records (MSAC_C1 Write/Read on either interface; one
+  /// backplane, one store: slaves/module_records.hpp); null without C1_Read_Write_supp.
+  const ModuleRecords* module_records() const { return m_records.get(); }
+
  private:
   class Iface;
   class User;
@@ -163,9 +175,11 @@ class SwitchedStationModel {
   std::uint32_t m_tsdr = 0;
   GsdBytes m_default_prm;
   std::optional<bus::Ticks> m_t_slave_um;
+  std::unique_ptr<ModuleRecords> m_records;  ///< before m_rs: outlives the handlers it installs
   std::unique_ptr<redundancy::RedundantSlave> m_rs;
   std::unique_ptr<Iface> m_if[2];
   std::vector<std::vector<ChannelBehaviour>> m_channels;  ///< per module
+  std::vector<bool> m_pulled;  ///< per module (set_module_pulled)
   std::vector<std::uint8_t> m_scratch;
   std::vector<redundancy::RedEvent> m_events;
   std::uint64_t m_dp_cycles = 0;

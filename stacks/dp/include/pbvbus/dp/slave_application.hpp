@@ -133,6 +133,10 @@ class SlaveApplication {
   // --- Records (any thread) ---
   void on_read(std::uint8_t slot, std::uint8_t index, RecordReadHandler h);
   void on_write(std::uint8_t slot, std::uint8_t index, RecordWriteHandler h);
+  /// The handler for a Write to a (slot, index) without a handler of its own (e.g. a module's
+  /// parameter records at any index; devices/slaves module_records.hpp). Unset: such a Write is
+  /// answered "invalid index" / "invalid slot" as before.
+  void on_write_any(RecordWriteHandler h);
   void complete_read(std::uint32_t id, std::span<const std::uint8_t> data);
   void complete_write(std::uint32_t id);
   void complete_error(std::uint32_t id, Dpv1Error e);
@@ -176,6 +180,7 @@ class SlaveApplication {
   std::function<void(std::uint8_t, std::uint8_t, std::uint8_t)> m_alarm_ack_cb;
   std::map<std::uint16_t, RecordReadHandler> m_read_handlers;
   std::map<std::uint16_t, RecordWriteHandler> m_write_handlers;
+  RecordWriteHandler m_write_any;
   std::map<std::uint32_t, Completion> m_completions;
 };
 

@@ -8,14 +8,12 @@
 #include <string>
 #include <utility>
 
+#include "pbvbus/s7h/h_event_ids.hpp"
 #include "pbvbus/s7h/h_system.hpp"
 
 namespace pbvbus::devices {
 
-namespace {
-/// OB 83 "module inserted": W#16#3861, the plug alarm's event ID (as h_system_diag.cpp).
-constexpr std::uint16_t kOb83Inserted = 0x3861;
-}  // namespace
+using h_event::kOb83Inserted;  // OB 83 "module inserted", W#16#3861 (h_event_ids.hpp)
 
 bool HSystemModel::switch_to_cpu(HSwitchVariant v, const HCpuConfig& master,
                                  const HCpuConfig& standby, std::vector<int> added_switched) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "pbvbus/s7h/h_event_ids.hpp"
 #include "pbvbus/s7h/h_system.hpp"
 #include "pbvbus/slaves/slave_fault.hpp"
 #include "pbvbus/dp/diagnosis.hpp"
@@ -12,15 +13,7 @@ namespace pbvbus::devices {
 
 namespace {
 
-// S7 event IDs ("System Software for S7-300/400", OB 82/83/122 local data): EV_CLASS 39 =
-// incoming, 38 = outgoing; OB 82 FLT_ID 42; OB 83 FLT_ID 61 (removed / inserted, type OK);
-// OB 122 EV_CLASS 29, SW_FLT 42 read / 43 write.
-constexpr std::uint16_t kOb82Incoming = 0x3942;
-constexpr std::uint16_t kOb82Outgoing = 0x3842;
-constexpr std::uint16_t kOb83Removed = 0x3961;
-constexpr std::uint16_t kOb83Inserted = 0x3861;
-constexpr std::uint16_t kOb122Read = 0x2942;
-constexpr std::uint16_t kOb122Write = 0x2943;
+using namespace h_event;  // the event IDs (h_event_ids.hpp)
 
 bool contains(const std::vector<std::uint32_t>& v, std::uint32_t k) {
   return std::find(v.begin(), v.end(), k) != v.end();

@@ -525,7 +525,13 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
       f.start <= std::min(std::max(f.start, f.end), earliest_in_flight())) {
     const std::size_t n = f.bytes.size();
     const std::size_t total = 32 + pad4(n);
-    std::uint8_t* p = reserve(total);
+    std::uint8_t* p = nullptr;
+    if (m_len + total <= m_buf.size()) {  // reserve(), without the call
+      p = m_buf.data() + m_len;
+      m_len += total;
+    } else {
+      p = reserve(total);
+    }
     const std::uint64_t ts_ns = timestamp_ns(f.start);
     put32(p, pcapng::kBlockEpb);
     put32(p + 4, static_cast<std::uint32_t>(total));
@@ -545,7 +551,7 @@ void PcapngWriter::write_frame(const bus::TapFrame& f) {
     m_unknown_if = add_interface("unknown", "frames of no known line", m_opts.line_link_type, 0);
   const std::uint32_t id =
       f.line ? interface_for(*f.line, f.probe) : static_cast<std::uint32_t>(m_unknown_if);
-  // Fast path: an intact frame that decodes needs neither flags nor comment.
+  // An intact frame that decodes needs neither flags nor comment.
   std::uint32_t flags = 0;
   std::string_view comment;
   if (f.flags != 0 || !fdl::decode_once(f, m_scratch).ok()) {

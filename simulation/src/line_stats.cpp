@@ -14,7 +14,8 @@ namespace {
 /// A 64-bit hash of a telegram, never 0 (0 marks "no request"). Eight octets per multiply, the
 /// last eight (overlapping the ones before) for the rest, and the length mixed in first; every
 /// step is a bijection of the state for a given word, so two telegrams of the same length that
-/// differ in one word never collide. A mixing of the state at the end only.
+/// differ in one word never collide. A mixing of the state at the end only. (An FNV-1a over
+/// single octets, then a mix after every word, were visible parts of the per-frame cost.)
 std::uint64_t hash_of(std::span<const std::uint8_t> b) {
   const std::size_t n = b.size();
   std::uint64_t h = 1469598103934665603ULL ^ (n * 0x9E3779B97F4A7C15ULL);
@@ -56,9 +57,9 @@ void LineStats::mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only) {
   if (!upgrade_only || heard[addr] < v) heard[addr] = v;
 }
 
-void LineStats::settle(const bus::TapFrame& f, const fdl::Telegram* t) {
+void LineStats::settle(const fdl::Telegram& frame) {
   m_awaiting = false;
-  if (f.flags != 0 || t == nullptr) return;  // a damaged frame decides nothing
+  const fdl::Telegram* t = &frame;
   if (m_await_token) {
     if (t->type != fdl::FrameType::SC && t->sa == m_await_da) return;  // the receiver is active
   } else if (t->type == fdl::FrameType::SC) {
@@ -91,7 +92,7 @@ void LineStats::on_frame(const bus::TapFrame& f) {
   else
     ++by_type[static_cast<std::size_t>(ti)];
   if (f.flags != 0) {
-    if (m_awaiting) settle(f, nullptr);
+    m_awaiting = false;  // a damaged frame decides nothing
     ++m_error_frames;
     if (f.flags & bus::kRxCollision) ++collisions;
     if (f.flags & (bus::kRxParity | bus::kRxFraming)) ++parity;
@@ -103,7 +104,7 @@ void LineStats::on_frame(const bus::TapFrame& f) {
   const fdl::DecodeError e = d.error;
   const fdl::Telegram& t = d.telegram;
   if (e != fdl::DecodeError::None) {
-    if (m_awaiting) settle(f, nullptr);
+    m_awaiting = false;  // a damaged frame decides nothing
     ++m_error_frames;
     if (e == fdl::DecodeError::BadFcs)
       ++bad_fcs;
@@ -111,7 +112,7 @@ void LineStats::on_frame(const bus::TapFrame& f) {
       ++malformed;
     return;
   }
-  if (m_awaiting) settle(f, &t);
+  if (m_awaiting) settle(t);
   const bool sync_needed = t.type == fdl::FrameType::SD4 || t.is_request();
   if (sync_needed && last_end >= 0 && f.line != nullptr && f.start - last_end < tsyn_of(*f.line))
     ++short_idle;

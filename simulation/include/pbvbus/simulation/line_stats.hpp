@@ -86,8 +86,9 @@ class LineStats final : public bus::Tap {
     return a;
   }
   void mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only);
-  /// The frame after a request or token (m_awaiting set): did its DA answer?
-  void settle(const bus::TapFrame& f, const fdl::Telegram* t);
+  /// The intact frame after a request or token (m_awaiting set): did its DA answer? (A
+  /// damaged one decides nothing: on_frame() only clears m_awaiting.)
+  void settle(const fdl::Telegram& frame);
   /// TSYN (33 bit times) of `line`, kept for the last line asked.
   bus::Ticks tsyn_of(const bus::Line& line);
 

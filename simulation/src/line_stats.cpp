@@ -1,5 +1,6 @@
 #include "pbvbus/simulation/line_stats.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "pbvbus/bus/device.hpp"
@@ -10,39 +11,44 @@
 namespace pbvbus::tools {
 
 namespace {
-/// A 64-bit hash of a telegram, never 0 (0 marks "no request"). Eight octets per multiply (an
-/// FNV-1a over single octets was a visible part of the per-frame cost); the length goes in too,
-/// so a telegram and its prefix padded with zeros differ.
+/// A 64-bit hash of a telegram, never 0 (0 marks "no request"). Eight octets per multiply, the
+/// last eight (overlapping the ones before) for the rest, and the length mixed in first; every
+/// step is a bijection of the state for a given word, so two telegrams of the same length that
+/// differ in one word never collide. A mixing of the state at the end only. (An FNV-1a over
+/// single octets, then a mix after every word, were visible parts of the per-frame cost.)
 std::uint64_t hash_of(std::span<const std::uint8_t> b) {
-  std::uint64_t h = 1469598103934665603ULL ^ (b.size() * 0x9E3779B97F4A7C15ULL);
-  std::size_t i = 0;
-  for (; i + 8 <= b.size(); i += 8) {
-    std::uint64_t w;
-    std::memcpy(&w, b.data() + i, 8);
-    h = (h ^ w) * 0xBF58476D1CE4E5B9ULL;
-    h ^= h >> 29;
+  const std::size_t n = b.size();
+  std::uint64_t h = 1469598103934665603ULL ^ (n * 0x9E3779B97F4A7C15ULL);
+  std::uint64_t w = 0;
+  if (n >= 8) {
+    const std::uint8_t* p = b.data();
+    for (std::size_t i = 0; i + 8 < n; i += 8) {
+      std::memcpy(&w, p + i, 8);
+      h = (h ^ w) * 0xBF58476D1CE4E5B9ULL;
+    }
+    std::memcpy(&w, p + n - 8, 8);
+  } else {
+    for (std::size_t k = 0; k < n; ++k) w = (w << 8) | b[k];
   }
-  if (i < b.size()) {
-    std::uint64_t w = 0;
-    for (std::size_t k = i; k < b.size(); ++k) w = (w << 8) | b[k];
-    h = (h ^ w) * 0x94D049BB133111EBULL;
-    h ^= h >> 29;
-  }
+  h = (h ^ w) * 0x94D049BB133111EBULL;
+  h ^= h >> 29;
   h *= 0xBF58476D1CE4E5B9ULL;
   h ^= h >> 32;
   return h == 0 ? 1 : h;
 }
 
-int type_index(std::uint8_t sd) {
-  switch (sd) {
-    case fdl::kSD1: return 0;
-    case fdl::kSD2: return 1;
-    case fdl::kSD3: return 2;
-    case fdl::kSD4: return 3;
-    case fdl::kSC: return 4;
-    default: return -1;
-  }
+/// by_type index of a first octet (-1: not a start delimiter), one load instead of a switch.
+constexpr std::array<std::int8_t, 256> make_type_index() {
+  std::array<std::int8_t, 256> a{};
+  for (auto& x : a) x = -1;
+  a[fdl::kSD1] = 0;
+  a[fdl::kSD2] = 1;
+  a[fdl::kSD3] = 2;
+  a[fdl::kSD4] = 3;
+  a[fdl::kSC] = 4;
+  return a;
 }
+constexpr std::array<std::int8_t, 256> kTypeIndex = make_type_index();
 }  // namespace
 
 void LineStats::mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only) {
@@ -51,10 +57,9 @@ void LineStats::mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only) {
   if (!upgrade_only || heard[addr] < v) heard[addr] = v;
 }
 
-void LineStats::settle(const bus::TapFrame& f, const fdl::Telegram* t) {
-  if (!m_awaiting) return;
+void LineStats::settle(const fdl::Telegram& frame) {
   m_awaiting = false;
-  if (f.flags != 0 || t == nullptr) return;  // a damaged frame decides nothing
+  const fdl::Telegram* t = &frame;
   if (m_await_token) {
     if (t->type != fdl::FrameType::SC && t->sa == m_await_da) return;  // the receiver is active
   } else if (t->type == fdl::FrameType::SC) {
@@ -67,18 +72,27 @@ void LineStats::settle(const bus::TapFrame& f, const fdl::Telegram* t) {
   if (m_await_counts) ++no_response;
 }
 
+bus::Ticks LineStats::tsyn_of(const bus::Line& line) {
+  if (&line != m_tsyn_line || line.baud() != m_tsyn_baud) {
+    m_tsyn_line = &line;
+    m_tsyn_baud = line.baud();
+    m_tsyn = 33 * line.bit_ticks();
+  }
+  return m_tsyn;
+}
+
 void LineStats::on_frame(const bus::TapFrame& f) {
   const bus::Ticks last_end = m_last_end;
   m_last_end = f.end;
   ++frames;
   octets += f.bytes.size();
-  const int ti = f.bytes.empty() ? -1 : type_index(f.bytes[0]);
+  const int ti = f.bytes.empty() ? -1 : kTypeIndex[f.bytes[0]];
   if (ti < 0)
     ++garbage;
   else
     ++by_type[static_cast<std::size_t>(ti)];
   if (f.flags != 0) {
-    settle(f, nullptr);
+    m_awaiting = false;  // a damaged frame decides nothing
     ++m_error_frames;
     if (f.flags & bus::kRxCollision) ++collisions;
     if (f.flags & (bus::kRxParity | bus::kRxFraming)) ++parity;
@@ -86,12 +100,11 @@ void LineStats::on_frame(const bus::TapFrame& f) {
     if (f.flags & bus::kRxBabble) ++babble;
     return;
   }
-  fdl::DecodedFrame scratch;
-  const fdl::DecodedFrame& d = fdl::decode_once(f, scratch);
+  const fdl::DecodedFrame& d = fdl::decode_once(f, m_scratch);
   const fdl::DecodeError e = d.error;
   const fdl::Telegram& t = d.telegram;
   if (e != fdl::DecodeError::None) {
-    settle(f, nullptr);
+    m_awaiting = false;  // a damaged frame decides nothing
     ++m_error_frames;
     if (e == fdl::DecodeError::BadFcs)
       ++bad_fcs;
@@ -99,10 +112,9 @@ void LineStats::on_frame(const bus::TapFrame& f) {
       ++malformed;
     return;
   }
-  settle(f, &t);
+  if (m_awaiting) settle(t);
   const bool sync_needed = t.type == fdl::FrameType::SD4 || t.is_request();
-  if (sync_needed && last_end >= 0 && f.line != nullptr &&
-      f.start - last_end < 33 * f.line->bit_ticks())
+  if (sync_needed && last_end >= 0 && f.line != nullptr && f.start - last_end < tsyn_of(*f.line))
     ++short_idle;
   if (t.type == fdl::FrameType::SD4) {
     ++tokens_by_sa[t.sa & 0x7F];

@@ -63,6 +63,7 @@
 #include "pbvbus/bus/tap.hpp"
 #include "pbvbus/captures/event_record.hpp"
 #include "pbvbus/captures/pcapng_format.hpp"
+#include "pbvbus/fdl/decoded_frame.hpp"
 
 namespace pbvbus::captures {
 
@@ -175,7 +176,12 @@ class PcapngWriter final : public bus::Tap {
     std::size_t off;
     std::size_t len;
   };
-  std::uint32_t interface_for(const bus::Line& line, int probe);
+  /// The interface of a frame from `line` at `probe` (the last one asked is kept at hand).
+  std::uint32_t interface_for(const bus::Line& line, int probe) {
+    if (&line == m_last_line && probe == m_last_probe) return m_last_id;
+    return find_interface(line, probe);
+  }
+  std::uint32_t find_interface(const bus::Line& line, int probe);
   std::uint32_t declare(const bus::Line& line, int probe, std::string_view name,
                         std::string_view where);
   /// Declares the interfaces of all of this writer's taps on `line` not declared yet.
@@ -208,6 +214,7 @@ class PcapngWriter final : public bus::Tap {
   std::int64_t m_events_if = -1;
   std::int64_t m_unknown_if = -1;
   std::string m_comment;
+  fdl::DecodedFrame m_scratch;  ///< decode_once()'s scratch (a frame without a memo)
   std::vector<std::uint8_t> m_event_buf;
   bool m_ok = true;
   std::string m_error;

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "pbvbus/bus/tap.hpp"
+#include "pbvbus/fdl/decoded_frame.hpp"
 #include "pbvbus/fdl/telegram.hpp"
 
 namespace pbvbus::tools {
@@ -85,8 +86,11 @@ class LineStats final : public bus::Tap {
     return a;
   }
   void mark(std::uint8_t addr, fdl::StationType t, bool upgrade_only);
-  /// The frame after a request or token: did its DA answer?
-  void settle(const bus::TapFrame& f, const fdl::Telegram* t);
+  /// The intact frame after a request or token (m_awaiting set): did its DA answer? (A
+  /// damaged one decides nothing: on_frame() only clears m_awaiting.)
+  void settle(const fdl::Telegram& frame);
+  /// TSYN (33 bit times) of `line`, kept for the last line asked.
+  bus::Ticks tsyn_of(const bus::Line& line);
 
   std::uint64_t m_error_frames = 0;
   // The request or token waiting for its reply.
@@ -96,6 +100,10 @@ class LineStats final : public bus::Tap {
   std::uint8_t m_await_da = 0;
   // The last request expecting a reply, by sender: a hash of its octets (0 = none).
   std::array<std::uint64_t, 128> m_last_request{};
+  const bus::Line* m_tsyn_line = nullptr;
+  bus::Baud m_tsyn_baud{};
+  bus::Ticks m_tsyn = 0;
+  fdl::DecodedFrame m_scratch;  ///< decode_once()'s scratch (a frame without a memo)
   bus::Ticks m_last_end = -1;  ///< end of the previous frame (-1 = none yet)
 };
 

@@ -2,6 +2,8 @@
 
 #include "pbvbus/fdl_traffic/fdl_responder.hpp"
 
+#include "counting_table.hpp"
+
 namespace pbvbus::devices {
 
 FdlPoller::FdlPoller(std::vector<PollItem> items)
@@ -49,9 +51,14 @@ bool FdlPoller::next_request(fdl::Priority prio, bus::Ticks, fdl::Request& out) 
     out.fn = it.fn;
     out.dsap.reset();
     out.ssap.reset();
-    out.data.resize(it.length);
     const std::uint8_t seq = m_seq[k]++;
-    fill_counting(out.data, seq);
+    if (it.length <= detail::kCountingMax) {  // the same octets, copied in one go
+      const std::uint8_t* from = detail::kCounting.data() + seq;
+      out.data.assign(from, from + it.length);
+    } else {
+      out.data.resize(it.length);
+      fill_counting(out.data, seq);
+    }
     out.tag = k;
     return true;
   }

@@ -1,5 +1,7 @@
 #include "pbvbus/fdl_traffic/fdl_responder.hpp"
 
+#include "counting_table.hpp"
+
 namespace pbvbus::devices {
 
 void FdlResponder::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
@@ -13,6 +15,12 @@ void FdlResponder::on_request(const fdl::Indication& ind, fdl::Reply& reply) {
         return;
       }
       const auto c = static_cast<std::uint8_t>(m_cycle++);
+      if (m_data.size() <= detail::kCountingMax) {
+        // The octets fill_counting() would write, straight from the table (m_data only gives
+        // the length then).
+        reply.respond(fdl::ResponseStatus::DL, {detail::kCounting.data() + c, m_data.size()});
+        return;
+      }
       fill_counting(m_data, c);
       reply.respond(fdl::ResponseStatus::DL, m_data);
       return;

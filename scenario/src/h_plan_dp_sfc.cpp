@@ -39,8 +39,10 @@ void plan_dp_sfc_calls(const scenario::HProgram& pr, devices::ProgramSpec& spec,
   for (int k = 0; k < pr.dpsyc_fr_size(); ++k) {
     const auto& n = pr.dpsyc_fr(k);
     const auto at = at_of(n, "dpsyc_fr", k, error_at);
-    const bool good = octet(n.group(), "dpsyc_fr", k, "group", "SFC 11: GROUP", error_at) &
-                      octet(n.mode(), "dpsyc_fr", k, "mode", "SFC 11: MODE", error_at);
+    // Both checked, so that both errors are reported at once.
+    const bool group_ok = octet(n.group(), "dpsyc_fr", k, "group", "SFC 11: GROUP", error_at);
+    const bool mode_ok = octet(n.mode(), "dpsyc_fr", k, "mode", "SFC 11: MODE", error_at);
+    const bool good = group_ok && mode_ok;
     if (!at || !good) continue;
     devices::DpSyncFreezeCall c;
     c.at = *at;

@@ -992,9 +992,10 @@ void svg_cpu(SvgCtx& c, const Timeline& tl, const CpuRowIndex& rows, int y0) {
 
 /// "takeover 40.000 ms" or "no takeover time" (value 0).
 std::string takeover_text(std::uint64_t ns) {
-  constexpr auto kMax = std::numeric_limits<std::int64_t>::max();
+  constexpr auto kMaxNs = std::numeric_limits<std::int64_t>::max();
   if (ns == 0) return "no takeover time";
-  return "takeover " + fmt_dur(ns > static_cast<std::uint64_t>(kMax) ? kMax : static_cast<std::int64_t>(ns));
+  return "takeover " +
+         fmt_dur(ns > static_cast<std::uint64_t>(kMaxNs) ? kMaxNs : static_cast<std::int64_t>(ns));
 }
 
 /// One row per Quantum rack from y0 (timeline.hpp "Quantum Hot Standby rows"): spans coloured

@@ -98,7 +98,7 @@ void wrong_identifier(TestContext& ctx, TestResult& r) {
   expect_cfg_fault(ctx, r, cfg, "one identifier changed");
 }
 
-void wrong_length(TestContext& ctx, TestResult& r) {
+void wrong_cfg_length(TestContext& ctx, TestResult& r) {
   auto cfg = cfg_du(ctx.params());
   if (cfg.size() > 1) cfg.pop_back();
   else cfg.push_back(0x10);
@@ -155,7 +155,7 @@ void add_chk_cfg_tests(std::vector<TestCase>& out) {
   out.push_back({"CFG-03", kChkCfgGroup, "Wrong configuration length refused",
                  "Chk_Cfg with more or fewer identifier octets than the real configuration sets "
                  "Cfg_Fault (§D.3)",
-                 wrong_length, {SlaveMutant::AcceptWrongCfg}});
+                 wrong_cfg_length, {SlaveMutant::AcceptWrongCfg}});
   out.push_back({"CFG-04", kChkCfgGroup, "Chk_Cfg in Wait_Prm refused",
                  "Before a Set_Prm, Chk_Cfg does not bring the slave to data exchange (Wait_Prm accepts "
                  "only Set_Prm, Slave_Diag, Get_Cfg, Set_Slave_Add; §D.8)",

@@ -24,10 +24,6 @@ namespace {
 
 constexpr const char* kClass2Group = "Class 2";
 
-bool data_answer(const TestContext& ctx, const Reply& r) {
-  return r.ok_with_data() || (r.kind == Reply::Kind::Sc && ctx.input_len() == 0);
-}
-
 dp::SlaveParams class2_params(const TestContext& ctx) {
   dp::SlaveParams p = ctx.params();
   p.station_status = dp::kPrmLockReq | dp::kPrmWdOn;

@@ -38,10 +38,6 @@ dp::SlaveParams with_short_watchdog(const TestContext& ctx, bus::Ticks& twd) {
   return p;
 }
 
-bool data_answer(const TestContext& ctx, const Reply& r) {
-  return r.ok_with_data() || (r.kind == Reply::Kind::Sc && ctx.input_len() == 0);
-}
-
 /// The slave is back in Wait_Prm: Station_Not_Ready, no master, Data_Exchange refused.
 bool in_wait_prm(Run& run, const std::string& when, std::vector<std::uint8_t>* diag6 = nullptr) {
   std::string why;

@@ -91,7 +91,7 @@ void wrong_ident(TestContext& ctx, TestResult& r) {
   expect_refused(ctx, r, p, "wrong Ident_Number");
 }
 
-void wrong_length(TestContext& ctx, TestResult& r) {
+void wrong_prm_length(TestContext& ctx, TestResult& r) {
   dp::SlaveParams p = ctx.params();
   if (!p.user_prm.empty()) p.user_prm.pop_back();
   else p.user_prm.push_back(0x00);
@@ -312,7 +312,7 @@ void add_set_prm_tests(std::vector<TestCase>& out) {
                  wrong_ident, {SlaveMutant::AcceptWrongIdent}});
   out.push_back({"PRM-02", kSetPrmGroup, "Wrong User_Prm_Data length refused",
                  "A Set_Prm whose User_Prm_Data length differs from the GSD's is refused with Prm_Fault",
-                 wrong_length, {}});
+                 wrong_prm_length, {}});
   out.push_back({"PRM-03", kSetPrmGroup, "Wrong User_Prm_Data content refused",
                  "A parameter value outside its ExtUserPrmData range is refused with Prm_Fault (GSD "
                  "PI 2.122; §D.2)",

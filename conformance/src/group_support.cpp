@@ -184,6 +184,10 @@ bool wait_prm_diag(const dp::StandardDiag& d) {
   return (d.status_1 & dp::kDiagStationNotReady) != 0 && d.master_add == dp::kNoMaster;
 }
 
+bool data_answer(const TestContext& ctx, const Reply& r) {
+  return r.ok_with_data() || (r.kind == Reply::Kind::Sc && ctx.input_len() == 0);
+}
+
 Exchange Run::c1(std::uint8_t dsap, std::span<const std::uint8_t> pdu, std::string note) {
   const auto t = srd(m_dut, m_tester, dsap, dp::kSapMs1, pdu);
   return bus().request(t, std::move(note));

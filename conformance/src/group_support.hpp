@@ -55,6 +55,10 @@ bool diag_ready(const dp::StandardDiag& d);
 /// there, not here), except where a test says otherwise.
 bool wait_prm_diag(const dp::StandardDiag& d);
 
+/// A Data_Exchange answered as a slave in data exchange answers: with data, or SC when the
+/// slave has no inputs.
+bool data_answer(const TestContext& ctx, const Reply& r);
+
 /// White box: the outputs the model's application holds now (what drives the process), in
 /// Data_Exchange order.
 std::vector<std::uint8_t> applied_outputs(devices::SlaveModel& model);

@@ -7,8 +7,6 @@
 
 namespace pbvbus::gateways {
 
-using namespace canopen;
-
 CanopenGateway::CanopenGateway(bus::Scheduler& sched, ProcessSource& source, CanHub& hub,
                                CanopenOptions options)
     : m_sched(sched), m_source(source), m_hub(hub), m_opt(std::move(options)) {
@@ -32,7 +30,9 @@ CanopenGateway::CanopenGateway(bus::Scheduler& sched, ProcessSource& source, Can
                           [this](const CanFrame& f, bus::Ticks now) { on_frame(f, now); });
 }
 
-CanopenGateway::~CanopenGateway() { m_hub.remove_port(m_port); }
+CanopenGateway::~CanopenGateway() {
+  m_hub.remove_port(m_port);
+}
 
 void CanopenGateway::start(bus::Ticks now) {
   if (m_started) return;
@@ -77,10 +77,10 @@ void CanopenGateway::on_event(bus::Ticks now, std::uint64_t tag) {
   const dp::MasterMode mode = m_source.mode();
   for (auto& n : m_nodes) {
     if (n.next_heartbeat > now) continue;
-    const auto state = heartbeat_state(status_of(n).state, mode);
+    const auto state = canopen::heartbeat_state(status_of(n).state, mode);
     if (state) {
       const std::uint8_t b = *state;
-      send(kCobHeartbeat + n.map.node, {&b, 1}, now);
+      send(canopen::kCobHeartbeat + n.map.node, {&b, 1}, now);
       ++m_stats.heartbeat_sent;
     }
     const bus::Ticks period = bus::Ticks{n.heartbeat_ms} * bus::kTicksPerMs;
@@ -106,9 +106,9 @@ SlaveStatus CanopenGateway::status_of(const Node& n) const {
 
 std::uint8_t CanopenGateway::error_register(const Node& n) const {
   std::uint8_t r = 0;
-  if (n.failure_active) r |= kErrCommunication;
-  if (n.ext_active) r |= kErrManufacturer;
-  if (r) r |= kErrGeneric;
+  if (n.failure_active) r |= canopen::kErrCommunication;
+  if (n.ext_active) r |= canopen::kErrManufacturer;
+  if (r) r |= canopen::kErrGeneric;
   return r;
 }
 
@@ -126,18 +126,18 @@ void CanopenGateway::check_node(Node& n, bus::Ticks now, bool cyclic) {
     const bool lost = !dx && !commanded_off;
     if ((lost || bounced) && !n.failure_active) {
       n.failure_active = true;
-      send_emcy(n, kEmcyHeartbeatError, error_register(n), {dp_state_code(st.state), 0, 0, 0, 0},
-                now);
+      send_emcy(n, canopen::kEmcyHeartbeatError, error_register(n),
+                {canopen::dp_state_code(st.state), 0, 0, 0, 0}, now);
     }
   }
   if (dx && (!n.seen || !n.data_exchange || bounced)) send_bootup(n, now);
   if (dx && n.failure_active) {
     n.failure_active = false;
-    send_emcy(n, kEmcyErrorReset, error_register(n), {}, now);
+    send_emcy(n, canopen::kEmcyErrorReset, error_register(n), {}, now);
   }
 
   // Extended diagnosis: appears, changes, clears.
-  const bool ext = has_ext_diag(st);
+  const bool ext = canopen::has_ext_diag(st);
   if (ext) {
     std::vector<std::uint8_t> ext_octets;
     if (st.diag.size() > dp::kStdDiagLen)
@@ -146,14 +146,16 @@ void CanopenGateway::check_node(Node& n, bus::Ticks now, bool cyclic) {
     if (!n.ext_active || ext_octets != n.ext_diag) {
       n.ext_active = true;
       n.ext_diag = std::move(ext_octets);
-      auto octet = [&](std::size_t i) -> std::uint8_t { return i < st.diag.size() ? st.diag[i] : 0; };
-      send_emcy(n, kEmcyDeviceSpecific, error_register(n),
+      auto octet = [&](std::size_t i) -> std::uint8_t {
+        return i < st.diag.size() ? st.diag[i] : 0;
+      };
+      send_emcy(n, canopen::kEmcyDeviceSpecific, error_register(n),
                 {octet(0), octet(1), octet(2), octet(6), octet(7)}, now);
     }
   } else if (n.ext_active) {
     n.ext_active = false;
     n.ext_diag.clear();
-    send_emcy(n, kEmcyErrorReset, error_register(n), {}, now);
+    send_emcy(n, canopen::kEmcyErrorReset, error_register(n), {}, now);
   }
 
   n.seen = true;
@@ -170,16 +172,17 @@ void CanopenGateway::send_tpdos(Node& n, bus::Ticks now, bool cyclic) {
   m_in_buf.assign(n.map.input_len, 0);
   if (!m_source.read_inputs(n.map.address, Side::Primary, m_in_buf)) return;
   for (std::size_t i = 0; i < n.map.tpdos; ++i) {
-    const std::size_t off = i * kPdoOctets;
-    const auto len = static_cast<std::uint8_t>(std::min(kPdoOctets, m_in_buf.size() - off));
+    const std::size_t off = i * canopen::kPdoOctets;
+    const auto len =
+        static_cast<std::uint8_t>(std::min(canopen::kPdoOctets, m_in_buf.size() - off));
     const std::uint8_t* p = m_in_buf.data() + off;
-    const bool changed = !n.sent[i] || n.last_len[i] != len ||
-                         std::memcmp(n.last[i].data(), p, len) != 0;
+    const bool changed =
+        !n.sent[i] || n.last_len[i] != len || std::memcmp(n.last[i].data(), p, len) != 0;
     if (!changed && !cyclic) continue;
     std::memcpy(n.last[i].data(), p, len);
     n.last_len[i] = len;
     n.sent[i] = true;
-    send(kCobTpdo[i] + n.map.node, {p, len}, now);
+    send(canopen::kCobTpdo[i] + n.map.node, {p, len}, now);
     ++m_stats.tpdo_sent;
   }
 }
@@ -194,13 +197,13 @@ void CanopenGateway::send_emcy(const Node& n, std::uint16_t code, std::uint8_t r
                                       manufacturer[2],
                                       manufacturer[3],
                                       manufacturer[4]};
-  send(kCobEmcy + n.map.node, d, now);
+  send(canopen::kCobEmcy + n.map.node, d, now);
   ++m_stats.emcy_sent;
 }
 
 void CanopenGateway::send_bootup(Node& n, bus::Ticks now) {
-  const std::uint8_t b = kStateBootUp;
-  send(kCobHeartbeat + n.map.node, {&b, 1}, now);
+  const std::uint8_t b = canopen::kStateBootUp;
+  send(canopen::kCobHeartbeat + n.map.node, {&b, 1}, now);
   ++m_stats.bootup_sent;
   n.sent.fill(false);  // a node that boots sends its process data afresh
 }
@@ -232,7 +235,7 @@ void CanopenGateway::on_frame(const CanFrame& f, bus::Ticks now) {
     ++m_stats.ignored;
     return;
   }
-  if (f.id == kCobNmt) {
+  if (f.id == canopen::kCobNmt) {
     on_nmt(f, now);
     return;
   }
@@ -246,9 +249,15 @@ void CanopenGateway::on_frame(const CanFrame& f, bus::Ticks now) {
     case 0x200:
     case 0x300:
     case 0x400:
-    case 0x500: on_rpdo(*n, (function - 0x200) >> 8, f); return;
-    case kCobSdoRx: on_sdo(*n, f, now); return;
-    default: ++m_stats.ignored; return;  // another producer's TPDO, heartbeat, EMCY, ...
+    case 0x500:
+      on_rpdo(*n, (function - 0x200) >> 8, f);
+      return;
+    case canopen::kCobSdoRx:
+      on_sdo(*n, f, now);
+      return;
+    default:
+      ++m_stats.ignored;
+      return;  // another producer's TPDO, heartbeat, EMCY, ...
   }
 }
 
@@ -268,8 +277,9 @@ void CanopenGateway::on_nmt(const CanFrame& f, bus::Ticks now) {
     ++m_stats.ignored;  // another node's command
     return;
   }
-  const bool known = cs == kNmtStart || cs == kNmtStop || cs == kNmtPreOperational ||
-                     cs == kNmtResetNode || cs == kNmtResetCommunication;
+  const bool known = cs == canopen::kNmtStart || cs == canopen::kNmtStop ||
+                     cs == canopen::kNmtPreOperational || cs == canopen::kNmtResetNode ||
+                     cs == canopen::kNmtResetCommunication;
   if (!known) {
     ++m_stats.bad;
     return;
@@ -281,9 +291,15 @@ void CanopenGateway::on_nmt(const CanFrame& f, bus::Ticks now) {
   bool ok = true;
   switch (cs) {
     // One mode for the whole master system, whichever of its nodes was addressed.
-    case kNmtStart: ok = m_source.command(dp::MasterMode::Operate); break;
-    case kNmtStop: ok = m_source.command(dp::MasterMode::Stop); break;
-    case kNmtPreOperational: ok = m_source.command(dp::MasterMode::Clear); break;
+    case canopen::kNmtStart:
+      ok = m_source.command(dp::MasterMode::Operate);
+      break;
+    case canopen::kNmtStop:
+      ok = m_source.command(dp::MasterMode::Stop);
+      break;
+    case canopen::kNmtPreOperational:
+      ok = m_source.command(dp::MasterMode::Clear);
+      break;
     default: {
       // Reset node / communication: the communication objects (0x1017) return to their
       // configured values, the node announces itself and its heartbeat starts anew. Only a
@@ -292,7 +308,7 @@ void CanopenGateway::on_nmt(const CanFrame& f, bus::Ticks now) {
       for (Node* n : targets) {
         n->heartbeat_ms = m_opt.heartbeat_ms;
         restart_heartbeat(*n, now);
-        if (heartbeat_state(status_of(*n).state, mode)) send_bootup(*n, now);
+        if (canopen::heartbeat_state(status_of(*n).state, mode)) send_bootup(*n, now);
       }
       arm();
       break;
@@ -305,12 +321,13 @@ void CanopenGateway::on_nmt(const CanFrame& f, bus::Ticks now) {
 }
 
 void CanopenGateway::on_rpdo(Node& n, std::size_t pdo, const CanFrame& f) {
-  const std::size_t off = pdo * kPdoOctets;
+  const std::size_t off = pdo * canopen::kPdoOctets;
   if (!n.map.outputs_writable || off >= n.map.output_len || !n.slave) {
     ++m_stats.rpdo_refused;
     return;
   }
-  const std::size_t len = std::min<std::size_t>({f.dlc, kPdoOctets, n.map.output_len - off});
+  const std::size_t len =
+      std::min<std::size_t>({f.dlc, canopen::kPdoOctets, n.map.output_len - off});
   m_out_buf.assign(n.map.output_len, 0);
   if (!m_source.read_outputs(n.map.address, Side::Primary, m_out_buf)) {
     ++m_stats.rpdo_refused;
@@ -336,38 +353,42 @@ void CanopenGateway::on_rpdo(Node& n, std::size_t pdo, const CanFrame& f) {
 
 void CanopenGateway::on_sdo(Node& n, const CanFrame& f, bus::Ticks now) {
   ++m_stats.sdo_received;
-  const SdoRequest r = parse_sdo_request({f.data.data(), std::min<std::size_t>(f.dlc, 8)});
-  SdoFrame resp{};
+  const canopen::SdoRequest r =
+      canopen::parse_sdo_request({f.data.data(), std::min<std::size_t>(f.dlc, 8)});
+  canopen::SdoFrame resp{};
   std::uint32_t abort = 0;
   switch (r.kind) {
-    case SdoRequestKind::ClientAbort: return;
-    case SdoRequestKind::Invalid: abort = r.abort; break;
-    case SdoRequestKind::Upload:
-    case SdoRequestKind::Download: {
-      NodeObjects obj{n.slave, status_of(n), error_register(n), n.heartbeat_ms};
-      if (r.kind == SdoRequestKind::Upload) {
-        const ObjectAccess a = read_object(obj, r.index, r.sub);
+    case canopen::SdoRequestKind::ClientAbort:
+      return;
+    case canopen::SdoRequestKind::Invalid:
+      abort = r.abort;
+      break;
+    case canopen::SdoRequestKind::Upload:
+    case canopen::SdoRequestKind::Download: {
+      canopen::NodeObjects obj{n.slave, status_of(n), error_register(n), n.heartbeat_ms};
+      if (r.kind == canopen::SdoRequestKind::Upload) {
+        const canopen::ObjectAccess a = canopen::read_object(obj, r.index, r.sub);
         abort = a.abort;
-        if (!abort) resp = sdo_upload_response(r.index, r.sub, a.value, a.size);
+        if (!abort) resp = canopen::sdo_upload_response(r.index, r.sub, a.value, a.size);
       } else {
-        const ObjectAccess a = check_write(obj, r.index, r.sub, r.size, r.value);
+        const canopen::ObjectAccess a = canopen::check_write(obj, r.index, r.sub, r.size, r.value);
         abort = a.abort;
         if (!abort) {
           // 0x1017: the new period starts now (CiA 301: the producer restarts with it).
           n.heartbeat_ms = static_cast<std::uint16_t>(a.value);
           restart_heartbeat(n, now);
           arm();
-          resp = sdo_download_response(r.index, r.sub);
+          resp = canopen::sdo_download_response(r.index, r.sub);
         }
       }
       break;
     }
   }
   if (abort) {
-    resp = sdo_abort(r.index, r.sub, abort);
+    resp = canopen::sdo_abort(r.index, r.sub, abort);
     ++m_stats.sdo_aborts;
   }
-  send(kCobSdoTx + n.map.node, resp, now);
+  send(canopen::kCobSdoTx + n.map.node, resp, now);
   ++m_stats.sdo_sent;
 }
 

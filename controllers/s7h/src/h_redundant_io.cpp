@@ -9,8 +9,6 @@ namespace pbvbus::devices {
 
 namespace {
 
-bool is_input(RedIoKind k) { return k == RedIoKind::DI || k == RedIoKind::AI; }
-
 bool get_bit(std::span<const std::uint8_t> b, std::uint32_t n) {
   return (b[n / 8] >> (n % 8)) & 1U;
 }

@@ -9,12 +9,6 @@
 
 namespace pbvbus::devices {
 
-namespace {
-
-bool is_input(RedIoKind k) { return k == RedIoKind::DI || k == RedIoKind::AI; }
-
-}  // namespace
-
 void HSystemModel::set_redundant_io(const std::vector<RedIoPair>& pairs) {
   std::vector<RedIoPairSpec> specs;
   specs.reserve(pairs.size());

@@ -31,6 +31,8 @@ inline constexpr std::uint16_t kRedIoOverflowPassivated = 0x7966;
 
 enum class RedIoKind : std::uint8_t { DI, AI, DO, AO };
 std::string_view to_string(RedIoKind k);
+/// Inputs (DI, AI) are read from both modules and compared; outputs are written to both.
+inline bool is_input(RedIoKind k) { return k == RedIoKind::DI || k == RedIoKind::AI; }
 
 /// Why a module was passivated.
 enum class RedIoCause : std::uint8_t {

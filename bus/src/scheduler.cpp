@@ -153,74 +153,50 @@ void Scheduler::FnTarget::on_event(Ticks, std::uint64_t tag) {
   if (fn) fn();
 }
 
-bool Scheduler::step() {
-  const Ticks until = kNever;
-  // The earliest pending entry (FIFO or heap, by (when, seq)), if it is due by `until`.
-  {
-    Entry e;
-    if (m_fifo_head != m_fifo.size() &&
-        (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
-         (m_fifo[m_fifo_head].when == m_heap.front().when &&
-          m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
-      if (m_fifo[m_fifo_head].when > until) return false;
-      e = m_fifo[m_fifo_head];
-      if (++m_fifo_head == m_fifo.size()) {
-        m_fifo.clear();
-        m_fifo_head = 0;
-      }
-    } else {
-      if (m_heap.empty() || m_heap.front().when > until) return false;
-      Entry* h = m_heap.data();
-      e = h[0];
-      if (e.slot) e.slot->m_pos = TimerSlot::kNone;
-      const std::size_t n = m_heap.size() - 1;
-      if (n == 1)
-        place(h, 0, h[1]);
-      else if (n > 1)
-        sift_down(0, h[n], n);
-      m_heap.pop_back();
+// Inlined into both callers: run_until's loop pays no call per event for the queue itself.
+[[gnu::always_inline]] inline bool Scheduler::pop_due(Ticks until, Entry& e) {
+  if (m_fifo_head != m_fifo.size() &&
+      (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
+       (m_fifo[m_fifo_head].when == m_heap.front().when &&
+        m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
+    if (m_fifo[m_fifo_head].when > until) return false;
+    e = m_fifo[m_fifo_head];
+    if (++m_fifo_head == m_fifo.size()) {
+      m_fifo.clear();
+      m_fifo_head = 0;
     }
-    m_now = e.when;
-    ++m_events_run;
-    e.target->on_event(e.when, e.tag);
+    return true;
   }
+  if (m_heap.empty() || m_heap.front().when > until) return false;
+  Entry* h = m_heap.data();
+  e = h[0];
+  if (e.slot) e.slot->m_pos = TimerSlot::kNone;
+  const std::size_t n = m_heap.size() - 1;
+  if (n == 1)
+    place(h, 0, h[1]);
+  else if (n > 1)
+    sift_down(0, h[n], n);
+  m_heap.pop_back();
+  return true;
+}
+
+bool Scheduler::step() {
+  Entry e;
+  if (!pop_due(kNever, e)) return false;
+  m_now = e.when;
+  ++m_events_run;
+  e.target->on_event(e.when, e.tag);
   return true;
 }
 
 void Scheduler::run_until(Ticks until) {
-  // The same as calling step() while next_time() <= until, with the pop written out here so
-  // that the loop pays no call per event for the queue itself.
+  // The same as calling step() while next_time() <= until.
   m_stop = false;
-  for (;;) {
-    // The earliest pending entry (FIFO or heap, by (when, seq)), if it is due by `until`.
-    {
-      Entry e;
-      if (m_fifo_head != m_fifo.size() &&
-          (m_heap.empty() || m_fifo[m_fifo_head].when < m_heap.front().when ||
-           (m_fifo[m_fifo_head].when == m_heap.front().when &&
-            m_fifo[m_fifo_head].seq < m_heap.front().seq))) {
-        if (m_fifo[m_fifo_head].when > until) break;
-        e = m_fifo[m_fifo_head];
-        if (++m_fifo_head == m_fifo.size()) {
-          m_fifo.clear();
-          m_fifo_head = 0;
-        }
-      } else {
-        if (m_heap.empty() || m_heap.front().when > until) break;
-        Entry* h = m_heap.data();
-        e = h[0];
-        if (e.slot) e.slot->m_pos = TimerSlot::kNone;
-        const std::size_t n = m_heap.size() - 1;
-        if (n == 1)
-          place(h, 0, h[1]);
-        else if (n > 1)
-          sift_down(0, h[n], n);
-        m_heap.pop_back();
-      }
-      m_now = e.when;
-      ++m_events_run;
-      e.target->on_event(e.when, e.tag);
-    }
+  Entry e;
+  while (pop_due(until, e)) {
+    m_now = e.when;
+    ++m_events_run;
+    e.target->on_event(e.when, e.tag);
     if (m_stop) return;
   }
   if (until > m_now) m_now = until;

@@ -268,13 +268,18 @@ void MpiStation::no_answer(bus::Ticks now, Served& s) {
   if (pool_.disconnect(now, s.sap, out_) != mpi::RequestError::None) return;
   s.reported = true;
   s.pending.clear();
+  report_server_end(now, s.sap, s.peer, EndReason::SessionEnded);
+}
+
+void MpiStation::report_server_end(bus::Ticks now, std::uint8_t sap, std::uint8_t peer,
+                                   EndReason reason) {
   StationEvent ev;
   ev.at = now;
   ev.kind = EventKind::Broken;
   ev.role = Role::Server;
-  ev.local_sap = s.sap;
-  ev.peer = s.peer;
-  ev.reason = EndReason::SessionEnded;
+  ev.local_sap = sap;
+  ev.peer = peer;
+  ev.reason = reason;
   count_end(ev.kind, ev.reason);
   emit(std::move(ev));
 }
@@ -408,15 +413,7 @@ void MpiStation::on_server_event(bus::Ticks now, const mpi::Event& e) {
       emit(std::move(ev));
       if (refused && pool_.disconnect(now, e.local_sap, out_) == mpi::RequestError::None) {
         served(e.local_sap)->reported = true;
-        StationEvent end;
-        end.at = now;
-        end.kind = EventKind::Broken;
-        end.role = Role::Server;
-        end.local_sap = e.local_sap;
-        end.peer = e.peer;
-        end.reason = EndReason::Refused;
-        count_end(end.kind, end.reason);
-        emit(std::move(end));
+        report_server_end(now, e.local_sap, e.peer, EndReason::Refused);
       }
       return;
     }

@@ -102,6 +102,9 @@ class Scheduler {
   void sift_down(std::size_t i, const Entry& e, std::size_t n);
   /// Removes the heap entry at `i`.
   void remove_at(std::size_t i);
+  /// Takes the earliest pending entry (FIFO or heap, by (when, seq)) into `e` if it is due by
+  /// `until`; false (nothing taken) otherwise.
+  bool pop_due(Ticks until, Entry& e);
   class FnTarget final : public EventTarget {
    public:
     explicit FnTarget(Scheduler& s) : m_s(s) {}

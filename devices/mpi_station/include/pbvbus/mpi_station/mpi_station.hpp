@@ -255,6 +255,8 @@ class MpiStation final : public bus::Device {
   void emit(StationEvent ev);
   void deliver();
   void count_end(EventKind kind, EndReason reason);
+  /// Counts and reports the end of a server connection that we disconnected (`reason`).
+  void report_server_end(bus::Ticks now, std::uint8_t sap, std::uint8_t peer, EndReason reason);
   /// Ring watch, connection deadlines and absence timeouts; then flush.
   void run_due(bus::Ticks now);
   void watch_ring(bus::Ticks now);
